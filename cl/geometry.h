@@ -1,0 +1,137 @@
+/* Geometry shared by the OpenCL kernels and the C++ host.
+ *
+ * Written once, compiled twice: as OpenCL C (embedded with the kernels) and as C++ (host
+ * paths, reference implementations, tests), so both sides compute the same numbers.
+ * Only scalar double arithmetic and the vector helpers below are used here; in C++ the
+ * names live in namespace tc::geo.
+ */
+#ifndef TETCOLLAPSE_GEOMETRY_H
+#define TETCOLLAPSE_GEOMETRY_H
+
+#ifdef __OPENCL_C_VERSION__
+#pragma OPENCL EXTENSION cl_khr_fp64 : enable
+#define TC_FN inline
+#define TC_D3(x, y, z) ((double3)((x), (y), (z)))
+typedef double3 tc_d3;
+#else
+#include <cmath>
+namespace tc::geo {
+#define TC_FN inline
+struct tc_d3 {
+  double x, y, z;
+};
+inline tc_d3 operator+(tc_d3 a, tc_d3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline tc_d3 operator-(tc_d3 a, tc_d3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline tc_d3 operator*(tc_d3 a, double s) { return {a.x * s, a.y * s, a.z * s}; }
+inline tc_d3 operator*(double s, tc_d3 a) { return {a.x * s, a.y * s, a.z * s}; }
+inline tc_d3 operator/(tc_d3 a, double s) { return {a.x / s, a.y / s, a.z / s}; }
+inline double dot(tc_d3 a, tc_d3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline tc_d3 cross(tc_d3 a, tc_d3 b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline double length(tc_d3 a) { return std::sqrt(dot(a, a)); }
+inline tc_d3 normalize(tc_d3 a) {
+  double l = length(a);
+  return l > 0 ? a / l : a;
+}
+using std::acos;
+using std::fabs;
+using std::sqrt;
+#define TC_D3(x, y, z) (tc::geo::tc_d3{(x), (y), (z)})
+#endif
+
+/* Point i of a packed xyz array. */
+TC_FN tc_d3 tc_point(const
+#ifdef __OPENCL_C_VERSION__
+                     __global
+#endif
+                     double* p,
+                     int i) {
+  return TC_D3(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
+}
+
+/* Six times the signed volume of (a, b, c, d): positive when d is on the side of the
+ * triangle (a, b, c) its normal (b-a)x(c-a) points to, i.e. the right-hand rule used by
+ * Gmsh, Medit and VTK for positively oriented tets. */
+TC_FN double tc_orient3d(tc_d3 a, tc_d3 b, tc_d3 c, tc_d3 d) {
+  return dot(cross(b - a, c - a), d - a);
+}
+
+TC_FN double tc_tet_volume(tc_d3 a, tc_d3 b, tc_d3 c, tc_d3 d) { return tc_orient3d(a, b, c, d) / 6.0; }
+
+/* Error bound of the floating-point tc_orient3d relative to its "permanent"
+ * (Shewchuk's o3derrboundA): when |det| > bound, the sign is exact. */
+TC_FN double tc_orient3d_errbound(tc_d3 a, tc_d3 b, tc_d3 c, tc_d3 d) {
+  tc_d3 ba = b - a, ca = c - a, da = d - a;
+  double perm = (fabs(ba.y * ca.z) + fabs(ba.z * ca.y)) * fabs(da.x) +
+                (fabs(ba.z * ca.x) + fabs(ba.x * ca.z)) * fabs(da.y) +
+                (fabs(ba.x * ca.y) + fabs(ba.y * ca.x)) * fabs(da.z);
+  const double eps = 1.1102230246251565e-16; /* 2^-53 */
+  return (7.0 + 56.0 * eps) * eps * perm * 2.0; /* x2: the differences are rounded too */
+}
+
+/* Unnormalised normal of triangle (a, b, c); its length is twice the area. */
+TC_FN tc_d3 tc_triangle_normal(tc_d3 a, tc_d3 b, tc_d3 c) { return cross(b - a, c - a); }
+
+/* Faces of a positively oriented tet (v0, v1, v2, v3), each listed so that its normal
+ * points out of the tet. Face i is opposite vertex i. */
+#ifdef __OPENCL_C_VERSION__
+__constant int TC_TET_FACES[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+__constant int TC_TET_EDGES[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+#else
+constexpr int TC_TET_FACES[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
+constexpr int TC_TET_EDGES[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+#endif
+
+/* Interior dihedral angle (radians) at edge (a, b) of tet (a, b, c, d). */
+TC_FN double tc_dihedral_angle(tc_d3 a, tc_d3 b, tc_d3 c, tc_d3 d) {
+  tc_d3 e = b - a;
+  tc_d3 n1 = cross(e, c - a); /* normal of face (a, b, c) */
+  tc_d3 n2 = cross(e, d - a); /* normal of face (a, b, d) */
+  double l1 = length(n1), l2 = length(n2);
+  if (l1 <= 0.0 || l2 <= 0.0) return 0.0;
+  double cosang = dot(n1, n2) / (l1 * l2);
+  if (cosang > 1.0) cosang = 1.0;
+  if (cosang < -1.0) cosang = -1.0;
+  return acos(cosang);
+}
+
+/* Smallest of the six interior dihedral angles (radians). */
+TC_FN double tc_min_dihedral(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3) {
+  double m = tc_dihedral_angle(p0, p1, p2, p3);
+  double t;
+  t = tc_dihedral_angle(p0, p2, p1, p3); m = t < m ? t : m;
+  t = tc_dihedral_angle(p0, p3, p1, p2); m = t < m ? t : m;
+  t = tc_dihedral_angle(p1, p2, p0, p3); m = t < m ? t : m;
+  t = tc_dihedral_angle(p1, p3, p0, p2); m = t < m ? t : m;
+  t = tc_dihedral_angle(p2, p3, p0, p1); m = t < m ? t : m;
+  return m;
+}
+
+/* Largest of the six interior dihedral angles (radians). */
+TC_FN double tc_max_dihedral(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3) {
+  double m = tc_dihedral_angle(p0, p1, p2, p3);
+  double t;
+  t = tc_dihedral_angle(p0, p2, p1, p3); m = t > m ? t : m;
+  t = tc_dihedral_angle(p0, p3, p1, p2); m = t > m ? t : m;
+  t = tc_dihedral_angle(p1, p2, p0, p3); m = t > m ? t : m;
+  t = tc_dihedral_angle(p1, p3, p0, p2); m = t > m ? t : m;
+  t = tc_dihedral_angle(p2, p3, p0, p1); m = t > m ? t : m;
+  return m;
+}
+
+/* Mean-ratio style quality 6*sqrt(2)*V / l_rms^3: 1 for a regular tet, -> 0 for slivers,
+ * negative when inverted (the "qmin" of ../shared/meshes/SOURCES.md). */
+TC_FN double tc_tet_quality(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3) {
+  double s = dot(p1 - p0, p1 - p0) + dot(p2 - p0, p2 - p0) + dot(p3 - p0, p3 - p0) +
+             dot(p2 - p1, p2 - p1) + dot(p3 - p1, p3 - p1) + dot(p3 - p2, p3 - p2);
+  double lrms = sqrt(s / 6.0);
+  if (lrms <= 0.0) return 0.0;
+  return 6.0 * sqrt(2.0) * tc_tet_volume(p0, p1, p2, p3) / (lrms * lrms * lrms);
+}
+
+#ifndef __OPENCL_C_VERSION__
+}  // namespace tc::geo
+#endif
+
+#endif /* TETCOLLAPSE_GEOMETRY_H */

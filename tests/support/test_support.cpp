@@ -1,0 +1,116 @@
+#include "test_support.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <sys/wait.h>
+
+namespace tc::test {
+
+std::string shared_meshes_dir() {
+  std::filesystem::path p(TC_SHARED_MESHES);
+  std::error_code ec;
+  if (std::filesystem::is_directory(p, ec)) return p.string();
+  return "";
+}
+
+std::string shared_mesh(const std::string& name) {
+  std::string dir = shared_meshes_dir();
+  if (dir.empty()) return "";
+  std::filesystem::path p = std::filesystem::path(dir) / name;
+  std::error_code ec;
+  return std::filesystem::exists(p, ec) ? p.string() : "";
+}
+
+std::vector<std::string> shared_volume_meshes() {
+  std::vector<std::string> out;
+  std::string dir = shared_meshes_dir();
+  if (dir.empty()) return out;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    if (!e.is_regular_file()) continue;
+    std::string ext = e.path().extension().string();
+    if (ext == ".msh" || ext == ".mesh" || ext == ".vtk" || ext == ".vtu") out.push_back(e.path().string());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::string project_mesh(const std::string& name) { return (std::filesystem::path(TC_PROJECT_MESHES) / name).string(); }
+
+TempDir::TempDir() {
+  std::random_device rd;
+  path_ = std::filesystem::temp_directory_path() / ("tctest_" + std::to_string(rd()) + std::to_string(rd()));
+  std::filesystem::create_directories(path_);
+}
+TempDir::~TempDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(path_, ec);
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream o(path, std::ios::binary);
+  o << text;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream i(path, std::ios::binary);
+  std::stringstream s;
+  s << i.rdbuf();
+  return s.str();
+}
+
+Mesh single_tet() {
+  Mesh m;
+  m.points = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  m.tets = {0, 1, 2, 3};
+  return m;
+}
+
+Mesh cube_tets(int n) {
+  Mesh m;
+  auto id = [n](int i, int j, int k) { return int32_t((k * (n + 1) + j) * (n + 1) + i); };
+  for (int k = 0; k <= n; ++k)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) {
+        m.points.push_back(double(i) / n);
+        m.points.push_back(double(j) / n);
+        m.points.push_back(double(k) / n);
+      }
+  // Kuhn subdivision: 6 tets around the main diagonal, all positively oriented.
+  static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        for (const auto& p : perms) {
+          std::array<int, 3> c = {i, j, k};
+          int32_t v[4];
+          v[0] = id(c[0], c[1], c[2]);
+          for (int s = 0; s < 3; ++s) {
+            c[p[s]] += 1;
+            v[s + 1] = id(c[0], c[1], c[2]);
+          }
+          // Orientation of the path tet depends on the parity of the permutation.
+          bool odd = (p[0] == 0 && p[1] == 2) || (p[0] == 1 && p[1] == 0) || (p[0] == 2 && p[1] == 1);
+          if (odd) std::swap(v[2], v[3]);
+          m.tets.insert(m.tets.end(), v, v + 4);
+        }
+  return m;
+}
+
+int run_command(const std::string& cmd, std::string* output) {
+  std::string full = cmd + " 2>&1";
+  FILE* p = popen(full.c_str(), "r");
+  if (!p) return -1;
+  std::array<char, 4096> buf;
+  std::string out;
+  size_t n;
+  while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  int st = pclose(p);
+  if (output) *output = out;
+  return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+}  // namespace tc::test

@@ -1,0 +1,49 @@
+// Helpers shared by the test executables.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "tetcollapse/mesh.hpp"
+
+namespace tc::test {
+
+// ../shared/meshes beside the project, or "" when absent (tests then GTEST_SKIP with a message).
+std::string shared_meshes_dir();
+// Full path of a shared mesh, or "" when the folder or the file is absent.
+std::string shared_mesh(const std::string& name);
+// Every volume mesh file of ../shared/meshes (not .sol, not surfaces/ or cad/).
+std::vector<std::string> shared_volume_meshes();
+// meshes/ of this project.
+std::string project_mesh(const std::string& name);
+
+// A fresh temporary folder, removed when the object dies.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+void write_text(const std::string& path, const std::string& text);
+std::string read_text(const std::string& path);
+
+// Small meshes built in code.
+Mesh single_tet();             // the unit right-corner tet, positively oriented
+Mesh cube_tets(int n);         // [0,1]^3 split into n^3 cubes of 6 tets each (Kuhn), labels none
+
+// Runs a shell command, returns its exit code; its stdout+stderr go into *output.
+int run_command(const std::string& cmd, std::string* output);
+
+}  // namespace tc::test
+
+#define TC_SKIP_IF_NO_SHARED()                                                                       \
+  do {                                                                                               \
+    if (tc::test::shared_meshes_dir().empty())                                                       \
+      GTEST_SKIP() << "../shared/meshes is not present beside the project; shared-mesh test skipped"; \
+  } while (0)
