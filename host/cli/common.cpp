@@ -1,0 +1,48 @@
+#include "cli/common.hpp"
+
+#include <iostream>
+
+namespace tc::cli {
+
+void add_input_options(CLI::App& cmd, InputOptions& o) {
+  cmd.add_option("--format", o.format,
+                 "Input format instead of the one the extension names: msh, mesh, meshb, vtk, vtu, node");
+  cmd.add_flag("--fix-orientation", o.fix_orientation,
+               "When tets are mixed positive and negative, flip the negative ones instead of refusing the mesh");
+  cmd.add_flag("--no-sol", o.no_sol, "Medit: do not read the .sol file beside the .mesh");
+}
+
+Mesh read_input(const std::string& path, const InputOptions& o, bool quiet) {
+  ReadOptions ro;
+  if (!o.format.empty()) ro.format = parse_format(o.format);
+  ro.orientation = o.fix_orientation ? OrientationPolicy::Fix : OrientationPolicy::Refuse;
+  ro.read_sol = !o.no_sol;
+  ReadNotes notes;
+  Mesh m = read_mesh(path, ro, &notes);
+  if (!quiet)
+    for (const auto& n : notes.notes) std::cerr << path << ": note: " << n << "\n";
+  return m;
+}
+
+void add_output_options(CLI::App& cmd, OutputOptions& o) {
+  cmd.add_option("--out-format", o.format,
+                 "Output format instead of the one the extension names: msh, mesh, meshb, vtk, vtu, node");
+  cmd.add_flag("--ascii", o.ascii, "Write text instead of binary where the format has both");
+  cmd.add_option("--gmsh-version", o.gmsh_version, "Gmsh output version: 41 (default) or 22")
+      ->check(CLI::IsMember({22, 41}));
+  cmd.add_option("--vtu-encoding", o.vtu_encoding, "VTU data: appended (raw, default), base64 or ascii")
+      ->check(CLI::IsMember({"appended", "base64", "ascii"}));
+}
+
+WriteOptions write_options(const OutputOptions& o) {
+  WriteOptions w;
+  if (!o.format.empty()) w.format = parse_format(o.format);
+  w.binary = !o.ascii;
+  w.gmsh_version = o.gmsh_version;
+  if (o.ascii || o.vtu_encoding == "ascii") w.vtu_encoding = WriteOptions::VtuEncoding::Ascii;
+  else if (o.vtu_encoding == "base64") w.vtu_encoding = WriteOptions::VtuEncoding::Base64;
+  else w.vtu_encoding = WriteOptions::VtuEncoding::Appended;
+  return w;
+}
+
+}  // namespace tc::cli

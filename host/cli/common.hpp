@@ -1,0 +1,46 @@
+// Pieces shared by the subcommands of the tetcollapse command line.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+#include "tetcollapse/io.hpp"
+
+namespace tc::cli {
+
+// Exit codes, documented in README.md.
+enum ExitCode : int {
+  kOk = 0,
+  kCheckFailed = 1,   // the mesh (or the result) failed a validity check
+  kBadInput = 2,      // unreadable input, bad usage
+  kDeviceError = 3,   // OpenCL / device failure
+  kOutputError = 4,   // the result could not be written (nothing half-written is left)
+};
+
+// Options every subcommand that reads a mesh shares.
+struct InputOptions {
+  std::string format;            // "" = from the extension
+  bool fix_orientation = false;  // flip negatively oriented tets of a mixed mesh
+  bool no_sol = false;
+};
+void add_input_options(CLI::App& cmd, InputOptions& o);
+Mesh read_input(const std::string& path, const InputOptions& o, bool quiet);
+
+struct OutputOptions {
+  std::string format;
+  bool ascii = false;
+  int gmsh_version = 41;
+  std::string vtu_encoding = "appended";
+};
+void add_output_options(CLI::App& cmd, OutputOptions& o);
+WriteOptions write_options(const OutputOptions& o);
+
+// Registration of each subcommand: adds it to `app` and returns a flag set when it ran.
+void register_info(CLI::App& app, int& exit_code);
+void register_convert(CLI::App& app, int& exit_code);
+void register_devices(CLI::App& app, int& exit_code);
+void register_check(CLI::App& app, int& exit_code);
+void register_features(CLI::App& app, int& exit_code);
+
+}  // namespace tc::cli

@@ -1,0 +1,99 @@
+// The command line as a user meets it: exit codes, messages, --help, --json keys.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "test_support.hpp"
+
+namespace {
+
+using tc::test::run_command;
+
+std::string cli() { return std::string("'") + TC_CLI + "'"; }
+std::string q(const std::string& s) { return "'" + s + "'"; }
+
+TEST(Cli, VersionAndHelp) {
+  std::string out;
+  EXPECT_EQ(run_command(cli() + " --version", &out), 0);
+  EXPECT_NE(out.find("tetcollapse " TETCOLLAPSE_VERSION), std::string::npos) << out;
+  EXPECT_EQ(run_command(cli() + " --help", &out), 0);
+  for (const char* sub : {"info", "convert", "devices", "features"}) EXPECT_NE(out.find(sub), std::string::npos) << sub;
+  EXPECT_NE(out.find("Exit codes"), std::string::npos);
+  EXPECT_EQ(run_command(cli() + " info --help", &out), 0);
+  EXPECT_NE(out.find("--json"), std::string::npos) << out;
+  EXPECT_EQ(run_command(cli() + " convert --help", &out), 0);
+  EXPECT_NE(out.find("--ascii"), std::string::npos) << out;
+}
+
+TEST(Cli, UsageErrorsExitWithTwo) {
+  std::string out;
+  EXPECT_EQ(run_command(cli(), &out), 2);
+  EXPECT_EQ(run_command(cli() + " frobnicate", &out), 2);
+  EXPECT_EQ(run_command(cli() + " info", &out), 2);  // MESH missing
+  EXPECT_NE(out.find("MESH"), std::string::npos) << out;
+}
+
+TEST(Cli, InfoJsonHasTheDocumentedKeys) {
+  std::string out;
+  ASSERT_EQ(run_command(cli() + " info --json " + q(tc::test::project_mesh("tet.mesh")), &out), 0) << out;
+  for (const char* key : {"\"vertices\":4", "\"tets\":1", "\"edges\":6", "\"boundary_faces\":4", "\"edge_length\":{",
+                          "\"min\":1", "\"max\":1.4142135623730951", "\"volume\":0.16666666666666666",
+                          "\"min_dihedral_deg\":", "\"face_vertices\":0", "\"corner_vertices\":4",
+                          "\"ridge_edges\":6"})
+    EXPECT_NE(out.find(key), std::string::npos) << key << " not in " << out;
+}
+
+TEST(Cli, InfoReportsLabelsOfTwoMaterials) {
+  std::string out;
+  ASSERT_EQ(run_command(cli() + " info --json " + q(tc::test::project_mesh("two_tets.mesh")), &out), 0) << out;
+  EXPECT_NE(out.find("\"medit:ref\":{\"1\":1,\"2\":1}"), std::string::npos) << out;
+  EXPECT_NE(out.find("\"interface_faces\":1"), std::string::npos) << out;
+}
+
+TEST(Cli, BadInputNamesFileAndLineAndExitsWithTwo) {
+  tc::test::TempDir dir;
+  std::string out;
+  EXPECT_EQ(run_command(cli() + " info " + q(dir.file("missing.msh")), &out), 2);
+  EXPECT_NE(out.find("missing.msh"), std::string::npos) << out;
+
+  std::string bad = dir.file("bad.mesh");
+  tc::test::write_text(bad, "MeshVersionFormatted 2\nDimension 3\nVertices\n4\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\n"
+                            "Tetrahedra\n1\n1 2 3 9 1\nEnd\n");
+  EXPECT_EQ(run_command(cli() + " info " + q(bad), &out), 2);
+  EXPECT_NE(out.find("bad.mesh:"), std::string::npos) << out;
+  EXPECT_NE(out.find("9"), std::string::npos) << out;
+
+  std::string unknown = dir.file("mesh.xyz");
+  tc::test::write_text(unknown, "hello");
+  EXPECT_EQ(run_command(cli() + " info " + q(unknown), &out), 2);
+  EXPECT_NE(out.find("unknown file extension"), std::string::npos) << out;
+}
+
+TEST(Cli, ConvertRoundTripsAndNeverLeavesHalfFiles) {
+  tc::test::TempDir dir;
+  std::string out;
+  std::string vtu = dir.file("tet.vtu");
+  ASSERT_EQ(run_command(cli() + " convert " + q(tc::test::project_mesh("two_tets.mesh")) + " " + q(vtu), &out), 0) << out;
+  ASSERT_EQ(run_command(cli() + " info --json " + q(vtu), &out), 0) << out;
+  EXPECT_NE(out.find("\"tets\":2"), std::string::npos) << out;
+  // A target folder that does not exist: exit 4, nothing written.
+  std::string nowhere = dir.file("no/such/folder/out.msh");
+  EXPECT_EQ(run_command(cli() + " convert " + q(tc::test::project_mesh("tet.mesh")) + " " + q(nowhere), &out), 4);
+  EXPECT_FALSE(std::filesystem::exists(nowhere));
+  // Failed conversion leaves no temporary files in the folder.
+  int files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path())) {
+    (void)e;
+    ++files;
+  }
+  EXPECT_EQ(files, 1);  // tet.vtu only
+}
+
+TEST(Cli, DefaultMeshInfo) {
+  std::string out;
+  ASSERT_EQ(run_command(cli() + " info --json " + q(tc::test::project_mesh("bracket.msh")), &out), 0) << out;
+  EXPECT_NE(out.find("\"tets\":23925"), std::string::npos) << out;
+  EXPECT_NE(out.find("\"vertices\":5580"), std::string::npos) << out;
+}
+
+}  // namespace
