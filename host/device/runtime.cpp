@@ -1,0 +1,408 @@
+// OpenCL runtime: listing, selection, context, program build with the on-disk binary cache.
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "device/program_cache.hpp"
+#include "tetcollapse/device.hpp"
+
+namespace tc::kernels {
+const char* find(const char* name);
+}
+
+namespace tc {
+
+const char* cl_error_name(int code) {
+  switch (code) {
+#define TC_CASE(x) \
+  case x:          \
+    return #x;
+    TC_CASE(CL_SUCCESS)
+    TC_CASE(CL_DEVICE_NOT_FOUND)
+    TC_CASE(CL_DEVICE_NOT_AVAILABLE)
+    TC_CASE(CL_COMPILER_NOT_AVAILABLE)
+    TC_CASE(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+    TC_CASE(CL_OUT_OF_RESOURCES)
+    TC_CASE(CL_OUT_OF_HOST_MEMORY)
+    TC_CASE(CL_PROFILING_INFO_NOT_AVAILABLE)
+    TC_CASE(CL_MEM_COPY_OVERLAP)
+    TC_CASE(CL_IMAGE_FORMAT_MISMATCH)
+    TC_CASE(CL_IMAGE_FORMAT_NOT_SUPPORTED)
+    TC_CASE(CL_BUILD_PROGRAM_FAILURE)
+    TC_CASE(CL_MAP_FAILURE)
+    TC_CASE(CL_MISALIGNED_SUB_BUFFER_OFFSET)
+    TC_CASE(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+    TC_CASE(CL_COMPILE_PROGRAM_FAILURE)
+    TC_CASE(CL_LINKER_NOT_AVAILABLE)
+    TC_CASE(CL_LINK_PROGRAM_FAILURE)
+    TC_CASE(CL_DEVICE_PARTITION_FAILED)
+    TC_CASE(CL_KERNEL_ARG_INFO_NOT_AVAILABLE)
+    TC_CASE(CL_INVALID_VALUE)
+    TC_CASE(CL_INVALID_DEVICE_TYPE)
+    TC_CASE(CL_INVALID_PLATFORM)
+    TC_CASE(CL_INVALID_DEVICE)
+    TC_CASE(CL_INVALID_CONTEXT)
+    TC_CASE(CL_INVALID_QUEUE_PROPERTIES)
+    TC_CASE(CL_INVALID_COMMAND_QUEUE)
+    TC_CASE(CL_INVALID_HOST_PTR)
+    TC_CASE(CL_INVALID_MEM_OBJECT)
+    TC_CASE(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR)
+    TC_CASE(CL_INVALID_IMAGE_SIZE)
+    TC_CASE(CL_INVALID_SAMPLER)
+    TC_CASE(CL_INVALID_BINARY)
+    TC_CASE(CL_INVALID_BUILD_OPTIONS)
+    TC_CASE(CL_INVALID_PROGRAM)
+    TC_CASE(CL_INVALID_PROGRAM_EXECUTABLE)
+    TC_CASE(CL_INVALID_KERNEL_NAME)
+    TC_CASE(CL_INVALID_KERNEL_DEFINITION)
+    TC_CASE(CL_INVALID_KERNEL)
+    TC_CASE(CL_INVALID_ARG_INDEX)
+    TC_CASE(CL_INVALID_ARG_VALUE)
+    TC_CASE(CL_INVALID_ARG_SIZE)
+    TC_CASE(CL_INVALID_KERNEL_ARGS)
+    TC_CASE(CL_INVALID_WORK_DIMENSION)
+    TC_CASE(CL_INVALID_WORK_GROUP_SIZE)
+    TC_CASE(CL_INVALID_WORK_ITEM_SIZE)
+    TC_CASE(CL_INVALID_GLOBAL_OFFSET)
+    TC_CASE(CL_INVALID_EVENT_WAIT_LIST)
+    TC_CASE(CL_INVALID_EVENT)
+    TC_CASE(CL_INVALID_OPERATION)
+    TC_CASE(CL_INVALID_GL_OBJECT)
+    TC_CASE(CL_INVALID_BUFFER_SIZE)
+    TC_CASE(CL_INVALID_MIP_LEVEL)
+    TC_CASE(CL_INVALID_GLOBAL_WORK_SIZE)
+    TC_CASE(CL_INVALID_PROPERTY)
+    TC_CASE(CL_INVALID_IMAGE_DESCRIPTOR)
+    TC_CASE(CL_INVALID_COMPILER_OPTIONS)
+    TC_CASE(CL_INVALID_LINKER_OPTIONS)
+    TC_CASE(CL_INVALID_DEVICE_PARTITION_COUNT)
+#undef TC_CASE
+    case -1001:
+      return "CL_PLATFORM_NOT_FOUND_KHR";
+    default: {
+      thread_local char buf[32];
+      std::snprintf(buf, sizeof buf, "CL_ERROR(%d)", code);
+      return buf;
+    }
+  }
+}
+
+namespace detail {
+void rethrow_cl_error(const cl::Error& e, const char* what) {
+  std::string call = e.what() ? e.what() : "OpenCL call";
+  throw DeviceError(call + "(" + what + "): " + cl_error_name(e.err()));
+}
+}  // namespace detail
+
+namespace {
+
+const char* kNoDriver =
+    "no OpenCL device found: install an OpenCL driver (e.g. the Debian package pocl-opencl-icd for the CPU, "
+    "or your GPU vendor's OpenCL ICD) and check `clinfo -l`";
+
+bool has_token(const std::string& list, const char* token) {
+  std::istringstream in(list);
+  std::string t;
+  while (in >> t)
+    if (t == token) return true;
+  return false;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string trim(std::string s) {
+  while (!s.empty() && std::isspace(static_cast<unsigned char>(s.back()))) s.pop_back();
+  size_t i = 0;
+  while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
+  return s.substr(i);
+}
+
+struct Found {
+  DeviceInfo info;
+  cl::Platform platform;
+  cl::Device device;
+};
+
+std::vector<Found> enumerate() {
+  std::vector<cl::Platform> platforms;
+  try {
+    cl::Platform::get(&platforms);
+  } catch (const cl::Error& e) {
+    // The ICD loader reports CL_PLATFORM_NOT_FOUND_KHR when no driver is installed.
+    throw DeviceError(std::string(kNoDriver) + " [clGetPlatformIDs: " + cl_error_name(e.err()) + "]");
+  }
+  std::vector<Found> out;
+  int pi = 0;
+  for (cl::Platform& p : platforms) {
+    std::vector<cl::Device> devices;
+    try {
+      p.getDevices(CL_DEVICE_TYPE_ALL, &devices);
+    } catch (const cl::Error&) {
+      devices.clear();  // CL_DEVICE_NOT_FOUND: a platform without devices
+    }
+    for (cl::Device& d : devices) {
+      detail::cl_call("clGetDeviceInfo", [&] {
+        DeviceInfo i;
+        i.index = static_cast<int>(out.size());
+        i.platform_index = pi;
+        i.platform_name = trim(p.getInfo<CL_PLATFORM_NAME>());
+        i.platform_vendor = trim(p.getInfo<CL_PLATFORM_VENDOR>());
+        i.platform_version = trim(p.getInfo<CL_PLATFORM_VERSION>());
+        i.name = trim(d.getInfo<CL_DEVICE_NAME>());
+        i.vendor = trim(d.getInfo<CL_DEVICE_VENDOR>());
+        i.driver_version = trim(d.getInfo<CL_DRIVER_VERSION>());
+        i.device_version = trim(d.getInfo<CL_DEVICE_VERSION>());
+        i.opencl_c_version = trim(d.getInfo<CL_DEVICE_OPENCL_C_VERSION>());
+        cl_device_type t = d.getInfo<CL_DEVICE_TYPE>();
+        i.type = (t & CL_DEVICE_TYPE_GPU)           ? "GPU"
+                 : (t & CL_DEVICE_TYPE_CPU)         ? "CPU"
+                 : (t & CL_DEVICE_TYPE_ACCELERATOR) ? "ACCELERATOR"
+                                                    : "OTHER";
+        i.compute_units = d.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>();
+        i.global_mem_bytes = d.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>();
+        i.local_mem_bytes = d.getInfo<CL_DEVICE_LOCAL_MEM_SIZE>();
+        i.max_alloc_bytes = d.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+        i.max_work_group_size = d.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>();
+        std::string ext = d.getInfo<CL_DEVICE_EXTENSIONS>();
+        cl_device_fp_config fp = 0;
+        try {
+          fp = d.getInfo<CL_DEVICE_DOUBLE_FP_CONFIG>();
+        } catch (const cl::Error&) {
+          fp = 0;  // a 1.2 device without fp64 may reject the query
+        }
+        i.fp64 = has_token(ext, "cl_khr_fp64") || fp != 0;
+        i.int64_atomics_base = has_token(ext, "cl_khr_int64_base_atomics");
+        i.int64_atomics_extended = has_token(ext, "cl_khr_int64_extended_atomics");
+        out.push_back({std::move(i), p, d});
+      });
+    }
+    ++pi;
+  }
+  if (out.empty()) throw DeviceError(kNoDriver);
+  return out;
+}
+
+std::string describe_all(const std::vector<Found>& all) {
+  std::string s;
+  for (const Found& f : all)
+    s += "\n  " + std::to_string(f.info.index) + ": " + f.info.name + " (" + f.info.vendor + ", " + f.info.platform_name +
+         ", " + f.info.type + (f.info.fp64 ? "" : ", no fp64") + ")";
+  return s;
+}
+
+const Found& choose(const std::vector<Found>& all, std::string spec) {
+  std::string origin = "--device";
+  if (trim(spec).empty()) {
+    const char* env = std::getenv("TETCOLLAPSE_DEVICE");
+    if (env && *env) {
+      spec = env;
+      origin = "TETCOLLAPSE_DEVICE";
+    }
+  }
+  spec = trim(spec);
+  const Found* pick = nullptr;
+  if (!spec.empty()) {
+    bool digits = std::all_of(spec.begin(), spec.end(), [](unsigned char c) { return std::isdigit(c); });
+    if (digits) {
+      unsigned long idx = spec.size() > 9 ? ~0ul : std::stoul(spec);
+      if (idx >= all.size())
+        throw DeviceError(origin + " " + spec + ": no device with that index; devices are:" + describe_all(all));
+      pick = &all[idx];
+    } else {
+      std::string needle = lower(spec);
+      for (const Found& f : all) {
+        if (lower(f.info.name).find(needle) != std::string::npos ||
+            lower(f.info.vendor).find(needle) != std::string::npos ||
+            lower(f.info.platform_name).find(needle) != std::string::npos) {
+          pick = &f;
+          break;
+        }
+      }
+      if (!pick)
+        throw DeviceError(origin + " '" + spec + "': no device name, vendor or platform contains it; devices are:" +
+                          describe_all(all));
+    }
+    if (!pick->info.fp64)
+      throw DeviceError("device " + std::to_string(pick->info.index) + " '" + pick->info.name +
+                        "' has no double precision (cl_khr_fp64), which tetcollapse needs; choose another with "
+                        "--device or TETCOLLAPSE_DEVICE:" + describe_all(all));
+    return *pick;
+  }
+  // Automatic choice: the first GPU with fp64, else the first CPU with fp64, else any with fp64.
+  for (const char* type : {"GPU", "CPU"})
+    for (const Found& f : all)
+      if (f.info.type == type && f.info.fp64) return f;
+  for (const Found& f : all)
+    if (f.info.fp64) return f;
+  throw DeviceError("no OpenCL device with double precision (cl_khr_fp64) found; tetcollapse needs fp64. Devices are:" +
+                    describe_all(all));
+}
+
+// Replaces each line `#include "name"` by the embedded text of name (once per name), since
+// kernels are compiled from memory and have no file path to include from.
+void expand(const std::string& name, std::string& out, std::set<std::string>& seen, int depth) {
+  const char* text = kernels::find(name.c_str());
+  if (!text) throw DeviceError("embedded kernel file '" + name + "' not found (is it in cl/?)");
+  if (depth > 16) throw DeviceError("kernel file '" + name + "': #include nesting too deep");
+  std::istringstream in(text);
+  std::string line;
+  while (std::getline(in, line)) {
+    std::string t = trim(line);
+    if (t.rfind("#include", 0) == 0) {
+      size_t a = t.find('"'), b = a == std::string::npos ? a : t.find('"', a + 1);
+      if (b != std::string::npos) {
+        std::string inc = t.substr(a + 1, b - a - 1);
+        if (seen.insert(inc).second) expand(inc, out, seen, depth + 1);
+        out += "\n";
+        continue;
+      }
+    }
+    out += line;
+    out += '\n';
+  }
+}
+
+}  // namespace
+
+std::vector<DeviceInfo> list_devices() {
+  std::vector<DeviceInfo> out;
+  for (Found& f : enumerate()) out.push_back(std::move(f.info));
+  return out;
+}
+
+DeviceInfo select_device(const std::string& spec) {
+  auto all = enumerate();
+  return choose(all, spec).info;
+}
+
+Context::Context(const std::string& spec) {
+  auto all = enumerate();
+  const Found& f = choose(all, spec);
+  info_ = f.info;
+  platform_ = f.platform;
+  device_ = f.device;
+  init(info_);
+}
+
+Context::Context(const DeviceInfo& info) {
+  auto all = enumerate();
+  if (info.index < 0 || static_cast<size_t>(info.index) >= all.size() || all[info.index].info.name != info.name)
+    throw DeviceError("device " + std::to_string(info.index) + " '" + info.name + "' is no longer present");
+  const Found& f = all[info.index];
+  if (!f.info.fp64) throw DeviceError("device '" + f.info.name + "' has no double precision (cl_khr_fp64)");
+  info_ = f.info;
+  platform_ = f.platform;
+  device_ = f.device;
+  init(info_);
+}
+
+Context::~Context() = default;
+
+void Context::init(const DeviceInfo&) {
+  detail::cl_call("clCreateContext", [&] { context_ = cl::Context(device_); });
+  detail::cl_call("clCreateCommandQueue", [&] { queue_ = cl::CommandQueue(context_, device_); });
+}
+
+size_t Context::group_size_for(const cl::Kernel& kernel) const {
+  size_t limit = info_.max_work_group_size;
+  detail::cl_call("clGetKernelWorkGroupInfo", [&] {
+    limit = std::min(limit, kernel.getWorkGroupInfo<CL_KERNEL_WORK_GROUP_SIZE>(device_));
+  });
+  size_t want = work_group_size_ ? work_group_size_ : 128;
+  want = std::min(want, std::max<size_t>(limit, 1));
+  size_t p = 1;
+  while (p * 2 <= want) p *= 2;
+  return p;
+}
+
+void Context::launch(cl::Kernel& kernel, size_t n, const char* what, size_t local) {
+  if (n == 0) return;
+  if (local == 0) local = group_size_for(kernel);
+  size_t global = (n + local - 1) / local * local;
+  detail::cl_call(what, [&] {
+    queue_.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(local));
+  });
+}
+
+void Context::finish() {
+  detail::cl_call("queue", [&] { queue_.finish(); });
+}
+
+std::string Context::cache_dir() {
+  if (const char* d = std::getenv("TETCOLLAPSE_CACHE_DIR"); d && *d) return d;
+  if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return (std::filesystem::path(x) / "tetcollapse").string();
+  if (const char* h = std::getenv("HOME"); h && *h) return (std::filesystem::path(h) / ".cache" / "tetcollapse").string();
+  return "";
+}
+
+cl::Program& Context::program(const std::string& file, const std::string& options) {
+  auto key = std::make_pair(file, options);
+  if (auto it = programs_.find(key); it != programs_.end()) {
+    last_build_source_ = BuildSource::Memory;
+    return it->second;
+  }
+  std::string source;
+  std::set<std::string> seen{file};
+  expand(file, source, seen, 0);
+  std::string opts = "-cl-std=CL1.2";
+  if (!options.empty()) opts += " " + options;
+
+  std::string cache_key = info_.name + '\n' + info_.vendor + '\n' + info_.driver_version + '\n' + info_.platform_version +
+                          '\n' + opts + '\n' + source;
+  device_detail::ProgramCache cache(cache_dir(), cache_key);
+
+  cl::Program prog;
+  bool built = false;
+  if (auto binary = cache.load()) {
+    try {
+      cl::Program::Binaries bins{*binary};
+      std::vector<cl_int> status;
+      prog = cl::Program(context_, {device_}, bins, &status);
+      prog.build({device_}, opts.c_str());
+      built = true;
+      last_build_source_ = BuildSource::DiskCache;
+    } catch (const cl::Error&) {
+      built = false;  // a stale or corrupt binary: rebuild from source below
+    }
+  }
+  if (!built) {
+    detail::cl_call(("clCreateProgramWithSource(" + file + ")").c_str(), [&] { prog = cl::Program(context_, source); });
+    try {
+      prog.build({device_}, opts.c_str());
+    } catch (const cl::Error& e) {
+      std::string log;
+      try {
+        log = prog.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
+      } catch (const cl::Error&) {
+        log = "(no build log)";
+      }
+      throw DeviceError("clBuildProgram(" + file + "): " + cl_error_name(e.err()) + " on '" + info_.name +
+                        "' with options '" + opts + "'; build log:\n" + log);
+    }
+    last_build_source_ = BuildSource::Source;
+    try {
+      auto bins = prog.getInfo<CL_PROGRAM_BINARIES>();
+      if (bins.size() == 1 && !bins[0].empty()) cache.store(bins[0]);
+    } catch (const cl::Error&) {
+      // Binaries are an optimisation; a device that cannot return them just recompiles.
+    }
+  }
+  return programs_.emplace(key, std::move(prog)).first->second;
+}
+
+cl::Kernel Context::kernel(const std::string& file, const std::string& name, const std::string& options) {
+  cl::Program& p = program(file, options);
+  cl::Kernel k;
+  detail::cl_call(("clCreateKernel(" + name + ")").c_str(), [&] { k = cl::Kernel(p, name.c_str()); });
+  return k;
+}
+
+}  // namespace tc

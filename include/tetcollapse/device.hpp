@@ -1,0 +1,204 @@
+// OpenCL runtime: device listing and selection, a context with its queue, programs built
+// from the embedded kernels (cached on disk), and a typed device buffer.
+//
+// Everything targets OpenCL 1.2 with fp64 so that the same code runs on PoCL and on any GPU.
+// Every OpenCL failure surfaces as tc::DeviceError whose message names the call and the
+// error, e.g. "clEnqueueNDRangeKernel(scan_blocks): CL_INVALID_WORK_GROUP_SIZE".
+#pragma once
+
+// Include <CL/opencl.hpp> only through this header. The Debian bindings (opencl-clhpp-headers
+// 3.0~2023.02.06) fail to compile with TARGET=300 and MINIMUM=120: CommandQueue calls
+// detail::getContextPlatformVersion, which the header only defines when MINIMUM < 120. With
+// MINIMUM=110 the bindings decide at run time (per platform) whether the 2.0 entry points exist,
+// which is what an OpenCL 1.2 baseline needs anyway.
+#if defined(CL_HPP_MINIMUM_OPENCL_VERSION) && CL_HPP_MINIMUM_OPENCL_VERSION == 120 && \
+    defined(CL_HPP_TARGET_OPENCL_VERSION) && CL_HPP_TARGET_OPENCL_VERSION >= 200
+#undef CL_HPP_MINIMUM_OPENCL_VERSION
+#define CL_HPP_MINIMUM_OPENCL_VERSION 110
+#endif
+#include <CL/opencl.hpp>
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tetcollapse/error.hpp"
+
+namespace tc {
+
+// One OpenCL device as listed by `tetcollapse devices`.
+struct DeviceInfo {
+  int index = 0;                 // global index over all platforms, as used by --device INDEX
+  int platform_index = 0;
+  std::string platform_name, platform_vendor, platform_version;
+  std::string name, vendor, driver_version, device_version, opencl_c_version;
+  std::string type;              // "GPU", "CPU", "ACCELERATOR" or "OTHER"
+  uint32_t compute_units = 0;
+  uint64_t global_mem_bytes = 0, local_mem_bytes = 0, max_alloc_bytes = 0;
+  size_t max_work_group_size = 0;
+  bool fp64 = false;                   // cl_khr_fp64 or a non-zero CL_DEVICE_DOUBLE_FP_CONFIG
+  bool int64_atomics_base = false;     // cl_khr_int64_base_atomics
+  bool int64_atomics_extended = false; // cl_khr_int64_extended_atomics
+};
+
+// Every device of every platform. Throws DeviceError (telling to install an OpenCL driver such
+// as pocl-opencl-icd) when there is no platform or no device at all.
+std::vector<DeviceInfo> list_devices();
+
+// Chooses a device: spec = "INDEX" (global index of list_devices) or a case-insensitive
+// substring of the device name, vendor or platform name; an empty spec falls back to the
+// environment variable TETCOLLAPSE_DEVICE, then to the first GPU, then to the first CPU.
+// A device without fp64 is refused with DeviceError.
+DeviceInfo select_device(const std::string& spec = "");
+
+// Translates an OpenCL error code into its name ("CL_OUT_OF_RESOURCES"); "CL_ERROR(<code>)"
+// for codes it does not know.
+const char* cl_error_name(int code);
+
+// A context, a device and one in-order command queue. Programs are compiled once per context
+// (in memory) and once per machine (the on-disk binary cache).
+class Context {
+ public:
+  // Selects the device as select_device(spec) does.
+  explicit Context(const std::string& spec = "");
+  explicit Context(const DeviceInfo& info);
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+  ~Context();
+
+  const DeviceInfo& info() const { return info_; }
+  cl::Context& context() { return context_; }
+  cl::Device& device() { return device_; }
+  cl::CommandQueue& queue() { return queue_; }
+
+  // Work-group size used by the library's kernels: 0 (default) picks one per kernel from the
+  // device limits. Results never depend on it; tests set it to check exactly that.
+  void set_work_group_size(size_t wg) { work_group_size_ = wg; }
+  size_t work_group_size() const { return work_group_size_; }
+  // The work-group size a launch of `kernel` uses: the set one (clamped to what the kernel
+  // and the device allow) or the default, always a power of two >= 1.
+  size_t group_size_for(const cl::Kernel& kernel) const;
+
+  // The program made of the embedded file `file` (e.g. "scan.cl"); `#include "x.h"` lines are
+  // replaced by the embedded text of x.h. Options are appended to "-cl-std=CL1.2". Built from
+  // the cache when possible; a build failure throws DeviceError with the build log.
+  cl::Program& program(const std::string& file, const std::string& options = "");
+  // A fresh kernel object of that program (kernels hold their arguments, so callers own them).
+  cl::Kernel kernel(const std::string& file, const std::string& name, const std::string& options = "");
+
+  // Enqueues a 1-D launch of n work items: the global size is n rounded up to a multiple of the
+  // work-group size, so kernels must check their global id against n. `what` names the kernel
+  // in error messages. local = 0 means group_size_for(kernel).
+  void launch(cl::Kernel& kernel, size_t n, const char* what, size_t local = 0);
+  void finish();
+
+  // Where compiled binaries are cached: $TETCOLLAPSE_CACHE_DIR, else $XDG_CACHE_HOME/tetcollapse,
+  // else ~/.cache/tetcollapse.
+  static std::string cache_dir();
+  // How the last program() call that compiled something was satisfied (for tests and benches).
+  enum class BuildSource { Memory, DiskCache, Source };
+  BuildSource last_build_source() const { return last_build_source_; }
+
+ private:
+  void init(const DeviceInfo& info);
+  DeviceInfo info_;
+  cl::Platform platform_;
+  cl::Device device_;
+  cl::Context context_;
+  cl::CommandQueue queue_;
+  size_t work_group_size_ = 0;
+  std::map<std::pair<std::string, std::string>, cl::Program> programs_;
+  BuildSource last_build_source_ = BuildSource::Memory;
+};
+
+namespace detail {
+// Runs f() and turns a cl::Error into DeviceError("<call>(<what>): <CL_NAME>").
+[[noreturn]] void rethrow_cl_error(const cl::Error& e, const char* what);
+template <class F>
+decltype(auto) cl_call(const char* what, F&& f) {
+  try {
+    return f();
+  } catch (const cl::Error& e) {
+    rethrow_cl_error(e, what);
+  }
+}
+}  // namespace detail
+
+// A device array of n values of T (T trivially copyable). A zero-size buffer holds a one-element
+// allocation so it can always be passed to kernels. Transfers are blocking.
+template <class T>
+class DeviceBuffer {
+ public:
+  DeviceBuffer() = default;
+  DeviceBuffer(Context& ctx, size_t n) : ctx_(&ctx) { allocate(n); }
+  DeviceBuffer(Context& ctx, const std::vector<T>& host) : ctx_(&ctx) {
+    allocate(host.size());
+    upload(host);
+  }
+
+  size_t size() const { return n_; }
+  size_t bytes() const { return n_ * sizeof(T); }
+  cl::Buffer& buffer() { return buf_; }
+  const cl::Buffer& buffer() const { return buf_; }
+  Context& context() const { return *ctx_; }
+
+  // Reallocates when n exceeds the capacity (contents are then lost); never shrinks memory.
+  void resize(size_t n) {
+    if (n > capacity_) allocate(n);
+    n_ = n;
+  }
+  void upload(const std::vector<T>& host) {
+    resize(host.size());
+    upload(host.data(), host.size());
+  }
+  void upload(const T* data, size_t count, size_t offset = 0) {
+    if (count == 0) return;
+    check_range(offset, count, "upload");
+    detail::cl_call("DeviceBuffer::upload", [&] {
+      ctx_->queue().enqueueWriteBuffer(buf_, CL_TRUE, offset * sizeof(T), count * sizeof(T), data);
+    });
+  }
+  std::vector<T> download() const { return download(0, n_); }
+  std::vector<T> download(size_t offset, size_t count) const {
+    std::vector<T> out(count);
+    download(out.data(), count, offset);
+    return out;
+  }
+  void download(T* data, size_t count, size_t offset = 0) const {
+    if (count == 0) return;
+    check_range(offset, count, "download");
+    detail::cl_call("DeviceBuffer::download", [&] {
+      ctx_->queue().enqueueReadBuffer(buf_, CL_TRUE, offset * sizeof(T), count * sizeof(T), data);
+    });
+  }
+  // Sets every element to value.
+  void fill(const T& value) {
+    if (n_ == 0) return;
+    detail::cl_call("DeviceBuffer::fill", [&] {
+      ctx_->queue().enqueueFillBuffer(buf_, value, 0, n_ * sizeof(T));
+    });
+  }
+
+ private:
+  void allocate(size_t n) {
+    size_t cap = n == 0 ? 1 : n;
+    if (cap > SIZE_MAX / sizeof(T)) throw DeviceError("DeviceBuffer: size overflow");
+    detail::cl_call("clCreateBuffer", [&] { buf_ = cl::Buffer(ctx_->context(), CL_MEM_READ_WRITE, cap * sizeof(T)); });
+    capacity_ = cap;
+    n_ = n;
+  }
+  void check_range(size_t offset, size_t count, const char* op) const {
+    if (offset > n_ || count > n_ - offset)
+      throw DeviceError(std::string("DeviceBuffer::") + op + ": range [" + std::to_string(offset) + ", " +
+                        std::to_string(offset + count) + ") outside a buffer of " + std::to_string(n_));
+  }
+  Context* ctx_ = nullptr;
+  cl::Buffer buf_;
+  size_t n_ = 0, capacity_ = 0;
+};
+
+}  // namespace tc
