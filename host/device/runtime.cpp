@@ -248,10 +248,16 @@ const Found& choose(const std::vector<Found>& all, std::string spec) {
 
 // Replaces each line `#include "name"` by the embedded text of name (once per name), since
 // kernels are compiled from memory and have no file path to include from.
+void expand_text(const std::string& text, std::string& out, std::set<std::string>& seen, int depth);
+
 void expand(const std::string& name, std::string& out, std::set<std::string>& seen, int depth) {
   const char* text = kernels::find(name.c_str());
-  if (!text) throw DeviceError("embedded kernel file '" + name + "' not found (is it in cl/?)");
+  if (!text) throw DeviceError("#include \"" + name + "\": no such embedded kernel file (is it in cl/?)");
   if (depth > 16) throw DeviceError("kernel file '" + name + "': #include nesting too deep");
+  expand_text(text, out, seen, depth);
+}
+
+void expand_text(const std::string& text, std::string& out, std::set<std::string>& seen, int depth) {
   std::istringstream in(text);
   std::string line;
   while (std::getline(in, line)) {
@@ -349,9 +355,20 @@ cl::Program& Context::program(const std::string& file, const std::string& option
     last_build_source_ = BuildSource::Memory;
     return it->second;
   }
+  const char* text = kernels::find(file.c_str());
+  if (!text) throw DeviceError("embedded kernel file '" + file + "' not found (is it in cl/?)");
+  return build(file, text, options);
+}
+
+cl::Program& Context::build(const std::string& file, const std::string& text, const std::string& options) {
+  auto key = std::make_pair(file, options);
+  if (auto it = programs_.find(key); it != programs_.end()) {
+    last_build_source_ = BuildSource::Memory;
+    return it->second;
+  }
   std::string source;
   std::set<std::string> seen{file};
-  expand(file, source, seen, 0);
+  expand_text(text, source, seen, 0);
   std::string opts = "-cl-std=CL1.2";
   if (!options.empty()) opts += " " + options;
 

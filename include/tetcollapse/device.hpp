@@ -87,6 +87,9 @@ class Context {
   // replaced by the embedded text of x.h. Options are appended to "-cl-std=CL1.2". Built from
   // the cache when possible; a build failure throws DeviceError with the build log.
   cl::Program& program(const std::string& file, const std::string& options = "");
+  // The same from source text given here (named `name` in messages); #include lines still refer
+  // to embedded files. Cached in memory under (name, options) and on disk like program().
+  cl::Program& build(const std::string& name, const std::string& source, const std::string& options = "");
   // A fresh kernel object of that program (kernels hold their arguments, so callers own them).
   cl::Kernel kernel(const std::string& file, const std::string& name, const std::string& options = "");
 
@@ -162,8 +165,8 @@ class DeviceBuffer {
       ctx_->queue().enqueueWriteBuffer(buf_, CL_TRUE, offset * sizeof(T), count * sizeof(T), data);
     });
   }
-  std::vector<T> download() const { return download(0, n_); }
-  std::vector<T> download(size_t offset, size_t count) const {
+  std::vector<T> download() const { return download_range(0, n_); }
+  std::vector<T> download_range(size_t offset, size_t count) const {
     std::vector<T> out(count);
     download(out.data(), count, offset);
     return out;
