@@ -21,8 +21,8 @@ void register_features(CLI::App& app, int& exit_code) {
       "3 both), the feature surface as triangles tagged 1 (boundary) / 2 (interface) and the ridge edges");
   cmd->add_option("MESH", o->in, "Input mesh")->required();
   cmd->add_option("OUT", o->out, "Output file, e.g. features.vtu")->required();
-  cmd->add_option("--eps-f", o->eps_f, "Face-vertex threshold (paper: 0.01)", true);
-  cmd->add_option("--eps-r", o->eps_r, "Ridge-edge threshold (paper: 0.1)", true);
+  cmd->add_option("--eps-f", o->eps_f, "Face-vertex threshold (paper: 0.01)")->capture_default_str();
+  cmd->add_option("--eps-r", o->eps_r, "Ridge-edge threshold (paper: 0.1)")->capture_default_str();
   cmd->add_flag("--no-labels", o->no_labels, "Ignore material labels (no interface surfaces)");
   add_input_options(*cmd, o->input);
   add_output_options(*cmd, o->output);

@@ -40,8 +40,8 @@ void register_info(CLI::App& app, int& exit_code) {
   auto* cmd = app.add_subcommand("info", "Print counts, sizes, quality and boundary features of a mesh");
   cmd->add_option("MESH", o->path, "Mesh file")->required();
   cmd->add_flag("--json", o->json, "Print one JSON object on stdout (keys documented in README.md)");
-  cmd->add_option("--eps-f", o->eps_f, "Face-vertex threshold on 1 - dot(n_i, n_j) (paper: 0.01)", true);
-  cmd->add_option("--eps-r", o->eps_r, "Ridge-edge threshold on 1 - dot(n_1, n_2) (paper: 0.1)", true);
+  cmd->add_option("--eps-f", o->eps_f, "Face-vertex threshold on 1 - dot(n_i, n_j) (paper: 0.01)")->capture_default_str();
+  cmd->add_option("--eps-r", o->eps_r, "Ridge-edge threshold on 1 - dot(n_1, n_2) (paper: 0.1)")->capture_default_str();
   cmd->add_flag("--no-labels", o->no_labels, "Ignore material labels (no interface surfaces)");
   add_input_options(*cmd, o->input);
   cmd->callback([o, &exit_code] {

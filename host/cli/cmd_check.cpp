@@ -1,0 +1,69 @@
+#include <iostream>
+
+#include "cli/common.hpp"
+#include "io/io_util.hpp"
+#include "tetcollapse/check.hpp"
+
+namespace tc::cli {
+
+// Writes `text` to `path` atomically, or to stdout when path is "-".
+void write_report(const std::string& path, const std::string& text) {
+  if (path == "-") {
+    std::cout << text << "\n";
+    return;
+  }
+  io::AtomicFile f(path, false);
+  f.stream() << text << "\n";
+  f.commit();
+}
+
+void register_check(CLI::App& app, int& exit_code) {
+  struct Opts {
+    std::string path, reference, json;
+    InputOptions input;
+    CheckOptions check;
+    bool quiet = false;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand(
+      "check",
+      "Check a mesh for validity (exact orientation, face pairing, closed manifold boundary without\n"
+      "self-intersection, duplicate vertices) and report its quality; exit code 1 when invalid.\n"
+      "With --reference: volume change, boundary Hausdorff distance, reduction, and the boundary\n"
+      "topology (components, Euler characteristic) must be unchanged.");
+  cmd->add_option("MESH", o->path, "Mesh to check")->required();
+  cmd->add_option("--reference", o->reference, "The input the mesh was made from, to compare with");
+  cmd->add_option("--json", o->json, "Write the full report as one JSON object to this file ('-' for stdout)");
+  cmd->add_option("--eps-v", o->check.eps_volume, "Count tets with volume below this (the paper's eps_v)")->capture_default_str();
+  cmd->add_flag("--small-volume-error", o->check.small_volume_is_error, "Tets below --eps-v make the mesh invalid");
+  cmd->add_option("--duplicate-tol", o->check.duplicate_tol,
+                  "Vertices closer than this on every axis are duplicates")
+      ->capture_default_str();
+  cmd->add_flag("!--no-self-intersection", o->check.self_intersection, "Skip the boundary self-intersection test");
+  cmd->add_flag("!--no-hausdorff", o->check.hausdorff, "Skip the Hausdorff distance to the reference");
+  cmd->add_flag("!--no-quality", o->check.quality, "Skip the quality statistics");
+  cmd->add_option("--min-dihedral", o->check.min_dihedral_gate_deg,
+                  "Fail when the smallest dihedral angle (degrees) is below this");
+  cmd->add_option("--max-hausdorff-rel", o->check.max_hausdorff_rel_gate,
+                  "Fail when the Hausdorff distance / reference bounding-box diagonal exceeds this");
+  cmd->add_option("--max-volume-change-rel", o->check.max_volume_change_rel_gate,
+                  "Fail when |volume change| / reference volume exceeds this");
+  cmd->add_flag("-q,--quiet", o->quiet, "Print only the verdict line");
+  add_input_options(*cmd, o->input);
+  cmd->callback([o, &exit_code] {
+    Mesh m = read_input(o->path, o->input, o->quiet);
+    Mesh ref;
+    if (!o->reference.empty()) ref = read_input(o->reference, o->input, o->quiet);
+    CheckReport r = check_mesh(m, o->check, o->reference.empty() ? nullptr : &ref);
+    if (!o->json.empty()) write_report(o->json, check_report_json(r));
+    if (o->json != "-") {
+      if (o->quiet)
+        std::cout << o->path << ": " << (r.valid ? "valid" : "INVALID") << "\n";
+      else
+        std::cout << o->path << "\n" << check_report_text(r);
+    }
+    exit_code = r.valid ? kOk : kCheckFailed;
+  });
+}
+
+}  // namespace tc::cli
