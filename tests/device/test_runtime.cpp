@@ -1,0 +1,268 @@
+// OpenCL runtime: listing, selection, error translation, program build with includes and the
+// on-disk binary cache, DeviceBuffer.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <random>
+#include <string>
+
+#include "test_support.hpp"
+#include "tetcollapse/device.hpp"
+#include "geometry.h"
+
+namespace {
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// Sets an environment variable for the lifetime of the object.
+class EnvVar {
+ public:
+  EnvVar(const char* name, const std::string& value) : name_(name) {
+    if (const char* old = std::getenv(name)) old_ = std::make_unique<std::string>(old);
+    ::setenv(name, value.c_str(), 1);
+  }
+  ~EnvVar() {
+    if (old_)
+      ::setenv(name_, old_->c_str(), 1);
+    else
+      ::unsetenv(name_);
+  }
+
+ private:
+  const char* name_;
+  std::unique_ptr<std::string> old_;
+};
+
+std::string message_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const tc::DeviceError& e) {
+    return e.what();
+  }
+  return "(no DeviceError)";
+}
+
+TEST(Runtime, ListsDevicesWithTheirProperties) {
+  auto devices = tc::list_devices();
+  ASSERT_FALSE(devices.empty());
+  for (size_t i = 0; i < devices.size(); ++i) {
+    const auto& d = devices[i];
+    EXPECT_EQ(d.index, static_cast<int>(i));
+    EXPECT_FALSE(d.name.empty());
+    EXPECT_FALSE(d.platform_name.empty());
+    EXPECT_FALSE(d.driver_version.empty());
+    EXPECT_GT(d.compute_units, 0u);
+    EXPECT_GT(d.global_mem_bytes, 0u);
+    EXPECT_GT(d.local_mem_bytes, 0u);
+    EXPECT_GE(d.max_work_group_size, 1u);
+    EXPECT_TRUE(d.type == "GPU" || d.type == "CPU" || d.type == "ACCELERATOR" || d.type == "OTHER");
+  }
+}
+
+TEST(Runtime, SelectsByIndexSubstringAndEnvironment) {
+  auto devices = tc::list_devices();
+  const auto& first = devices[0];
+  if (!first.fp64) GTEST_SKIP() << "device 0 has no fp64";
+  EnvVar clear("TETCOLLAPSE_DEVICE", "");
+  EXPECT_EQ(tc::select_device("0").name, first.name);
+  // Case-insensitive substring of the name, of the vendor, of the platform.
+  std::string part = first.name.substr(0, std::min<size_t>(first.name.size(), 6));
+  EXPECT_EQ(tc::select_device(lower(part)).name, first.name);
+  EXPECT_EQ(tc::select_device(lower(first.platform_name)).platform_name, first.platform_name);
+  {
+    EnvVar env("TETCOLLAPSE_DEVICE", "0");
+    EXPECT_EQ(tc::select_device().index, 0);
+  }
+  {
+    EnvVar env("TETCOLLAPSE_DEVICE", "no-such-device-xyz");
+    std::string m = message_of([] { tc::select_device(); });
+    EXPECT_NE(m.find("TETCOLLAPSE_DEVICE"), std::string::npos) << m;
+    EXPECT_NE(m.find("no-such-device-xyz"), std::string::npos) << m;
+    // An explicit spec wins over the environment.
+    EXPECT_EQ(tc::select_device("0").index, 0);
+  }
+  std::string m = message_of([&] { tc::select_device(std::to_string(devices.size())); });
+  EXPECT_NE(m.find("no device with that index"), std::string::npos) << m;
+  EXPECT_NE(m.find(first.name), std::string::npos) << "the message lists the devices: " << m;
+  m = message_of([] { tc::select_device("zzz-not-a-device"); });
+  EXPECT_NE(m.find("zzz-not-a-device"), std::string::npos) << m;
+  // The automatic choice prefers a GPU with fp64, then a CPU with fp64.
+  auto chosen = tc::select_device();
+  EXPECT_TRUE(chosen.fp64);
+  bool gpu_fp64 = false;
+  for (const auto& d : devices) gpu_fp64 |= d.type == "GPU" && d.fp64;
+  EXPECT_EQ(chosen.type, gpu_fp64 ? "GPU" : "CPU");
+}
+
+// Re-runs this test binary with no OpenCL driver visible to the ICD loader.
+TEST(Runtime, NoDriverSaysToInstallOne) {
+  if (std::getenv("TC_TEST_EXPECT_NO_DRIVER")) {
+    std::string m = message_of([] { tc::list_devices(); });
+    EXPECT_NE(m.find("install an OpenCL driver"), std::string::npos) << m;
+    m = message_of([] { tc::Context ctx; });
+    EXPECT_NE(m.find("install an OpenCL driver"), std::string::npos) << m;
+    return;
+  }
+  tc::test::TempDir empty;
+  std::string self = std::filesystem::read_symlink("/proc/self/exe").string();
+  std::string out;
+  int rc = tc::test::run_command("OCL_ICD_VENDORS=" + empty.path().string() + " OCL_ICD_FILENAMES= TC_TEST_EXPECT_NO_DRIVER=1 '" +
+                                     self + "' --gtest_filter=Runtime.NoDriverSaysToInstallOne",
+                                 &out);
+  EXPECT_EQ(rc, 0) << out;
+  EXPECT_NE(out.find("[  PASSED  ] 1 test"), std::string::npos) << out;
+}
+
+TEST(Runtime, ErrorNames) {
+  EXPECT_STREQ(tc::cl_error_name(CL_OUT_OF_RESOURCES), "CL_OUT_OF_RESOURCES");
+  EXPECT_STREQ(tc::cl_error_name(CL_INVALID_WORK_GROUP_SIZE), "CL_INVALID_WORK_GROUP_SIZE");
+  EXPECT_STREQ(tc::cl_error_name(-1001), "CL_PLATFORM_NOT_FOUND_KHR");
+  EXPECT_STREQ(tc::cl_error_name(-12345), "CL_ERROR(-12345)");
+}
+
+class RuntimeCtx : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    cache_ = std::make_unique<EnvVar>("TETCOLLAPSE_CACHE_DIR", dir_.path().string());
+    ctx_ = std::make_unique<tc::Context>();
+  }
+  tc::test::TempDir dir_;
+  std::unique_ptr<EnvVar> cache_;
+  std::unique_ptr<tc::Context> ctx_;
+};
+
+TEST_F(RuntimeCtx, LaunchErrorsNameTheCallTheKernelAndTheError) {
+  const char* src = "__kernel void fill(__global uint* a, uint n) { uint i = get_global_id(0); if (i < n) a[i] = i; }";
+  cl::Program& p = ctx_->build("fill_test", src);
+  cl::Kernel k(p, "fill");
+  tc::DeviceBuffer<uint32_t> a(*ctx_, 16);
+  k.setArg(0, a.buffer());
+  k.setArg(1, cl_uint(16));
+  size_t too_big = ctx_->info().max_work_group_size * 2;
+  std::string m = message_of([&] { ctx_->launch(k, too_big, "fill", too_big); });
+  EXPECT_NE(m.find("clEnqueueNDRangeKernel(fill): CL_INVALID_WORK_"), std::string::npos) << m;
+  ctx_->launch(k, 16, "fill");
+  auto v = a.download();
+  for (uint32_t i = 0; i < 16; ++i) EXPECT_EQ(v[i], i);
+}
+
+TEST_F(RuntimeCtx, BuildFailureCarriesTheBuildLog) {
+  std::string m = message_of([&] { ctx_->build("broken_test", "__kernel void k(__global int* a) { a[0] = undeclared_thing; }"); });
+  EXPECT_NE(m.find("clBuildProgram(broken_test): CL_BUILD_PROGRAM_FAILURE"), std::string::npos) << m;
+  EXPECT_NE(m.find("build log"), std::string::npos) << m;
+  EXPECT_NE(m.find("undeclared_thing"), std::string::npos) << "the log names the bad identifier: " << m;
+  m = message_of([&] { ctx_->build("bad_include", "#include \"no_such_file.h\"\n"); });
+  EXPECT_NE(m.find("no_such_file.h"), std::string::npos) << m;
+  m = message_of([&] { ctx_->program("no_such_stage.cl"); });
+  EXPECT_NE(m.find("no_such_stage.cl"), std::string::npos) << m;
+}
+
+// geometry.h is included textually from the embedded copy and gives the same numbers as the
+// C++ compilation of the same header.
+TEST_F(RuntimeCtx, IncludesEmbeddedGeometryHeader) {
+  const char* src = R"(#include "geometry.h"
+__kernel void orient(__global const double* p, __global double* out) {
+  out[0] = tc_orient3d(tc_point(p, 0), tc_point(p, 1), tc_point(p, 2), tc_point(p, 3));
+})";
+  cl::Program& p = ctx_->build("orient_test", src);
+  cl::Kernel k(p, "orient");
+  std::vector<double> pts{0.1, 0.2, 0.3, 1.7, 0.1, -0.4, 0.3, 2.1, 0.9, -0.2, 0.5, 1.3};
+  tc::DeviceBuffer<double> dp(*ctx_, pts), out(*ctx_, 1);
+  k.setArg(0, dp.buffer());
+  k.setArg(1, out.buffer());
+  ctx_->launch(k, 1, "orient", 1);
+  using namespace tc::geo;
+  double ref = tc_orient3d(tc_point(pts.data(), 0), tc_point(pts.data(), 1), tc_point(pts.data(), 2),
+                           tc_point(pts.data(), 3));
+  EXPECT_NE(ref, 0.0);
+  EXPECT_DOUBLE_EQ(out.download()[0], ref);
+}
+
+TEST_F(RuntimeCtx, BinaryCacheIsUsedOnSecondStartAndSurvivesCorruption) {
+  // A unique option makes a fresh cache key even if the folder were shared.
+  std::string opts = "-DTC_TEST_NONCE=" + std::to_string(std::random_device{}());
+  auto entries = [&] {
+    std::vector<std::filesystem::path> v;
+    for (auto& e : std::filesystem::directory_iterator(dir_.path())) v.push_back(e.path());
+    return v;
+  };
+  ctx_->program("scan.cl", opts);
+  EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Source);
+  ctx_->program("scan.cl", opts);
+  EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Memory);
+  ASSERT_EQ(entries().size(), 1u) << "one cache entry, no temporary left behind";
+  auto file = entries()[0];
+
+  auto second = std::make_unique<tc::Context>();
+  second->program("scan.cl", opts);
+  EXPECT_EQ(second->last_build_source(), tc::Context::BuildSource::DiskCache);
+  second->kernel("scan.cl", "scan_reduce", opts);  // the cached binary holds the kernels
+
+  // Flip a byte inside the binary: the checksum rejects it and the source build takes over.
+  {
+    std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(40);
+    char c = 0;
+    f.read(&c, 1);
+    f.seekp(40);
+    c = static_cast<char>(c ^ 0x5a);
+    f.write(&c, 1);
+  }
+  auto third = std::make_unique<tc::Context>();
+  third->program("scan.cl", opts);
+  EXPECT_EQ(third->last_build_source(), tc::Context::BuildSource::Source);
+  // ... which rewrote a good entry.
+  auto fourth = std::make_unique<tc::Context>();
+  fourth->program("scan.cl", opts);
+  EXPECT_EQ(fourth->last_build_source(), tc::Context::BuildSource::DiskCache);
+
+  // A truncated entry and garbage are ignored too.
+  std::filesystem::resize_file(file, 20);
+  auto fifth = std::make_unique<tc::Context>();
+  fifth->program("scan.cl", opts);
+  EXPECT_EQ(fifth->last_build_source(), tc::Context::BuildSource::Source);
+  tc::test::write_text(file.string(), "garbage");
+  auto sixth = std::make_unique<tc::Context>();
+  sixth->program("scan.cl", opts);
+  EXPECT_EQ(sixth->last_build_source(), tc::Context::BuildSource::Source);
+}
+
+TEST(Runtime, CacheDirFollowsTheEnvironment) {
+  EnvVar a("TETCOLLAPSE_CACHE_DIR", "/tmp/tc-a");
+  EXPECT_EQ(tc::Context::cache_dir(), "/tmp/tc-a");
+  EnvVar b("TETCOLLAPSE_CACHE_DIR", "");
+  EnvVar c("XDG_CACHE_HOME", "/tmp/xdg");
+  EXPECT_EQ(tc::Context::cache_dir(), "/tmp/xdg/tetcollapse");
+  EnvVar d("XDG_CACHE_HOME", "");
+  EnvVar e("HOME", "/home/someone");
+  EXPECT_EQ(tc::Context::cache_dir(), "/home/someone/.cache/tetcollapse");
+}
+
+TEST_F(RuntimeCtx, DeviceBufferRoundTripsAndChecksRanges) {
+  std::vector<uint64_t> v{1, 2, 3, ~uint64_t{0}};
+  tc::DeviceBuffer<uint64_t> b(*ctx_, v);
+  EXPECT_EQ(b.size(), 4u);
+  EXPECT_EQ(b.download(), v);
+  EXPECT_EQ(b.download_range(1, 2), (std::vector<uint64_t>{2, 3}));
+  uint64_t x = 9;
+  b.upload(&x, 1, 3);
+  EXPECT_EQ(b.download()[3], 9u);
+  EXPECT_THROW(b.upload(&x, 1, 4), tc::DeviceError);
+  EXPECT_THROW(b.download_range(3, 2), tc::DeviceError);
+  b.fill(7);
+  EXPECT_EQ(b.download(), (std::vector<uint64_t>(4, 7)));
+  tc::DeviceBuffer<uint64_t> empty(*ctx_, 0);
+  EXPECT_EQ(empty.size(), 0u);
+  EXPECT_TRUE(empty.download().empty());
+  empty.resize(3);
+  EXPECT_EQ(empty.size(), 3u);
+}
+
+}  // namespace
