@@ -37,6 +37,7 @@ void add_output_options(CLI::App& cmd, OutputOptions& o);
 WriteOptions write_options(const OutputOptions& o);
 
 // Registration of each subcommand: adds it to `app` and returns a flag set when it ran.
+void register_collapse(CLI::App& app, int& exit_code);
 void register_info(CLI::App& app, int& exit_code);
 void register_convert(CLI::App& app, int& exit_code);
 void register_devices(CLI::App& app, int& exit_code);

@@ -11,8 +11,9 @@ int main(int argc, char** argv) {
       ": coarsen unstructured tetrahedral meshes by massively parallel edge collapse (OpenCL).\n"
       "Exit codes: 0 ok, 1 failed check, 2 bad input or usage, 3 device error, 4 output not written, 5 internal error."};
   app.set_version_flag("--version", "tetcollapse " TETCOLLAPSE_VERSION);
-  app.require_subcommand(1, 1);
+  app.require_subcommand(0, 1);
   int exit_code = kOk;
+  register_collapse(app, exit_code);
   register_info(app, exit_code);
   register_convert(app, exit_code);
   register_devices(app, exit_code);

@@ -1,0 +1,305 @@
+// The main job: tetcollapse IN OUT [options] coarsens a mesh by parallel edge collapse.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <set>
+#include <sstream>
+
+#include "cli/common.hpp"
+#include "io/io_util.hpp"
+#include "json.hpp"
+#include "tetcollapse/collapse.hpp"
+#ifdef TETCOLLAPSE_HAVE_CHECK
+#include "tetcollapse/check.hpp"
+#endif
+
+namespace tc::cli {
+
+void write_report(const std::string& path, const std::string& text);  // cmd_check.cpp
+
+namespace {
+
+struct CollapseCli {
+  std::string in, out;
+  InputOptions input;
+  OutputOptions output;
+  CollapseOptions opt;
+  double target_length = 0, target_factor = 0;
+  std::string boundary = "features";
+  std::string region, sizing_field, labels, cost_cl, device, stats;
+  bool check = false, quiet = false, no_labels = false;
+};
+
+std::vector<double> parse_numbers(const std::string& s, const std::string& what) {
+  std::vector<double> v;
+  std::stringstream ss(s);
+  std::string tok;
+  while (std::getline(ss, tok, ',')) {
+    char* end = nullptr;
+    double x = std::strtod(tok.c_str(), &end);
+    if (tok.empty() || *end != '\0' || !std::isfinite(x))
+      throw CLI::ValidationError(what, "'" + tok + "' is not a number");
+    v.push_back(x);
+  }
+  return v;
+}
+
+// --region box:X0,Y0,Z0,X1,Y1,Z1 | sphere:X,Y,Z,R -> per-vertex mask (1 inside).
+std::vector<uint8_t> region_mask(const Mesh& m, const std::string& spec) {
+  auto colon = spec.find(':');
+  std::string kind = spec.substr(0, colon);
+  if (colon == std::string::npos || (kind != "box" && kind != "sphere"))
+    throw CLI::ValidationError("--region", "expected box:X0,Y0,Z0,X1,Y1,Z1 or sphere:X,Y,Z,R");
+  std::vector<double> v = parse_numbers(spec.substr(colon + 1), "--region");
+  std::vector<uint8_t> mask(static_cast<size_t>(m.num_vertices()), 0);
+  if (kind == "box") {
+    if (v.size() != 6) throw CLI::ValidationError("--region", "box needs 6 numbers");
+    for (int64_t i = 0; i < m.num_vertices(); ++i) {
+      bool in = true;
+      for (int k = 0; k < 3; ++k) {
+        double x = m.points[3 * i + k];
+        in = in && x >= std::min(v[k], v[k + 3]) && x <= std::max(v[k], v[k + 3]);
+      }
+      mask[i] = in;
+    }
+  } else {
+    if (v.size() != 4 || v[3] < 0) throw CLI::ValidationError("--region", "sphere needs X,Y,Z,R with R >= 0");
+    for (int64_t i = 0; i < m.num_vertices(); ++i) {
+      double d2 = 0;
+      for (int k = 0; k < 3; ++k) d2 += (m.points[3 * i + k] - v[k]) * (m.points[3 * i + k] - v[k]);
+      mask[i] = d2 <= v[3] * v[3];
+    }
+  }
+  return mask;
+}
+
+// --labels A,B,...: a vertex is selected when every tet around it has a selected primary label,
+// so material interfaces to unselected labels stay where they are.
+std::vector<uint8_t> label_mask(const Mesh& m, const std::string& spec) {
+  if (m.tet_labels.empty()) throw InputError("--labels", "the mesh has no labels");
+  std::set<int32_t> wanted;
+  for (double x : parse_numbers(spec, "--labels")) wanted.insert(static_cast<int32_t>(x));
+  std::vector<uint8_t> mask(static_cast<size_t>(m.num_vertices()), 1);
+  const auto& lab = m.tet_labels[0].values;
+  for (int64_t t = 0; t < m.num_tets(); ++t)
+    if (!wanted.count(lab[t]))
+      for (int k = 0; k < 4; ++k) mask[m.tets[4 * t + k]] = 0;
+  return mask;
+}
+
+void combine(std::vector<uint8_t>& mask, const std::vector<uint8_t>& more) {
+  if (mask.empty()) {
+    mask = more;
+    return;
+  }
+  for (size_t i = 0; i < mask.size(); ++i) mask[i] = mask[i] && more[i];
+}
+
+std::string stats_json(const CollapseCli& c, const CollapseReport& r, double seconds_total, double seconds_read,
+                       double seconds_write, const std::string& check_verdict) {
+  JsonWriter w;
+  w.begin_object()
+      .field("input", c.in)
+      .field("output", c.out)
+      .field("device", r.device)
+      .field("vertices_in", r.vertices_in)
+      .field("vertices_out", r.vertices_out)
+      .field("tets_in", r.tets_in)
+      .field("tets_out", r.tets_out)
+      .field("tet_reduction", r.tets_in ? 1.0 - double(r.tets_out) / double(r.tets_in) : 0.0)
+      .field("target_length", r.target_length)
+      .field("median_edge_length", r.median_edge_length)
+      .field("eps_c", c.opt.eps_c)
+      .field("eps_v", r.eps_v)
+      .field("boundary", c.boundary)
+      .field("seconds_total", seconds_total)
+      .field("seconds_collapse", r.seconds_total)
+      .field("seconds_upload", r.seconds_upload)
+      .field("seconds_download", r.seconds_download)
+      .field("seconds_read", seconds_read)
+      .field("seconds_write", seconds_write);
+  if (!check_verdict.empty()) w.field("check", check_verdict);
+  w.key("iterations").begin_array();
+  for (const auto& it : r.iterations) {
+    w.begin_object()
+        .field("iteration", it.iteration)
+        .field("vertices", it.vertices)
+        .field("tets", it.tets)
+        .field("edges", it.edges)
+        .field("marked", it.marked)
+        .field("admissible", it.admissible)
+        .field("after_pass1", it.after_pass1)
+        .field("after_pass2", it.after_pass2)
+        .field("collapsed", it.collapsed)
+        .field("tets_after", it.tets_after)
+        .field("vertices_after", it.vertices_after)
+        .field("seconds_connectivity", it.seconds_connectivity)
+        .field("seconds_cost", it.seconds_cost)
+        .field("seconds_admissible", it.seconds_admissible)
+        .field("seconds_pass1", it.seconds_pass1)
+        .field("seconds_pass2", it.seconds_pass2)
+        .field("seconds_collapse", it.seconds_collapse)
+        .field("seconds_total", it.seconds_total)
+        .end_object();
+  }
+  w.end_array().end_object();
+  return w.str();
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+void register_collapse(CLI::App& app, int& exit_code) {
+  auto c = std::make_shared<CollapseCli>();
+  app.add_option("IN", c->in, "Input mesh (coarsen mode: tetcollapse IN OUT [options])");
+  app.add_option("OUT", c->out, "Output mesh, written to a temporary file and renamed");
+  auto* tl = app.add_option("--target-length", c->target_length,
+                            "Collapse edges shorter than L (mesh units)");
+  auto* tf = app.add_option("--target-factor", c->target_factor,
+                            "Collapse edges shorter than F x the input's median edge length (default 1)");
+  tl->excludes(tf);
+  app.add_option("--eps-c", c->opt.eps_c, "Stop when an iteration collapses fewer than N edges (default 0: until none)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--max-iterations", c->opt.max_iterations, "Stop after N iterations")->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_option("--boundary", c->boundary,
+                 "strict: boundary vertices never move; features (default): the paper's protection,\n"
+                 "face vertices move along faces, ridge vertices along ridges, corners never;\n"
+                 "free: no protection (e.g. volume-rendering data)")
+      ->check(CLI::IsMember({"strict", "features", "free"}));
+  app.add_flag("--paper-boundary-rule", c->opt.paper_boundary_rule,
+               "Refuse every non-boundary edge that touches the boundary, as the paper does\n"
+               "(default: an interior vertex may collapse onto a boundary vertex, which stays put)");
+  app.add_flag("--no-labels", c->no_labels, "Do not protect material interfaces between labels");
+  app.add_option("--eps-f", c->opt.eps_f, "Face-vertex threshold on 1 - dot of normals (paper: 0.01)")
+      ->capture_default_str();
+  app.add_option("--eps-r", c->opt.eps_r, "Ridge-edge threshold on 1 - dot of normals (paper: 0.1)")
+      ->capture_default_str();
+  app.add_option("--eps-v", c->opt.eps_v, "Refuse collapses leaving a tet with volume below this (paper: 2e-12)")
+      ->capture_default_str();
+  app.add_flag("--eps-v-relative", c->opt.eps_v_relative,
+               "Read --eps-v relative to the cube of the bounding-box diagonal");
+  app.add_option("--region", c->region,
+                 "Only collapse edges inside a region: box:X0,Y0,Z0,X1,Y1,Z1 or sphere:X,Y,Z,R");
+  app.add_option("--sizing-field", c->sizing_field,
+                 "Per-vertex field of the input giving the wanted edge length: an edge is collapsed\n"
+                 "when shorter than the mean of the field at its ends (replaces --target-*)");
+  app.add_option("--labels", c->labels, "Only coarsen inside these primary labels, e.g. 1,3");
+  app.add_option("--cost-cl", c->cost_cl,
+                 "OpenCL C file defining double tc_user_cost(double3 p0, double3 p1, double f0, double f1);\n"
+                 "edges with a cost below --target-length are collapsed (see README)");
+  app.add_option("--device", c->device, "OpenCL device: index or name substring (see 'tetcollapse devices');\n"
+                                        "default: $TETCOLLAPSE_DEVICE, else the first GPU, else the first CPU");
+  app.add_option("--stats", c->stats, "Write the run's statistics as JSON to this file ('-' for stdout)");
+  app.add_flag("--check", c->check, "Check the result (validity, unchanged boundary topology) and fail if invalid");
+  app.add_flag("-q,--quiet", c->quiet, "No progress lines, only errors");
+  add_input_options(app, c->input);
+  add_output_options(app, c->output);
+
+  app.callback([c, &app, &exit_code] {
+    if (!app.get_subcommands().empty()) return;
+    if (c->in.empty() || c->out.empty())
+      throw CLI::RequiredError("IN and OUT (or a subcommand; see --help)");
+    auto t0 = std::chrono::steady_clock::now();
+    Mesh mesh = read_input(c->in, c->input, c->quiet);
+    double seconds_read = seconds_since(t0);
+    Mesh input;
+    if (c->check) input = mesh;
+
+    CollapseOptions& opt = c->opt;
+    opt.boundary = c->boundary == "strict" ? CollapseOptions::Strict
+                   : c->boundary == "free" ? CollapseOptions::Free
+                                           : CollapseOptions::Features;
+    opt.use_labels = !c->no_labels;
+    if (c->target_length > 0) opt.target_length = c->target_length;
+    if (c->target_factor > 0) opt.target_factor = c->target_factor;
+    if (!c->region.empty()) combine(opt.vertex_mask, region_mask(mesh, c->region));
+    if (!c->labels.empty()) combine(opt.vertex_mask, label_mask(mesh, c->labels));
+    size_t sizing_index = 0;
+    if (!c->cost_cl.empty()) {
+      if (!c->sizing_field.empty())
+        throw CLI::ValidationError("--cost-cl", "cannot be combined with --sizing-field");
+      opt.cost_cl_source = io::load_file(c->cost_cl);
+      if (opt.target_length <= 0) throw CLI::ValidationError("--cost-cl", "needs --target-length");
+    } else if (!c->sizing_field.empty()) {
+      // The user cost sees the first vertex field: move the sizing field there for the run.
+      bool found = false;
+      for (size_t i = 0; i < mesh.vertex_fields.size(); ++i)
+        if (mesh.vertex_fields[i].name == c->sizing_field) {
+          sizing_index = i;
+          found = true;
+        }
+      if (!found) throw InputError(c->in, "no vertex field named '" + c->sizing_field + "'");
+      std::swap(mesh.vertex_fields[0], mesh.vertex_fields[sizing_index]);
+      opt.cost_cl_source =
+          "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) {\n"
+          "  double h = 0.5 * (f0 + f1);\n"
+          "  return h > 0.0 ? length(p1 - p0) / h : INFINITY;\n"
+          "}\n";
+      opt.target_length = 1.0;
+    }
+    if (!c->quiet)
+      opt.progress = [](const IterationStats& it) {
+        std::fprintf(stderr,
+                     "iteration %3d: marked %9lld  admissible %9lld  pass1 %8lld  pass2 %8lld  collapsed %8lld  "
+                     "tets %9lld  %.3f s\n",
+                     it.iteration + 1, (long long)it.marked, (long long)it.admissible, (long long)it.after_pass1,
+                     (long long)it.after_pass2, (long long)it.collapsed, (long long)it.tets_after, it.seconds_total);
+      };
+
+    Context ctx(c->device);
+    if (!c->quiet) std::cerr << "device: " << ctx.info().name << " (" << ctx.info().platform_name << ")\n";
+    CollapseReport r = collapse(mesh, opt, ctx);
+    if (!c->sizing_field.empty()) std::swap(mesh.vertex_fields[0], mesh.vertex_fields[sizing_index]);
+
+    std::string verdict;
+    if (c->check) {
+#ifdef TETCOLLAPSE_HAVE_CHECK
+      CheckOptions co;
+      co.hausdorff = opt.boundary == CollapseOptions::Strict;  // 0 expected in strict mode
+      CheckReport cr = check_mesh(mesh, co, &input);
+      verdict = cr.valid ? "valid" : "invalid";
+      if (!cr.valid) {
+        std::cerr << "check: the result is INVALID\n" << check_report_text(cr);
+        exit_code = kCheckFailed;
+      } else if (!c->quiet) {
+        std::cerr << "check: valid, boundary topology unchanged\n";
+      }
+#else
+      throw CLI::ValidationError("--check", "this build has no checker (CGAL)");
+#endif
+    }
+    auto tw = std::chrono::steady_clock::now();
+    if (exit_code != kCheckFailed) write_mesh(c->out, mesh, write_options(c->output));
+    double seconds_write = seconds_since(tw);
+    double seconds_total = seconds_since(t0);
+    if (!c->quiet) {
+      double stage[6] = {0, 0, 0, 0, 0, 0};
+      for (const auto& it : r.iterations) {
+        stage[0] += it.seconds_connectivity;
+        stage[1] += it.seconds_cost;
+        stage[2] += it.seconds_admissible;
+        stage[3] += it.seconds_pass1;
+        stage[4] += it.seconds_pass2;
+        stage[5] += it.seconds_collapse;
+      }
+      std::fprintf(stderr,
+                   "%s -> %s\n  vertices %lld -> %lld, tets %lld -> %lld (%.1f%% fewer), %zu iterations, "
+                   "target length %.6g\n  collapse %.3f s (connectivity %.3f, cost %.3f, admissible %.3f, "
+                   "pass1 %.3f, pass2 %.3f, collapse %.3f), read %.3f s, write %.3f s, total %.3f s\n",
+                   c->in.c_str(), c->out.c_str(), (long long)r.vertices_in, (long long)r.vertices_out,
+                   (long long)r.tets_in, (long long)r.tets_out,
+                   r.tets_in ? 100.0 * (1.0 - double(r.tets_out) / double(r.tets_in)) : 0.0, r.iterations.size(),
+                   r.target_length, r.seconds_total, stage[0], stage[1], stage[2], stage[3], stage[4], stage[5],
+                   seconds_read, seconds_write, seconds_total);
+    }
+    if (!c->stats.empty()) write_report(c->stats, stats_json(*c, r, seconds_total, seconds_read, seconds_write, verdict));
+    if (exit_code != kCheckFailed) exit_code = kOk;
+  });
+}
+
+}  // namespace tc::cli
