@@ -1,0 +1,159 @@
+/* Helpers shared by the collapse kernels (cl/collapse_*.cl).
+ *
+ * Connectivity of one iteration, all built by cl/collapse_connectivity.cl:
+ *   vt_off[v] .. vt_off[v+1]     ring(v): the tets containing v, ascending, in vt[]
+ *   nb_off[v] .. nb_off[v+1]     N(v): the neighbour vertices of v, ascending, in nb[], and
+ *                                nb_edge[] the id of the edge (v, nb[k])
+ *   edges[2e], edges[2e+1]       edge e = (v0 < v1); edges are sorted lexicographically
+ * The floating-point contraction is switched off so that face normals and their dot products
+ * are bit-identical to the host's tc::build_topology (which the tests compare against).
+ */
+#ifndef TETCOLLAPSE_COLLAPSE_COMMON_H
+#define TETCOLLAPSE_COLLAPSE_COMMON_H
+
+#pragma OPENCL FP_CONTRACT OFF
+#include "geometry.h"
+
+/* Bits of vflags / eflags. */
+#define TCC_BOUNDARY 1u  /* on a face with one tet */
+#define TCC_INTERFACE 2u /* on a face between tets of different labels */
+#define TCC_RIDGE 4u     /* eflags only: a ridge (feature) edge */
+
+/* Vertex classes (tc::VertexClass) */
+#define TCC_INTERIOR 0
+#define TCC_FACE 1
+#define TCC_RIDGEV 2
+#define TCC_CORNER 3
+
+/* Boundary modes (tc::CollapseOptions::Boundary) */
+#define TCC_STRICT 0
+#define TCC_FEATURES 1
+#define TCC_FREE 2
+
+/* Refusal reasons written by the admissible filter (tc::collapse::Reason). */
+#define TCC_OK 0
+#define TCC_NOT_MARKED 1
+#define TCC_REFUSED_Q 2
+#define TCC_REFUSED_LINK 3
+#define TCC_REFUSED_VOLUME 4
+
+/* Does tet t contain vertex x? */
+inline int tcc_has(__global const int* tets, int t, int x) {
+  __global const int* q = tets + 4 * t;
+  return q[0] == x || q[1] == x || q[2] == x || q[3] == x;
+}
+
+/* Local index (0..3) of x in tet t, or -1. */
+inline int tcc_local(__global const int* tets, int t, int x) {
+  __global const int* q = tets + 4 * t;
+  return q[0] == x ? 0 : q[1] == x ? 1 : q[2] == x ? 2 : q[3] == x ? 3 : -1;
+}
+
+/* Edge id of (x, y), x != y, by binary search in N(min); -1 when absent. */
+inline int tcc_edge_id(__global const uint* nb_off, __global const int* nb, __global const int* nb_edge, int x,
+                       int y) {
+  int lo = (int)nb_off[x], hi = (int)nb_off[x + 1];
+  while (lo < hi) {
+    int mid = (lo + hi) >> 1;
+    if (nb[mid] < y) lo = mid + 1;
+    else hi = mid;
+  }
+  return (lo < (int)nb_off[x + 1] && nb[lo] == y) ? nb_edge[lo] : -1;
+}
+
+/* The face of tet t opposite local vertex f is shared with how many other tets? The first one
+ * found goes to *other. The face's vertices are all in ring(x) for x = any face vertex. */
+inline int tcc_face_others(__global const int* tets, __global const uint* vt_off, __global const int* vt, int t, int f,
+                           int* other) {
+  __global const int* q = tets + 4 * t;
+  int p0 = q[TC_TET_FACES[f][0]], p1 = q[TC_TET_FACES[f][1]], p2 = q[TC_TET_FACES[f][2]];
+  int n = 0;
+  *other = -1;
+  for (uint i = vt_off[p0]; i < vt_off[p0 + 1]; ++i) {
+    int u = vt[i];
+    if (u != t && tcc_has(tets, u, p1) && tcc_has(tets, u, p2)) {
+      if (n == 0) *other = u;
+      ++n;
+    }
+  }
+  return n;
+}
+
+/* Is the face of tet t opposite local vertex f an S-face owned by t (as in tc::build_topology:
+ * a boundary face is owned by its only tet; an interface face by the tet of the smaller label;
+ * a face in more than two tets, invalid input, counts as boundary for each)? Returns 0 when
+ * not, else TCC_BOUNDARY or TCC_INTERFACE. *on_s receives the kind even when t does not own it. */
+inline uint tcc_owned_sface(__global const int* tets, __global const uint* vt_off, __global const int* vt,
+                            __global const int* labels, int use_labels, int t, int f, uint* on_s) {
+  int other;
+  int n = tcc_face_others(tets, vt_off, vt, t, f, &other);
+  if (n != 1) {
+    *on_s = TCC_BOUNDARY;
+    return TCC_BOUNDARY;
+  }
+  if (use_labels && labels[t] != labels[other]) {
+    *on_s = TCC_INTERFACE;
+    return labels[t] < labels[other] ? TCC_INTERFACE : 0u;
+  }
+  *on_s = 0u;
+  return 0u;
+}
+
+/* Is the triangle (x, y, z) an S-face (boundary or interface)? Scans ring(x). */
+inline uint tcc_triangle_kind(__global const int* tets, __global const uint* vt_off, __global const int* vt,
+                              __global const int* labels, int use_labels, int x, int y, int z) {
+  int n = 0, t0 = -1, t1 = -1;
+  for (uint i = vt_off[x]; i < vt_off[x + 1]; ++i) {
+    int u = vt[i];
+    if (tcc_has(tets, u, y) && tcc_has(tets, u, z)) {
+      if (n == 0) t0 = u;
+      else if (n == 1) t1 = u;
+      ++n;
+    }
+  }
+  if (n == 0) return 0u; /* not a triangle of the mesh */
+  if (n != 2) return TCC_BOUNDARY;
+  if (use_labels && labels[t0] != labels[t1]) return TCC_INTERFACE;
+  return 0u;
+}
+
+/* Bit-exact twins of tc::geo::cross / dot / normalize on the host (no built-ins, whose rounding
+ * is implementation-defined). */
+inline double3 tcc_cross(double3 a, double3 b) {
+  return (double3)(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+inline double tcc_dot(double3 a, double3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline double3 tcc_normalize(double3 a) {
+  double l = sqrt(tcc_dot(a, a));
+  return l > 0.0 ? (double3)(a.x / l, a.y / l, a.z / l) : a;
+}
+
+/* Unit normal of the face of tet t opposite local vertex f, oriented out of t, computed as
+ * tc::build_topology does from the face's vertices in TC_TET_FACES order. */
+inline double3 tcc_face_normal(__global const double* pts, __global const int* tets, int t, int f) {
+  __global const int* q = tets + 4 * t;
+  double3 p0 = tc_point(pts, q[TC_TET_FACES[f][0]]);
+  double3 p1 = tc_point(pts, q[TC_TET_FACES[f][1]]);
+  double3 p2 = tc_point(pts, q[TC_TET_FACES[f][2]]);
+  return tcc_normalize(tcc_cross(p1 - p0, p2 - p0));
+}
+
+/* Collapse direction of an admissible edge, written by the admissible filter (edge_dir):
+ * bit 0 set: the removed vertex is v1 (survivor v0), else the removed vertex is v0;
+ * bit 1 set: midpoint placement, else the survivor keeps its position. */
+#define TCC_DIR_REMOVE_V1 1u
+#define TCC_DIR_MIDPOINT 2u
+
+inline double3 tcc_placement(__global const double* pts, int v0, int v1, uint dir) {
+  double3 p0 = tc_point(pts, v0), p1 = tc_point(pts, v1);
+  if (dir & TCC_DIR_MIDPOINT) return (p0 + p1) * 0.5;
+  return (dir & TCC_DIR_REMOVE_V1) ? p0 : p1;
+}
+
+/* (cost, index) order used by both conflict passes. */
+inline int tcc_before(__global const double* cost, int f, int e) {
+  double cf = cost[f], ce = cost[e];
+  return cf < ce || (cf == ce && f < e);
+}
+
+#endif

@@ -1,0 +1,260 @@
+/* Stage 1 of a collapse iteration: connectivity of the current mesh, without global sorts.
+ *
+ *   vertex -> tets   count (atomic_inc per corner) + exclusive scan + scatter (atomic cursor)
+ *                    + a per-vertex sort of each short list, so the lists are deterministic.
+ *   vertex -> verts  N(v): gather the other corners of ring(v), sort and unique per vertex in
+ *                    a scratch area of 3 |ring(v)| slots, count, scan, copy.
+ *   edges            (v, u) for u in N(v), u > v, in that order: sorted lexicographically, the
+ *                    same numbering as tc::build_topology; nb_edge gives each N(v) entry's edge.
+ *   boundary         derived locally from the rings (see collapse_common.h): S-faces, edge and
+ *                    vertex flags, ridge edges and vertex classes with tc::build_topology's rules.
+ */
+#include "collapse_common.h"
+
+__kernel void conn_count(__global const int* tets, uint nt, __global uint* count) {
+  uint t = get_global_id(0);
+  if (t >= nt) return;
+  for (int k = 0; k < 4; ++k) atomic_inc(&count[tets[4 * t + k]]);
+}
+
+__kernel void conn_scatter(__global const int* tets, uint nt, __global const uint* vt_off, __global uint* cursor,
+                           __global int* vt) {
+  uint t = get_global_id(0);
+  if (t >= nt) return;
+  for (int k = 0; k < 4; ++k) {
+    int v = tets[4 * t + k];
+    uint slot = atomic_inc(&cursor[v]);
+    vt[vt_off[v] + slot] = (int)t;
+  }
+}
+
+/* Insertion sort of a short global segment (lists are a few dozen entries). */
+inline void tcc_sort_segment(__global int* a, uint n) {
+  for (uint i = 1; i < n; ++i) {
+    int x = a[i];
+    uint j = i;
+    while (j > 0 && a[j - 1] > x) {
+      a[j] = a[j - 1];
+      --j;
+    }
+    a[j] = x;
+  }
+}
+
+/* Sorts ring(v); then gathers N(v) into scratch[3 vt_off[v] ..], sorted and unique, and counts
+ * it (nb_count) and its part above v (up_count). */
+__kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __global const uint* vt_off,
+                                        __global int* vt, __global int* scratch, __global uint* nb_count,
+                                        __global uint* up_count) {
+  uint v = get_global_id(0);
+  if (v >= nv) return;
+  uint b = vt_off[v], n = vt_off[v + 1] - b;
+  tcc_sort_segment(vt + b, n);
+  __global int* s = scratch + 3 * b;
+  uint m = 0;
+  for (uint i = 0; i < n; ++i) {
+    __global const int* q = tets + 4 * vt[b + i];
+    for (int k = 0; k < 4; ++k) {
+      int u = q[k];
+      if (u == (int)v) continue;
+      /* insert into the sorted prefix s[0..m) unless present */
+      uint j = m;
+      while (j > 0 && s[j - 1] > u) --j;
+      if (j > 0 && s[j - 1] == u) continue;
+      for (uint k2 = m; k2 > j; --k2) s[k2] = s[k2 - 1];
+      s[j] = u;
+      ++m;
+    }
+  }
+  uint up = 0;
+  for (uint i = 0; i < m; ++i) up += s[i] > (int)v ? 1u : 0u;
+  nb_count[v] = m;
+  up_count[v] = up;
+}
+
+/* Copies N(v) to nb[] and writes the edges owned by v (u > v) and their ids. */
+__kernel void conn_write_neighbours(uint nv, __global const uint* vt_off, __global const int* scratch,
+                                    __global const uint* nb_off, __global const uint* edge_off, __global int* nb,
+                                    __global int* nb_edge, __global int* edges) {
+  uint v = get_global_id(0);
+  if (v >= nv) return;
+  __global const int* s = scratch + 3 * vt_off[v];
+  uint b = nb_off[v], m = nb_off[v + 1] - b;
+  uint lower = m - (edge_off[v + 1] - edge_off[v]);
+  for (uint i = 0; i < m; ++i) {
+    int u = s[i];
+    nb[b + i] = u;
+    if (i >= lower) {
+      uint e = edge_off[v] + (i - lower);
+      nb_edge[b + i] = (int)e;
+      edges[2 * e] = (int)v;
+      edges[2 * e + 1] = u;
+    }
+  }
+}
+
+/* Edge ids of the entries u < v of N(v): edge (u, v) is owned by u. */
+__kernel void conn_lower_edges(uint nv, __global const uint* nb_off, __global const int* nb,
+                               __global const uint* edge_off, __global int* nb_edge) {
+  uint v = get_global_id(0);
+  if (v >= nv) return;
+  uint b = nb_off[v], m = nb_off[v + 1] - b;
+  uint lower = m - (edge_off[v + 1] - edge_off[v]);
+  for (uint i = 0; i < lower; ++i) {
+    int u = nb[b + i];
+    /* position of v among the upper part of N(u) */
+    uint ub = nb_off[u + 1] - (edge_off[u + 1] - edge_off[u]);
+    uint lo = ub, hi = nb_off[u + 1];
+    while (lo < hi) {
+      uint mid = (lo + hi) >> 1;
+      if (nb[mid] < (int)v) lo = mid + 1;
+      else hi = mid;
+    }
+    nb_edge[b + i] = (int)(edge_off[u] + (lo - ub));
+  }
+}
+
+/* Edge flags: S membership (boundary / interface) and the ridge rule of tc::build_topology:
+ * an S-edge is a ridge when it has a number of S-faces other than two, when its two S-faces do
+ * not traverse it in opposite directions, or when 1 - dot(n1, n2) > eps_r. */
+__kernel void conn_edge_flags(uint ne, __global const int* edges, __global const int* tets,
+                              __global const uint* vt_off, __global const int* vt, __global const int* labels,
+                              int use_labels, __global const double* pts, double eps_r, __global uchar* eflags) {
+  uint e = get_global_id(0);
+  if (e >= ne) return;
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  uint flags = 0;
+  int ns = 0;
+  int ft[2], ff[2];
+  for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
+    int t = vt[i];
+    int lb = tcc_local(tets, t, b);
+    if (lb < 0) continue;
+    int la = tcc_local(tets, t, a);
+    for (int f = 0; f < 4; ++f) {
+      if (f == la || f == lb) continue; /* faces containing a and b are opposite the others */
+      uint on_s;
+      uint own = tcc_owned_sface(tets, vt_off, vt, labels, use_labels, t, f, &on_s);
+      flags |= on_s;
+      if (own) {
+        if (ns < 2) {
+          ft[ns] = t;
+          ff[ns] = f;
+        }
+        ++ns;
+      }
+    }
+  }
+  if (ns > 0) {
+    int ridge = 0;
+    if (ns != 2) {
+      ridge = 1;
+    } else {
+      int dir[2];
+      for (int k = 0; k < 2; ++k) {
+        __global const int* q = tets + 4 * ft[k];
+        int f0 = q[TC_TET_FACES[ff[k]][0]], f1 = q[TC_TET_FACES[ff[k]][1]], f2 = q[TC_TET_FACES[ff[k]][2]];
+        dir[k] = (f0 == a && f1 == b) || (f1 == a && f2 == b) || (f2 == a && f0 == b);
+      }
+      if (dir[0] == dir[1]) {
+        ridge = 1;
+      } else {
+        double3 n0 = tcc_face_normal(pts, tets, ft[0], ff[0]);
+        double3 n1 = tcc_face_normal(pts, tets, ft[1], ff[1]);
+        ridge = 1.0 - tcc_dot(n0, n1) > eps_r;
+      }
+    }
+    if (ridge) flags |= TCC_RIDGE;
+  }
+  eflags[e] = (uchar)flags;
+}
+
+#ifndef TCC_MAX_VERTEX_SFACES
+#define TCC_MAX_VERTEX_SFACES 64
+#endif
+
+/* Vertex flags and class with tc::build_topology's rules (see include/tetcollapse/topology.hpp):
+ * ridge when exactly two ridge edges; face when no ridge edge, all normals within eps_f and the
+ * S-faces form one closed fan; corner otherwise. More than TCC_MAX_VERTEX_SFACES S-faces at a
+ * vertex (never seen in practice) classify it as corner, which only protects it more. */
+__kernel void conn_vertex_class(uint nv, __global const int* tets, __global const uint* vt_off,
+                                __global const int* vt, __global const int* labels, int use_labels,
+                                __global const double* pts, __global const uint* nb_off,
+                                __global const int* nb_edge, __global const uchar* eflags, double eps_f,
+                                __global uchar* vflags, __global uchar* vclass) {
+  uint v = get_global_id(0);
+  if (v >= nv) return;
+  double3 normal[TCC_MAX_VERTEX_SFACES];
+  int after[TCC_MAX_VERTEX_SFACES], before[TCC_MAX_VERTEX_SFACES];
+  int fn = 0, overflow = 0;
+  uint flags = 0;
+  for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
+    int t = vt[i];
+    int lv = tcc_local(tets, t, (int)v);
+    for (int f = 0; f < 4; ++f) {
+      if (f == lv) continue;
+      uint on_s;
+      uint own = tcc_owned_sface(tets, vt_off, vt, labels, use_labels, t, f, &on_s);
+      flags |= on_s;
+      if (!own) continue;
+      if (fn == TCC_MAX_VERTEX_SFACES) {
+        overflow = 1;
+        continue;
+      }
+      __global const int* q = tets + 4 * t;
+      int w[3] = {q[TC_TET_FACES[f][0]], q[TC_TET_FACES[f][1]], q[TC_TET_FACES[f][2]]};
+      int p = w[0] == (int)v ? 0 : w[1] == (int)v ? 1 : 2;
+      after[fn] = w[(p + 1) % 3];
+      before[fn] = w[(p + 2) % 3];
+      normal[fn] = tcc_face_normal(pts, tets, t, f);
+      ++fn;
+    }
+  }
+  vflags[v] = (uchar)flags;
+  uchar cls;
+  if (fn == 0 && !overflow) {
+    cls = TCC_INTERIOR;
+  } else if (overflow) {
+    cls = TCC_CORNER;
+  } else {
+    int ridges = 0;
+    for (uint i = nb_off[v]; i < nb_off[v + 1]; ++i) ridges += (eflags[nb_edge[i]] & TCC_RIDGE) ? 1 : 0;
+    if (ridges == 2) {
+      cls = TCC_RIDGEV;
+    } else if (ridges != 0) {
+      cls = TCC_CORNER;
+    } else {
+      cls = TCC_FACE;
+      for (int i = 0; i < fn && cls == TCC_FACE; ++i)
+        for (int j = i + 1; j < fn; ++j)
+          if (1.0 - tcc_dot(normal[i], normal[j]) > eps_f) {
+            cls = TCC_CORNER;
+            break;
+          }
+      if (cls == TCC_FACE) {
+        /* one closed fan: following before -> the unique face whose `after` equals it runs
+         * through all fn faces and closes (the walk's result does not depend on the start) */
+        int cur = 0;
+        for (int step = 1; step <= fn; ++step) {
+          int want = before[cur], next = -1, found = 0;
+          for (int j = 0; j < fn; ++j)
+            if (after[j] == want) {
+              next = j;
+              ++found;
+            }
+          if (found != 1) {
+            cls = TCC_CORNER;
+            break;
+          }
+          cur = next;
+          if (cur == 0 && step != fn) {
+            cls = TCC_CORNER;
+            break;
+          }
+        }
+        if (cls == TCC_FACE && cur != 0) cls = TCC_CORNER;
+      }
+    }
+  }
+  vclass[v] = cls;
+}

@@ -1,0 +1,181 @@
+// The collapse loop (paper, Algorithm 1) over the stages of host/collapse/stages.cpp.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "collapse/stages.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "geometry.h"
+
+namespace tc {
+
+using namespace collapse_detail;
+
+namespace {
+
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Median of the first-iteration edge lengths (the cost buffer holds them when there is no user
+// cost). nth_element: the lower median for an even count, as in tc::summarize.
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0;
+  size_t m = (v.size() - 1) / 2;
+  std::nth_element(v.begin(), v.begin() + m, v.end());
+  return v[m];
+}
+
+void remap_elements(std::vector<int32_t>& elems, std::vector<int32_t>& tags, int arity,
+                    const std::vector<int32_t>& origin) {
+  const size_t n = elems.size() / arity;
+  std::vector<int32_t> out, out_tags;
+  out.reserve(elems.size());
+  for (size_t i = 0; i < n; ++i) {
+    int32_t v[3];
+    bool ok = true;
+    for (int k = 0; k < arity; ++k) {
+      int32_t x = elems[i * arity + k];
+      if (x < 0 || size_t(x) >= origin.size()) {
+        ok = false;
+        break;
+      }
+      v[k] = origin[x];
+      for (int j = 0; j < k; ++j) ok = ok && v[j] != v[k];
+    }
+    if (!ok) continue;
+    out.insert(out.end(), v, v + arity);
+    if (i < tags.size()) out_tags.push_back(tags[i]);
+  }
+  elems.swap(out);
+  if (!tags.empty()) tags.swap(out_tags);
+}
+
+}  // namespace
+
+double median_edge_length(const Mesh& mesh) {
+  std::vector<uint64_t> keys;
+  keys.reserve(mesh.tets.size() / 4 * 6);
+  for (size_t t = 0; t + 3 < mesh.tets.size(); t += 4)
+    for (int e = 0; e < 6; ++e) {
+      uint32_t a = uint32_t(mesh.tets[t + geo::TC_TET_EDGES[e][0]]), b = uint32_t(mesh.tets[t + geo::TC_TET_EDGES[e][1]]);
+      if (a > b) std::swap(a, b);
+      keys.push_back(uint64_t(a) << 32 | b);
+    }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<double> len;
+  len.reserve(keys.size());
+  const int64_t nv = mesh.num_vertices();
+  for (uint64_t k : keys) {
+    int64_t a = int64_t(k >> 32), b = int64_t(k & 0xffffffffu);
+    if (a >= nv || b >= nv) continue;
+    double d = 0;
+    for (int c = 0; c < 3; ++c) d += (mesh.points[3 * b + c] - mesh.points[3 * a + c]) * (mesh.points[3 * b + c] - mesh.points[3 * a + c]);
+    len.push_back(std::sqrt(d));
+  }
+  return median_of(std::move(len));
+}
+
+CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
+  if (options.max_iterations < 0) throw std::invalid_argument("max_iterations must be >= 0");
+  if (!options.cost_cl_source.empty() && !(options.target_length > 0))
+    throw std::invalid_argument("a user cost (cost_cl_source) needs an explicit target_length > 0");
+  if (!(options.target_length > 0) && !(options.target_factor > 0))
+    throw std::invalid_argument("target_factor must be > 0 when target_length is not given");
+
+  CollapseReport report;
+  report.device = ctx.info().name;
+  report.vertices_in = mesh.num_vertices();
+  report.tets_in = mesh.num_tets();
+
+  StageParams p = params_from(options);
+  if (options.eps_v_relative) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i + 2 < mesh.points.size(); i += 3)
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = std::min(lo[c], mesh.points[i + c]);
+        hi[c] = std::max(hi[c], mesh.points[i + c]);
+      }
+    double d2 = 0;
+    for (int c = 0; c < 3; ++c) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
+    p.eps_v = options.eps_v * d2 * std::sqrt(d2);
+  }
+  report.eps_v = p.eps_v;
+
+  const double t_start = now();
+  DeviceMesh dm, next;
+  upload_mesh(ctx, mesh, options, dm);
+  const uint32_t n_origin = dm.nv;
+  std::vector<int32_t> identity(n_origin);
+  for (uint32_t i = 0; i < n_origin; ++i) identity[i] = int32_t(i);
+  DeviceBuffer<int32_t> origin(ctx, identity);
+  ctx.finish();
+  report.seconds_upload = now() - t_start;
+
+  Connectivity conn;
+  EdgeState st;
+  p.target = options.target_length;
+  const double t_loop = now();
+  for (int it = 0; it < options.max_iterations && dm.nt > 0; ++it) {
+    IterationStats s;
+    s.iteration = it;
+    s.vertices = dm.nv;
+    s.tets = dm.nt;
+    double t0 = now();
+    build_connectivity(ctx, dm, conn, p);
+    ctx.finish();
+    double t1 = now();
+    s.seconds_connectivity = t1 - t0;
+    s.edges = conn.ne;
+    if (it == 0 && !(p.target > 0)) {
+      // the target from the input's median edge length, on the device's edge list
+      StageParams q = p;
+      q.cost_source.clear();
+      q.target = 0;
+      cost_and_mark(ctx, dm, conn, st, q);
+      report.median_edge_length = median_of(st.cost.download_range(0, conn.ne));
+      p.target = options.target_factor * report.median_edge_length;
+    }
+    s.marked = cost_and_mark(ctx, dm, conn, st, p);
+    double t2 = now();
+    s.seconds_cost = t2 - t1;
+    s.admissible = admissible(ctx, dm, conn, st, p);
+    double t3 = now();
+    s.seconds_admissible = t3 - t2;
+    s.after_pass1 = conflict_pass1(ctx, dm, conn, st);
+    double t4 = now();
+    s.seconds_pass1 = t4 - t3;
+    s.after_pass2 = conflict_pass2(ctx, dm, conn, st);
+    s.collapsed = s.after_pass2;
+    double t5 = now();
+    s.seconds_pass2 = t5 - t4;
+    if (s.collapsed > 0) collapse_and_compact(ctx, dm, next, conn, st, origin, n_origin);
+    ctx.finish();
+    double t6 = now();
+    s.seconds_collapse = t6 - t5;
+    s.seconds_total = t6 - t0;
+    s.vertices_after = dm.nv;
+    s.tets_after = dm.nt;
+    report.iterations.push_back(s);
+    if (options.progress) options.progress(s);
+    if (s.collapsed < std::max<int64_t>(options.eps_c, 1)) break;
+  }
+  report.target_length = p.target;
+  const double t_down = now();
+  report.seconds_total = t_down - t_loop;
+
+  download_mesh(dm, mesh);
+  if (!mesh.tris.empty() || !mesh.edges.empty()) {
+    std::vector<int32_t> org = origin.download();
+    remap_elements(mesh.tris, mesh.tri_tags, 3, org);
+    remap_elements(mesh.edges, mesh.edge_tags, 2, org);
+  }
+  report.seconds_download = now() - t_down;
+  report.vertices_out = mesh.num_vertices();
+  report.tets_out = mesh.num_tets();
+  return report;
+}
+
+}  // namespace tc

@@ -1,0 +1,281 @@
+// Host side of the collapse stages: buffer management and kernel launches (cl/collapse_*.cl).
+#include "collapse/stages.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+
+#include "device/primitives.hpp"
+#include "tetcollapse/error.hpp"
+
+namespace tc::collapse_detail {
+
+namespace {
+
+template <class T>
+void ensure(DeviceBuffer<T>& b, Context& ctx, size_t n) {
+  if (!b.buffer()()) b = DeviceBuffer<T>(ctx, n);
+  else b.resize(n);
+}
+
+template <class... A>
+void set_args(cl::Kernel& k, const char* what, const A&... a) {
+  detail::cl_call(what, [&] {
+    cl_uint i = 0;
+    (k.setArg(i++, a), ...);
+  });
+}
+
+// Kernel arguments: buffers by their cl::Buffer, scalars as OpenCL types.
+template <class T>
+const cl::Buffer& B(const DeviceBuffer<T>& b) {
+  return b.buffer();
+}
+cl_uint U(size_t v) { return static_cast<cl_uint>(v); }
+cl_int I(int v) { return static_cast<cl_int>(v); }
+
+void run(Context& ctx, const std::string& file, const char* name, size_t n, const std::string& options,
+         const auto&... args) {
+  cl::Kernel k = ctx.kernel(file, name, options);
+  set_args(k, name, args...);
+  ctx.launch(k, n, name);
+}
+
+// Exclusive scan of counts[0..n) into off[0..n], off[n] = total.
+uint32_t scan_offsets(Context& ctx, DeviceBuffer<uint32_t>& counts, DeviceBuffer<uint32_t>& off, size_t n) {
+  ensure(off, ctx, n + 1);
+  uint32_t total = dev::exclusive_scan(ctx, counts, off, n);
+  off.upload(&total, 1, n);
+  return total;
+}
+
+const cl::Buffer& primary_labels(DeviceMesh& dm) { return dm.labels[0].buffer(); }
+
+}  // namespace
+
+StageParams params_from(const CollapseOptions& o) {
+  StageParams p;
+  p.mode = o.boundary == CollapseOptions::Strict ? 0 : o.boundary == CollapseOptions::Features ? 1 : 2;
+  p.paper_rule = o.paper_boundary_rule;
+  p.use_labels = o.use_labels;
+  p.eps_f = o.eps_f;
+  p.eps_r = o.eps_r;
+  p.eps_v = o.eps_v;
+  p.mask_mode = o.vertex_mask.empty() ? 0 : o.mask_either ? 2 : 1;
+  p.cost_source = o.cost_cl_source;
+  return p;
+}
+
+void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm) {
+  const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
+  if (mesh.points.size() % 3 != 0 || mesh.tets.size() % 4 != 0)
+    throw InputError("<mesh>", "point or tet array length is not a multiple of 3 or 4");
+  // Edges and N(v) entries must fit 31-bit indices: 12 nt scratch slots bound both.
+  if (nv >= std::numeric_limits<int32_t>::max() || nt >= std::numeric_limits<int32_t>::max() / 12)
+    throw InputError("<mesh>", "mesh too large for the device pipeline's 32-bit indices: " + std::to_string(nv) +
+                                   " vertices, " + std::to_string(nt) + " tets");
+  for (int64_t t = 0; t < nt; ++t) {
+    const int32_t* q = &mesh.tets[4 * t];
+    for (int i = 0; i < 4; ++i) {
+      if (q[i] < 0 || q[i] >= nv)
+        throw InputError("<mesh>", "tet " + std::to_string(t) + " has vertex index " + std::to_string(q[i]) +
+                                       " outside [0, " + std::to_string(nv) + ")");
+      for (int j = 0; j < i; ++j)
+        if (q[i] == q[j]) throw InputError("<mesh>", "tet " + std::to_string(t) + " repeats vertex " + std::to_string(q[i]));
+    }
+  }
+  dm.nv = uint32_t(nv);
+  dm.nt = uint32_t(nt);
+  dm.points = DeviceBuffer<double>(ctx, mesh.points);
+  dm.tets = DeviceBuffer<int32_t>(ctx, mesh.tets);
+  dm.labels.clear();
+  for (const Labels& l : mesh.tet_labels) {
+    if (l.values.size() != size_t(nt))
+      throw InputError("<mesh>", "label array '" + l.name + "' has " + std::to_string(l.values.size()) +
+                                     " values for " + std::to_string(nt) + " tets");
+    dm.labels.emplace_back(ctx, l.values);
+  }
+  dm.has_labels = !dm.labels.empty() && o.use_labels;
+  if (dm.labels.empty()) dm.labels.emplace_back(ctx, 0);  // placeholder argument
+  auto pack = [&](const std::vector<Field>& fields, int64_t count, const char* kind, uint32_t& comps,
+                  DeviceBuffer<double>& out) {
+    comps = 0;
+    for (const Field& f : fields) {
+      if (f.components <= 0 || f.values.size() != size_t(count) * size_t(f.components))
+        throw InputError("<mesh>", std::string(kind) + " field '" + f.name + "' has " + std::to_string(f.values.size()) +
+                                       " values, expected " + std::to_string(count) + " x " + std::to_string(f.components));
+      comps += uint32_t(f.components);
+    }
+    std::vector<double> packed(size_t(count) * comps);
+    uint32_t c0 = 0;
+    for (const Field& f : fields) {
+      for (int64_t i = 0; i < count; ++i)
+        for (int c = 0; c < f.components; ++c) packed[size_t(i) * comps + c0 + c] = f.values[size_t(i) * f.components + c];
+      c0 += uint32_t(f.components);
+    }
+    out = DeviceBuffer<double>(ctx, packed);
+  };
+  pack(mesh.vertex_fields, nv, "vertex", dm.vfield_comps, dm.vfields);
+  pack(mesh.tet_fields, nt, "tet", dm.tfield_comps, dm.tfields);
+  dm.has_mask = !o.vertex_mask.empty();
+  if (dm.has_mask && o.vertex_mask.size() != size_t(nv))
+    throw std::invalid_argument("vertex_mask has " + std::to_string(o.vertex_mask.size()) + " entries for " +
+                                std::to_string(nv) + " vertices");
+  dm.vmask = DeviceBuffer<uint8_t>(ctx, o.vertex_mask);
+}
+
+void download_mesh(const DeviceMesh& dm, Mesh& mesh) {
+  mesh.points = dm.points.download_range(0, size_t(dm.nv) * 3);
+  mesh.tets = dm.tets.download_range(0, size_t(dm.nt) * 4);
+  for (size_t l = 0; l < mesh.tet_labels.size(); ++l) mesh.tet_labels[l].values = dm.labels[l].download_range(0, dm.nt);
+  auto unpack = [](std::vector<Field>& fields, const DeviceBuffer<double>& buf, uint32_t comps, uint32_t count) {
+    std::vector<double> packed = buf.download_range(0, size_t(count) * comps);
+    uint32_t c0 = 0;
+    for (Field& f : fields) {
+      f.values.assign(size_t(count) * f.components, 0.0);
+      for (uint32_t i = 0; i < count; ++i)
+        for (int c = 0; c < f.components; ++c) f.values[size_t(i) * f.components + c] = packed[size_t(i) * comps + c0 + c];
+      c0 += uint32_t(f.components);
+    }
+  };
+  unpack(mesh.vertex_fields, dm.vfields, dm.vfield_comps, dm.nv);
+  unpack(mesh.tet_fields, dm.tfields, dm.tfield_comps, dm.nt);
+}
+
+void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const StageParams& p) {
+  const std::string F = "collapse_connectivity.cl";
+  const uint32_t nv = dm.nv, nt = dm.nt;
+  ensure(c.count, ctx, nv);
+  ensure(c.cursor, ctx, nv);
+  c.count.fill(0);
+  c.cursor.fill(0);
+  ensure(c.vt, ctx, size_t(nt) * 4);
+  run(ctx, F, "conn_count", nt, "", B(dm.tets), U(nt), B(c.count));
+  scan_offsets(ctx, c.count, c.vt_off, nv);
+  run(ctx, F, "conn_scatter", nt, "", B(dm.tets), U(nt), B(c.vt_off), B(c.cursor), B(c.vt));
+  ensure(c.scratch, ctx, size_t(nt) * 12);
+  ensure(c.up_count, ctx, nv);
+  // c.count is reused for |N(v)|
+  run(ctx, F, "conn_ring_sort_and_gather", nv, "", B(dm.tets), U(nv), B(c.vt_off), B(c.vt), B(c.scratch),
+      B(c.count), B(c.up_count));
+  uint32_t nnb = scan_offsets(ctx, c.count, c.nb_off, nv);
+  c.ne = scan_offsets(ctx, c.up_count, c.edge_off, nv);
+  ensure(c.nb, ctx, nnb);
+  ensure(c.nb_edge, ctx, nnb);
+  ensure(c.edges, ctx, size_t(c.ne) * 2);
+  run(ctx, F, "conn_write_neighbours", nv, "", U(nv), B(c.vt_off), B(c.scratch), B(c.nb_off), B(c.edge_off), B(c.nb),
+      B(c.nb_edge), B(c.edges));
+  run(ctx, F, "conn_lower_edges", nv, "", U(nv), B(c.nb_off), B(c.nb), B(c.edge_off), B(c.nb_edge));
+  ensure(c.eflags, ctx, c.ne);
+  ensure(c.vflags, ctx, nv);
+  ensure(c.vclass, ctx, nv);
+  const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
+  run(ctx, F, "conn_edge_flags", c.ne, "", U(c.ne), B(c.edges), B(dm.tets), B(c.vt_off), B(c.vt),
+      primary_labels(dm), use_labels, B(dm.points), p.eps_r, B(c.eflags));
+  run(ctx, F, "conn_vertex_class", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), primary_labels(dm), use_labels,
+      B(dm.points), B(c.nb_off), B(c.nb_edge), B(c.eflags), p.eps_f, B(c.vflags), B(c.vclass));
+}
+
+namespace {
+uint32_t counter(EdgeState& s, int i) {
+  uint32_t v = 0;
+  s.counters.download(&v, 1, size_t(i));
+  return v;
+}
+}  // namespace
+
+uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p) {
+  ensure(s.counters, ctx, 4);
+  s.counters.fill(0);
+  ensure(s.cost, ctx, c.ne);
+  ensure(s.marked, ctx, c.ne);
+  cl::Kernel k;
+  if (p.cost_source.empty()) {
+    k = ctx.kernel("collapse_cost.cl", "cost_and_mark");
+  } else {
+    // the user's function between the shared helpers and the kernel (see collapse_cost.cl)
+    const std::string src = "#include \"collapse_common.h\"\n" + p.cost_source + "\n#include \"collapse_cost.cl\"\n";
+    cl::Program& prog = ctx.build("user cost (cost_cl_source)", src, "-DTCC_USER_COST");
+    k = detail::cl_call("clCreateKernel(cost_and_mark)", [&] { return cl::Kernel(prog, "cost_and_mark"); });
+  }
+  const cl_int mask_mode = dm.has_mask ? p.mask_mode : 0;
+  set_args(k, "cost_and_mark", U(c.ne), B(c.edges), B(dm.points), B(dm.vfields), U(dm.vfield_comps),
+           I(dm.vfield_comps > 0 ? 1 : 0), B(dm.vmask), mask_mode, p.target, B(s.cost), B(s.marked), B(s.counters));
+  ctx.launch(k, c.ne, "cost_and_mark");
+  return counter(s, 0);
+}
+
+uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p) {
+  ensure(s.adm, ctx, c.ne);
+  ensure(s.dir, ctx, c.ne);
+  ensure(s.reason, ctx, c.ne);
+  const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
+  run(ctx, "collapse_admissible.cl", "admissible", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(dm.tets),
+      B(c.vt_off), B(c.vt), B(c.nb_off), B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points),
+      B(c.vflags), B(c.vclass), B(c.eflags), I(p.mode), I(p.paper_rule ? 1 : 0), p.eps_v, B(s.adm), B(s.dir),
+      B(s.reason), B(s.counters));
+  return counter(s, 1);
+}
+
+uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
+  ensure(s.p1, ctx, c.ne);
+  ensure(s.vaff, ctx, dm.nv);
+  s.vaff.fill(-1);
+  run(ctx, "collapse_conflict.cl", "conflict_pass1", c.ne, "", U(c.ne), B(c.edges), B(s.adm), B(s.cost), B(c.nb_off),
+      B(c.nb_edge), B(s.p1), B(s.vaff), B(s.counters));
+  return counter(s, 2);
+}
+
+uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
+  ensure(s.kill, ctx, c.ne);
+  ensure(s.fin, ctx, c.ne);
+  s.kill.fill(0);
+  run(ctx, "collapse_conflict.cl", "conflict_pass2", dm.nt, "", U(dm.nt), B(dm.tets), B(s.vaff), B(s.cost), B(s.kill));
+  run(ctx, "collapse_conflict.cl", "conflict_finalize", c.ne, "", U(c.ne), B(c.edges), B(s.p1), B(s.kill), B(s.fin),
+      B(s.vaff), B(s.counters));
+  return counter(s, 3);
+}
+
+void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connectivity& c, EdgeState& s,
+                          DeviceBuffer<int32_t>& origin, uint32_t n_origin) {
+  const std::string F = "collapse_compact.cl";
+  const uint32_t nv = dm.nv, nt = dm.nt;
+  // vertices
+  DeviceBuffer<uint32_t>& vkeep = c.count;  // scratch reuse: nv entries
+  DeviceBuffer<uint32_t>& vnew = c.cursor;
+  run(ctx, F, "vertex_keep", nv, "", U(nv), B(s.vaff), B(c.edges), B(s.dir), B(vkeep));
+  const uint32_t nv2 = dev::exclusive_scan(ctx, vkeep, vnew, nv);
+  DeviceBuffer<int32_t> vmap(ctx, nv);
+  run(ctx, F, "vertex_map", nv, "", U(nv), B(s.vaff), B(c.edges), B(s.dir), B(vnew), B(vkeep), B(vmap));
+  next.nv = nv2;
+  ensure(next.points, ctx, size_t(nv2) * 3);
+  ensure(next.vfields, ctx, size_t(nv2) * dm.vfield_comps);
+  ensure(next.vmask, ctx, dm.has_mask ? nv2 : 0);
+  next.vfield_comps = dm.vfield_comps;
+  next.tfield_comps = dm.tfield_comps;
+  next.has_mask = dm.has_mask;
+  next.has_labels = dm.has_labels;
+  run(ctx, F, "vertex_write", nv, "", U(nv), B(s.vaff), B(c.edges), B(s.dir), B(vkeep), B(vnew), B(dm.points),
+      B(next.points), U(dm.vfield_comps), B(dm.vfields), B(next.vfields), I(dm.has_mask ? 1 : 0), B(dm.vmask),
+      B(next.vmask));
+  // tets
+  DeviceBuffer<uint32_t> tkeep(ctx, nt), tnew(ctx, nt);
+  run(ctx, F, "tet_keep", nt, "", U(nt), B(dm.tets), B(s.vaff), B(c.edges), B(tkeep));
+  const uint32_t nt2 = dev::exclusive_scan(ctx, tkeep, tnew, nt);
+  next.nt = nt2;
+  ensure(next.tets, ctx, size_t(nt2) * 4);
+  run(ctx, F, "tet_write", nt, "", U(nt), B(dm.tets), B(tkeep), B(tnew), B(vmap), B(next.tets));
+  next.labels.resize(dm.labels.size());
+  for (size_t l = 0; l < dm.labels.size(); ++l) {
+    ensure(next.labels[l], ctx, dm.labels[l].size() == 0 ? 0 : nt2);
+    if (dm.labels[l].size() != 0)
+      run(ctx, F, "compact_ints", nt, "", U(nt), B(tkeep), B(tnew), U(1), B(dm.labels[l]), B(next.labels[l]));
+  }
+  ensure(next.tfields, ctx, size_t(nt2) * dm.tfield_comps);
+  if (dm.tfield_comps > 0)
+    run(ctx, F, "compact_doubles", nt, "", U(nt), B(tkeep), B(tnew), U(dm.tfield_comps), B(dm.tfields), B(next.tfields));
+  if (n_origin > 0) run(ctx, F, "origin_update", n_origin, "", U(n_origin), B(vmap), B(origin));
+  std::swap(dm, next);
+}
+
+}  // namespace tc::collapse_detail

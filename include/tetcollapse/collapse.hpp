@@ -1,0 +1,117 @@
+// Parallel edge collapse on an OpenCL device (paper, Algorithm 1).
+//
+//   tc::Context ctx;                        // device selection: see device.hpp
+//   tc::CollapseOptions opt;                // defaults: target = 1 x median edge length
+//   opt.target_factor = 2;
+//   tc::CollapseReport r = tc::collapse(mesh, opt, ctx);   // mesh is replaced by the result
+//
+// One iteration = connectivity of the current mesh (rebuilt on the device without global
+// sorts), cost and marking, the admissible filter (predicate Q, link condition, volumes),
+// conflict pass 1 over edges, conflict pass 2 over tets, collapse + compaction. Iterations stop
+// when one collapses fewer than max(eps_c, 1) edges or after max_iterations.
+//
+// Boundary and material interfaces. The feature surface S is the outer boundary plus, when the
+// mesh has labels, every face between tets of different primary labels (tet_labels[0]).
+// Vertices are classified interior / face / ridge / corner with the rules of tc::build_topology
+// (topology.hpp), recomputed every iteration. Modes:
+//   Strict    a vertex of S is never removed or moved; only interior vertices are removed, onto
+//             an interior neighbour (midpoint) or onto a vertex of S (which stays put).
+//   Features  the paper's rule: rank interior 0 < face 1 < ridge 2 < corner 3; the removed
+//             vertex has the lower rank (equal ranks: the higher index is removed and the
+//             survivor goes to the midpoint; different ranks: the survivor keeps its position);
+//             corners never move; a face vertex is removed only along an S-edge, a ridge vertex
+//             only along a ridge edge; an edge joining two S vertices that is not an S-edge is
+//             refused. By default an interior vertex may collapse onto a vertex of S (placement =
+//             that vertex, so S stays exact); paper_boundary_rule refuses that, as the paper does.
+//   Free      anything the link condition and the volume test allow, midpoint placement.
+//
+// Attributes: every label array and tet field is carried with its tet; vertex fields stay with
+// the survivor (averaged with the removed vertex for midpoint placement); input triangles and
+// edges (mesh.tris, mesh.edges) are remapped through the vertex map and dropped when degenerate.
+//
+// Determinism: the same input and options give the same output bit for bit, whatever the run and
+// the work-group size (atomics only count; every list is sorted).
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "tetcollapse/device.hpp"
+#include "tetcollapse/mesh.hpp"
+
+namespace tc {
+
+struct IterationStats {
+  int iteration = 0;              // 0-based
+  int64_t vertices = 0, tets = 0, edges = 0;  // of the mesh this iteration started from
+  int64_t marked = 0;             // cost < target (and in the mask)
+  int64_t admissible = 0;         // passed Q, the link condition and the volume test
+  int64_t after_pass1 = 0;        // survived conflict pass 1 (edges)
+  int64_t after_pass2 = 0;        // survived conflict pass 2 (tets) = collapsed
+  int64_t collapsed = 0;
+  int64_t tets_after = 0, vertices_after = 0;
+  // Seconds per stage (wall time, the queue finished after each stage).
+  double seconds_connectivity = 0, seconds_cost = 0, seconds_admissible = 0, seconds_pass1 = 0,
+         seconds_pass2 = 0, seconds_collapse = 0, seconds_total = 0;
+};
+
+struct CollapseReport {
+  int64_t vertices_in = 0, vertices_out = 0, tets_in = 0, tets_out = 0;
+  std::vector<IterationStats> iterations;
+  double seconds_total = 0;  // collapse() without the host<->device transfers of the mesh
+  double seconds_upload = 0, seconds_download = 0;
+  std::string device;
+  double target_length = 0;   // the threshold actually used
+  double median_edge_length = 0;  // of the input (computed when target_length <= 0)
+  double eps_v = 0;           // the volume threshold actually used
+};
+
+struct CollapseOptions {
+  // Edges with a cost below target_length are marked. <= 0: target_factor x the input's median
+  // edge length.
+  double target_length = 0;
+  double target_factor = 1;
+  // Stop when an iteration collapses fewer than max(eps_c, 1) edges.
+  int64_t eps_c = 0;
+  int max_iterations = 1000;
+
+  enum Boundary { Strict, Features, Free };
+  Boundary boundary = Features;
+  bool paper_boundary_rule = false;  // Features/Strict: refuse every non-S edge touching S
+  bool use_labels = true;            // material interfaces from tet_labels[0]
+
+  double eps_f = 0.01;   // face threshold on 1 - dot(n_i, n_j)  (see topology.hpp)
+  double eps_r = 0.1;    // ridge threshold on 1 - dot(n_1, n_2)
+  // Tets of the collapsed neighbourhood must keep a volume >= eps_v. With eps_v_relative the
+  // threshold is eps_v x (bounding-box diagonal of the input)^3.
+  double eps_v = 2e-12;
+  bool eps_v_relative = false;
+
+  // Adaptive marking: with a non-empty mask (one byte per input vertex, non-zero = selected),
+  // only edges whose both end points are selected are marked, or either end point with
+  // mask_either. The mask travels with the survivors.
+  std::vector<uint8_t> vertex_mask;
+  bool mask_either = false;
+
+  // Optional user cost, OpenCL C source defining
+  //     double tc_user_cost(double3 p0, double3 p1, double f0, double f1);
+  // p0, p1: end points; f0, f1: first component of the first vertex field at them (0 without
+  // vertex fields). Edges with tc_user_cost < target_length are marked (target_length must then
+  // be > 0, there is no median of a user cost). Compiled into the cost kernel at run time.
+  std::string cost_cl_source;
+
+  // Called after every iteration (e.g. for a progress line).
+  std::function<void(const IterationStats&)> progress;
+};
+
+// Coarsens `mesh` in place. Throws tc::InputError for a mesh the pipeline cannot take (index out
+// of range, repeated vertex in a tet, more than 2^31 entities), std::invalid_argument for bad
+// options, tc::DeviceError for device failures (including a user cost that does not compile).
+CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx);
+
+// Median edge length of a mesh (unique edges), on the host. 0 for a mesh without tets.
+double median_edge_length(const Mesh& mesh);
+
+}  // namespace tc

@@ -1,0 +1,124 @@
+// Stage 1 (device connectivity of an iteration) against the CPU reference tc::build_topology.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "collapse/stages.hpp"
+#include "tetcollapse/io.hpp"
+#include "tetcollapse/topology.hpp"
+#include "test_support.hpp"
+
+using namespace tc;
+using namespace tc::collapse_detail;
+
+namespace {
+
+// A cube of cube_tets(n) with the upper half (z > 0.5 at the centroid) labelled 2, the rest 1.
+Mesh two_materials(int n) {
+  Mesh m = test::cube_tets(n);
+  Labels l{"material", {}};
+  for (int64_t t = 0; t < m.num_tets(); ++t) {
+    double z = 0;
+    for (int k = 0; k < 4; ++k) z += m.points[3 * m.tets[4 * t + k] + 2];
+    l.values.push_back(z / 4 > 0.5 ? 2 : 1);
+  }
+  m.tet_labels.push_back(l);
+  return m;
+}
+
+void compare_with_reference(Context& ctx, const Mesh& mesh) {
+  CollapseOptions o;
+  StageParams p = params_from(o);
+  DeviceMesh dm;
+  upload_mesh(ctx, mesh, o, dm);
+  Connectivity c;
+  build_connectivity(ctx, dm, c, p);
+  Topology ref = build_topology(mesh);
+
+  ASSERT_EQ(int64_t(c.ne), int64_t(ref.num_edges()));
+  EXPECT_EQ(c.edges.download_range(0, 2 * size_t(c.ne)), ref.edges);
+  EXPECT_EQ(c.vt_off.download_range(0, dm.nv + 1),
+            std::vector<uint32_t>(ref.vertex_tets_offsets.begin(), ref.vertex_tets_offsets.end()));
+  EXPECT_EQ(c.vt.download_range(0, 4 * size_t(dm.nt)), ref.vertex_tets);
+  // vertex -> edges: the same sets (our list is ordered by neighbour, the reference by edge id)
+  std::vector<uint32_t> nb_off = c.nb_off.download_range(0, dm.nv + 1);
+  std::vector<int32_t> nb_edge = c.nb_edge.download_range(0, nb_off.back());
+  std::vector<int32_t> nb = c.nb.download_range(0, nb_off.back());
+  for (int32_t v = 0; v < ref.num_vertices; ++v) {
+    std::vector<int32_t> mine(nb_edge.begin() + nb_off[v], nb_edge.begin() + nb_off[v + 1]);
+    std::sort(mine.begin(), mine.end());
+    std::vector<int32_t> theirs(ref.vertex_edges.begin() + ref.vertex_edges_offsets[v],
+                                ref.vertex_edges.begin() + ref.vertex_edges_offsets[v + 1]);
+    ASSERT_EQ(mine, theirs) << "vertex " << v;
+    for (uint32_t k = nb_off[v]; k < nb_off[v + 1]; ++k) {
+      int32_t e = nb_edge[k];
+      int32_t u = nb[k];
+      ASSERT_TRUE((ref.edges[2 * e] == v && ref.edges[2 * e + 1] == u) || (ref.edges[2 * e] == u && ref.edges[2 * e + 1] == v));
+    }
+  }
+  std::vector<uint8_t> eflags = c.eflags.download_range(0, c.ne), vflags = c.vflags.download_range(0, dm.nv),
+                       vclass = c.vclass.download_range(0, dm.nv);
+  for (int32_t e = 0; e < ref.num_edges(); ++e) {
+    ASSERT_EQ(eflags[e] & 3, ref.edge_boundary[e]) << "edge " << e;
+    ASSERT_EQ((eflags[e] >> 2) & 1, ref.edge_ridge[e]) << "edge " << e;
+  }
+  EXPECT_EQ(vflags, ref.vertex_boundary);
+  EXPECT_EQ(vclass, ref.vertex_class);
+}
+
+}  // namespace
+
+TEST(CollapseConnectivity, CubeMatchesBuildTopology) {
+  Context ctx;
+  compare_with_reference(ctx, test::cube_tets(4));
+}
+
+TEST(CollapseConnectivity, MaterialInterfaceMatchesBuildTopology) {
+  Context ctx;
+  Mesh m = two_materials(4);
+  compare_with_reference(ctx, m);
+  Topology ref = build_topology(m);
+  int interface_vertices = 0;
+  for (uint8_t b : ref.vertex_boundary) interface_vertices += (b & kOnInterface) ? 1 : 0;
+  EXPECT_EQ(interface_vertices, 25);  // the z = 0.5 plane of a 4 x 4 x 4 grid
+}
+
+TEST(CollapseConnectivity, IndependentOfWorkGroupSize) {
+  Context ctx;
+  Mesh m = two_materials(3);
+  std::vector<int32_t> first;
+  for (size_t wg : {1, 8, 64}) {
+    ctx.set_work_group_size(wg);
+    CollapseOptions o;
+    DeviceMesh dm;
+    upload_mesh(ctx, m, o, dm);
+    Connectivity c;
+    build_connectivity(ctx, dm, c, params_from(o));
+    std::vector<int32_t> all = c.vt.download_range(0, 4 * size_t(dm.nt));
+    std::vector<int32_t> nb = c.nb.download();
+    all.insert(all.end(), nb.begin(), nb.end());
+    if (first.empty()) first = all;
+    EXPECT_EQ(all, first) << "work-group size " << wg;
+  }
+}
+
+TEST(CollapseConnectivity, SharedMeshesMatchBuildTopology) {
+  TC_SKIP_IF_NO_SHARED();
+  Context ctx;
+  for (const char* name : {"mmg_tinyBoxt.mesh", "libigl_octopus-low.mesh", "polyfem_bimetal.msh"}) {
+    std::string path = test::shared_mesh(name);
+    if (path.empty()) {
+      std::printf("skipping %s: absent\n", name);
+      continue;
+    }
+    Mesh m;
+    try {
+      m = read_mesh(path);
+    } catch (const std::exception& e) {
+      std::printf("skipping %s: %s\n", name, e.what());
+      continue;
+    }
+    SCOPED_TRACE(name);
+    compare_with_reference(ctx, m);
+  }
+}
