@@ -47,9 +47,15 @@ class Records {
  public:
   Records(std::string_view text, const std::string& file) : c_(io::blank_comments(text, storage_), file) {}
 
-  // Starts a record; `what` names it for "unexpected end of file" messages.
-  void begin(const std::string& what) {
-    if (c_.at_end()) c_.fail("unexpected end of file (expected " + what + ")");
+  // Starts a record; `what` (and, for data records, "i of n") names it for "unexpected
+  // end of file" messages. The message is built only on failure: this runs per line.
+  void begin(const char* what, int64_t i = -1, int64_t n = 0) {
+    if (c_.at_end()) {
+      std::string msg = "unexpected end of file (expected ";
+      msg += what;
+      if (i >= 0) msg.append(" ").append(std::to_string(i + 1)).append(" of ").append(std::to_string(n));
+      c_.fail(msg + ")");
+    }
     line_ = c_.line();
   }
   // True when the current record has another value on its line.
@@ -119,7 +125,7 @@ NodeFile read_node(const std::string& path, Mesh& m, ReadNotes& notes) {
   }
   int64_t nonzero_markers = 0;
   for (int64_t i = 0; i < n; ++i) {
-    r.begin("node " + std::to_string(i + 1) + " of " + std::to_string(n));
+    r.begin("node", i, n);
     const int64_t index = r.integer("node index");
     if (i == 0) {
       if (index != 0 && index != 1) r.fail("first node index " + std::to_string(index) + " is not 0 or 1");
@@ -166,7 +172,7 @@ void read_ele(const std::string& path, const NodeFile& nf, Mesh& m, ReadNotes& n
   m.tets.resize(static_cast<size_t>(4 * n));
   std::vector<std::vector<double>> attrs(static_cast<size_t>(nattr), std::vector<double>(static_cast<size_t>(n)));
   for (int64_t i = 0; i < n; ++i) {
-    r.begin("element " + std::to_string(i + 1) + " of " + std::to_string(n));
+    r.begin("element", i, n);
     r.integer("element index");
     for (int j = 0; j < per; ++j) {
       int32_t v = vertex_ref(r, nf, "node index");
@@ -207,7 +213,7 @@ void read_face(const std::string& path, const NodeFile& nf, Mesh& m) {
   m.tris.resize(static_cast<size_t>(3 * n));
   m.tri_tags.assign(static_cast<size_t>(n), 0);
   for (int64_t i = 0; i < n; ++i) {
-    r.begin("face " + std::to_string(i + 1) + " of " + std::to_string(n));
+    r.begin("face", i, n);
     r.integer("face index");
     for (int j = 0; j < 3; ++j) m.tris[static_cast<size_t>(3 * i + j)] = vertex_ref(r, nf, "node index");
     if (nbmarker) {
