@@ -843,7 +843,10 @@ void write_medit(const std::string& path, const Mesh& m, const WriteOptions& opt
     const int version = binary_size_estimate(m) < (uint64_t(1) << 31) ? 2 : 3;
     mesh_bytes = mesh_binary(m, version);
     if (with_sol) {
-      BinaryWriter w(version);
+      uint64_t sol_size = 64;
+      for (const Solution& x : vsols) sol_size += uint64_t(m.num_vertices()) * uint64_t(x.size()) * 8;
+      for (const Solution& x : tsols) sol_size += uint64_t(m.num_tets()) * uint64_t(x.size()) * 8;
+      BinaryWriter w(sol_size < (uint64_t(1) << 31) ? 2 : 3);
       w.begin(kDimension);
       w.put<int32_t>(3);
       append_sol_binary(w, kSolAtVertices, m.num_vertices(), vsols);
