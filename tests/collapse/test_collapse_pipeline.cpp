@@ -1,0 +1,207 @@
+// The whole collapse loop: validity, feature preservation, strict mode, determinism, shared meshes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <set>
+#include <tuple>
+
+#include "tetcollapse/check.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/io.hpp"
+#include "tetcollapse/topology.hpp"
+#include "test_support.hpp"
+
+using namespace tc;
+
+namespace {
+
+CheckReport check(const Mesh& m, const Mesh* ref = nullptr) {
+  CheckOptions o;
+  o.quality = false;
+  o.hausdorff = false;
+  return check_mesh(m, o, ref);
+}
+
+std::set<std::tuple<double, double, double>> boundary_points(const Mesh& m) {
+  Topology t = build_topology(m);
+  std::set<std::tuple<double, double, double>> s;
+  for (int32_t v = 0; v < t.num_vertices; ++v)
+    if (t.vertex_boundary[v]) s.insert({m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]});
+  return s;
+}
+
+}  // namespace
+
+TEST(CollapsePipeline, CubeCoarsenedToTwiceMedianStaysValid) {
+  Context ctx;
+  Mesh in = test::cube_tets(6), m = in;
+  CollapseOptions o;
+  o.target_factor = 2;
+  CollapseReport r = collapse(m, o, ctx);
+  EXPECT_GT(r.iterations.size(), 1u);
+  EXPECT_LT(r.tets_out, r.tets_in / 3) << "reduction too small";
+  EXPECT_EQ(r.tets_out, m.num_tets());
+  CheckReport c = check(m, &in);
+  EXPECT_TRUE(c.valid) << check_report_text(c);
+  EXPECT_FALSE(c.reference.topology_changed);
+  // the 8 corners are still there, at their exact positions
+  auto b = boundary_points(m);
+  for (int i = 0; i < 8; ++i)
+    EXPECT_TRUE(b.count({double(i & 1), double((i >> 1) & 1), double((i >> 2) & 1)})) << "corner " << i;
+  // every boundary vertex is still on the cube's surface
+  for (auto [x, y, z] : b) {
+    bool on = x == 0 || x == 1 || y == 0 || y == 1 || z == 0 || z == 1;
+    EXPECT_TRUE(on) << x << " " << y << " " << z;
+  }
+  // volume preserved exactly up to rounding (the boundary only slides within its faces)
+  EXPECT_NEAR(c.volume, 1.0, 1e-12);
+  // statistics are consistent
+  int64_t collapsed = 0;
+  for (const auto& s : r.iterations) {
+    EXPECT_LE(s.admissible, s.marked);
+    EXPECT_LE(s.after_pass1, s.admissible);
+    EXPECT_LE(s.after_pass2, s.after_pass1);
+    EXPECT_EQ(s.vertices - s.vertices_after, s.collapsed);
+    collapsed += s.collapsed;
+  }
+  EXPECT_EQ(r.vertices_in - r.vertices_out, collapsed);
+}
+
+TEST(CollapsePipeline, StrictKeepsBoundaryVerticesBitIdentical) {
+  Context ctx;
+  Mesh in = test::cube_tets(5), m = in;
+  CollapseOptions o;
+  o.target_factor = 2;
+  o.boundary = CollapseOptions::Strict;
+  CollapseReport r = collapse(m, o, ctx);
+  EXPECT_LT(r.tets_out, r.tets_in);
+  EXPECT_TRUE(check(m, &in).valid);
+  EXPECT_EQ(boundary_points(m), boundary_points(in));
+}
+
+TEST(CollapsePipeline, PaperBoundaryRuleCollapsesLess) {
+  Context ctx;
+  Mesh in = test::cube_tets(5);
+  CollapseOptions o;
+  o.target_factor = 2;
+  Mesh a = in, b = in;
+  CollapseReport ra = collapse(a, o, ctx);
+  o.paper_boundary_rule = true;
+  CollapseReport rb = collapse(b, o, ctx);
+  EXPECT_TRUE(check(b, &in).valid);
+  EXPECT_LE(ra.tets_out, rb.tets_out);
+}
+
+TEST(CollapsePipeline, DeterministicAcrossWorkGroupSizes) {
+  Context ctx;
+  Mesh in = test::cube_tets(5);
+  // a label array and fields travel along
+  Labels l{"material", {}};
+  Field tf{"tq", 1, {}}, vf{"vx", 3, {}};
+  for (int64_t t = 0; t < in.num_tets(); ++t) {
+    l.values.push_back(in.points[3 * in.tets[4 * t]] < 0.5 ? 1 : 2);
+    tf.values.push_back(double(t));
+  }
+  for (int64_t v = 0; v < in.num_vertices(); ++v)
+    for (int c = 0; c < 3; ++c) vf.values.push_back(in.points[3 * v + c] * 10);
+  in.tet_labels.push_back(l);
+  in.tet_fields.push_back(tf);
+  in.vertex_fields.push_back(vf);
+  CollapseOptions o;
+  o.target_factor = 2.5;
+  Mesh first;
+  for (size_t wg : {0, 1, 4, 32, 256}) {
+    ctx.set_work_group_size(wg);
+    Mesh m = in;
+    collapse(m, o, ctx);
+    if (wg == 0) {
+      first = m;
+      CheckReport c = check(m, &in);
+      EXPECT_TRUE(c.valid) << check_report_text(c);
+      EXPECT_EQ(m.tet_labels[0].values.size(), size_t(m.num_tets()));
+      EXPECT_EQ(m.tet_fields[0].values.size(), size_t(m.num_tets()));
+      EXPECT_EQ(m.vertex_fields[0].values.size(), size_t(3 * m.num_vertices()));
+      // the vertex field follows the vertices: 10 x position, also after midpoint averaging
+      for (int64_t v = 0; v < m.num_vertices(); ++v)
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(m.vertex_fields[0].values[3 * v + c], 10 * m.points[3 * v + c], 1e-12);
+      // the material interface x = 0.5 is kept: labels on each side of it
+      for (int64_t t = 0; t < m.num_tets(); ++t) {
+        double x = 0;
+        for (int k = 0; k < 4; ++k) x += m.points[3 * m.tets[4 * t + k]] / 4;
+        EXPECT_EQ(m.tet_labels[0].values[t], x < 0.5 ? 1 : 2);
+      }
+      continue;
+    }
+    EXPECT_EQ(m.points, first.points) << "work-group size " << wg;
+    EXPECT_EQ(m.tets, first.tets) << "work-group size " << wg;
+    EXPECT_EQ(m.tet_labels[0].values, first.tet_labels[0].values);
+    EXPECT_EQ(m.tet_fields[0].values, first.tet_fields[0].values);
+    EXPECT_EQ(m.vertex_fields[0].values, first.vertex_fields[0].values);
+  }
+}
+
+TEST(CollapsePipeline, TrianglesAndEdgesAreRemapped) {
+  Context ctx;
+  Mesh m = test::cube_tets(4);
+  // tag the boundary triangles of the z = 0 face and the edges of its border
+  Topology t = build_topology(m);
+  for (int32_t f = 0; f < t.num_sfaces(); ++f) {
+    bool bottom = true;
+    for (int k = 0; k < 3; ++k) bottom = bottom && m.points[3 * t.sfaces[3 * f + k] + 2] == 0;
+    if (bottom) {
+      m.tris.insert(m.tris.end(), &t.sfaces[3 * f], &t.sfaces[3 * f] + 3);
+      m.tri_tags.push_back(7);
+    }
+  }
+  const size_t tris_in = m.tri_tags.size();
+  CollapseOptions o;
+  o.target_factor = 2;
+  collapse(m, o, ctx);
+  ASSERT_EQ(m.tris.size(), 3 * m.tri_tags.size());
+  EXPECT_LT(m.tri_tags.size(), tris_in);
+  EXPECT_GT(m.tri_tags.size(), 0u);
+  // every remaining triangle is a boundary face of the result on z = 0
+  Topology r = build_topology(m);
+  std::set<std::array<int32_t, 3>> faces;
+  for (int32_t f = 0; f < r.num_sfaces(); ++f) {
+    std::array<int32_t, 3> k{r.sfaces[3 * f], r.sfaces[3 * f + 1], r.sfaces[3 * f + 2]};
+    std::sort(k.begin(), k.end());
+    faces.insert(k);
+  }
+  for (size_t i = 0; i < m.tri_tags.size(); ++i) {
+    std::array<int32_t, 3> k{m.tris[3 * i], m.tris[3 * i + 1], m.tris[3 * i + 2]};
+    std::sort(k.begin(), k.end());
+    EXPECT_TRUE(faces.count(k)) << "triangle " << i;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(m.points[3 * k[c] + 2], 0.0);
+  }
+}
+
+TEST(CollapsePipeline, SharedMeshesCoarsenedToMedianStayValid) {
+  TC_SKIP_IF_NO_SHARED();
+  Context ctx;
+  for (const char* name : {"libigl_octopus-low.mesh", "polyfem_screw.msh", "polyfem_bimetal.msh", "mmg_tinyBoxt.mesh"}) {
+    std::string path = test::shared_mesh(name);
+    if (path.empty()) {
+      std::printf("skipping %s: absent\n", name);
+      continue;
+    }
+    Mesh in;
+    try {
+      in = read_mesh(path);
+    } catch (const std::exception& e) {
+      std::printf("skipping %s: cannot read it: %s\n", name, e.what());
+      continue;
+    }
+    SCOPED_TRACE(name);
+    Mesh m = in;
+    CollapseOptions o;
+    CollapseReport r = collapse(m, o, ctx);
+    std::printf("%s: tets %lld -> %lld, %zu iterations\n", name, (long long)r.tets_in, (long long)r.tets_out,
+                r.iterations.size());
+    EXPECT_LT(r.tets_out, r.tets_in);
+    CheckReport c = check(m, &in);
+    EXPECT_TRUE(c.valid) << check_report_text(c);
+    EXPECT_FALSE(c.reference.topology_changed);
+  }
+}
