@@ -115,6 +115,7 @@ class VtuReader {
   int64_t num_points_ = 0, num_cells_ = 0;
   size_t piece_pos_ = 0;
   std::vector<ArrayDesc> arrays_;
+  std::vector<uint64_t> appended_offsets_;  // of every appended array, FieldData ones too
 
   int64_t line_of(size_t offset) const {
     offset = std::min(offset, data_.size());
@@ -278,6 +279,7 @@ class VtuReader {
             std::any_of(data_.begin() + std::ptrdiff_t(a.content_begin), data_.begin() + std::ptrdiff_t(a.content_end),
                         [](char c) { return !is_space(c); }))
           fail_line(t->begin, "appended DataArray '" + a.name + "' has inline data");
+        if (a.format == Encoding::Appended) appended_offsets_.push_back(a.offset);
         if (where != Where::Other) arrays_.push_back(std::move(a));
       } else if (t->name == "AppendedData") {
         const std::string* enc = t->attr("encoding");
@@ -435,8 +437,8 @@ class VtuReader {
       where = appended_begin_ + size_t(a.offset);
       // The array ends where the next one starts (or at the end of the appended data).
       size_t end = appended_end_;
-      for (const ArrayDesc& o : arrays_)
-        if (o.format == Encoding::Appended && o.offset > a.offset) end = std::min(end, appended_begin_ + size_t(o.offset));
+      for (uint64_t o : appended_offsets_)
+        if (o > a.offset && o <= appended_end_ - appended_begin_) end = std::min(end, appended_begin_ + size_t(o));
       std::string_view region = std::string_view(data_).substr(where, end - where);
       if (appended_base64_) {
         if (!base64_segments(region, decoded)) fail_byte(where, what + ": invalid base64 data");

@@ -241,6 +241,24 @@ TEST(VtkMeshio, ReadsOurBinary) { meshio_check(true); }
 
 // ------------------------------------------------------------ bad input
 
+TEST(VtkBad, EveryTruncationIsAnInputError) {
+  for (bool binary : {false, true}) {
+    tc::test::TempDir dir;
+    tc::Mesh a = tc::test::attribute_mesh();
+    tc::WriteOptions opt;
+    opt.binary = binary;
+    tc::write_vtk(dir.file("full.vtk"), a, opt);
+    std::string full = tc::test::read_text(dir.file("full.vtk"));
+    int64_t failed = tc::test::check_truncations(full, dir.file("cut.vtk"), 7, [](const std::string& p) {
+      tc::ReadNotes notes;
+      tc::read_vtk(p, notes);
+    });
+    // A cut inside the last value of a block (before the next keyword) leaves a shorter but
+    // well-formed file; there are 7 blocks, each with a value of at most 24 characters.
+    EXPECT_GE(failed, int64_t(full.size() / 7) - 7 * 4) << (binary ? "binary" : "ascii");
+  }
+}
+
 TEST(VtkBad, EmptyFile) { EXPECT_NE(error_of_text("").find("empty file"), std::string::npos); }
 
 TEST(VtkBad, NotVtk) {

@@ -241,6 +241,22 @@ TEST(VtuRoundTrip, EmptyMeshWritesAndReadsBack) {
 
 // ------------------------------------------------------------ bad input
 
+TEST(VtuBad, EveryTruncationIsAnInputError) {
+  using Enc = tc::WriteOptions::VtuEncoding;
+  for (Enc enc : {Enc::Ascii, Enc::Base64, Enc::Appended}) {
+    tc::test::TempDir dir;
+    tc::WriteOptions opt;
+    opt.vtu_encoding = enc;
+    tc::write_vtu(dir.file("full.vtu"), tc::test::attribute_mesh(), opt);
+    std::string full = tc::test::read_text(dir.file("full.vtu"));
+    int64_t failed = tc::test::check_truncations(full, dir.file("cut.vtu"), 5, [](const std::string& p) {
+      tc::ReadNotes notes;
+      tc::read_vtu(p, notes);
+    });
+    EXPECT_GT(failed, int64_t(full.size() / 5) / 2) << "encoding " << int(enc);
+  }
+}
+
 TEST(VtuBad, EmptyFile) { EXPECT_NE(error_of_text("").find("empty file"), std::string::npos); }
 
 TEST(VtuBad, NotVtkXml) {

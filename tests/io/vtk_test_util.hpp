@@ -101,3 +101,24 @@ std::string input_error_of(F&& f) {
 }
 
 }  // namespace tc::test
+
+namespace tc::test {
+
+// Every prefix of a valid file (in steps of `step` bytes) must read or fail with an
+// InputError: never crash, never throw anything else. Returns how many prefixes failed.
+template <class Read>
+int64_t check_truncations(const std::string& full, const std::string& path, size_t step, Read&& read) {
+  int64_t failed = 0;
+  for (size_t n = 0; n < full.size(); n += step) {
+    write_text(path, full.substr(0, n));
+    try {
+      read(path);
+    } catch (const InputError& e) {
+      ++failed;
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << "multi-line error: " << e.what();
+    }
+  }
+  return failed;
+}
+
+}  // namespace tc::test
