@@ -79,8 +79,8 @@ class StageClock {
 
 DeviceTopology build_device_topology(Context& ctx, const DeviceBuffer<double>& points, const DeviceBuffer<int32_t>& tets,
                                      uint32_t num_vertices, const DeviceBuffer<int32_t>* labels,
-                                     const TopologyOptions& options, ConnectivityTimings* timings) {
-  ConnectivityTimings tm;
+                                     const TopologyOptions& options, TopologyTimings* timings) {
+  TopologyTimings tm;
   StageClock clock(ctx);
   DeviceTopology t;
   const size_t nt = tets.size() / 4;
@@ -211,7 +211,7 @@ DeviceTopology build_device_topology(Context& ctx, const DeviceBuffer<double>& p
 }
 
 DeviceTopology build_device_topology(Context& ctx, const Mesh& mesh, const TopologyOptions& options,
-                                     ConnectivityTimings* timings) {
+                                     TopologyTimings* timings) {
   if (mesh.points.size() % 3 != 0 || mesh.tets.size() % 4 != 0)
     throw InputError("<mesh>", "point or tet array length is not a multiple of 3 / 4");
   if (mesh.num_vertices() > std::numeric_limits<int32_t>::max())

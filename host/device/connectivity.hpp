@@ -41,22 +41,16 @@ struct DeviceTopology {
   Topology download() const;
 };
 
-// Wall time of each stage in seconds (each stage ends with a queue finish).
-struct ConnectivityTimings {
-  double check = 0, edges = 0, vertex_lists = 0, faces = 0, sface_lists = 0, flags = 0, classify = 0;
-  double total() const { return check + edges + vertex_lists + faces + sface_lists + flags + classify; }
-};
-
 // points: 3 doubles per vertex (num_vertices of them); tets: 4 indices per tet; labels: one
 // per tet or nullptr (ignored unless options.use_labels). Throws tc::InputError ("<mesh>")
 // for an index out of range or a repeated vertex in a tet, DeviceError on OpenCL failures.
 DeviceTopology build_device_topology(Context& ctx, const DeviceBuffer<double>& points,
                                      const DeviceBuffer<int32_t>& tets, uint32_t num_vertices,
                                      const DeviceBuffer<int32_t>* labels, const TopologyOptions& options = {},
-                                     ConnectivityTimings* timings = nullptr);
+                                     TopologyTimings* timings = nullptr);
 
 // Convenience: uploads the mesh (first label array as labels) and builds.
 DeviceTopology build_device_topology(Context& ctx, const Mesh& mesh, const TopologyOptions& options = {},
-                                     ConnectivityTimings* timings = nullptr);
+                                     TopologyTimings* timings = nullptr);
 
 }  // namespace tc::dev

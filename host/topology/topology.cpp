@@ -4,6 +4,7 @@
 #include "tetcollapse/topology.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -168,8 +169,17 @@ uint8_t classify_vertex(const Topology& t, int32_t v, double eps_f) {
 
 }  // namespace topology_detail
 
-Topology build_topology(const Mesh& mesh, const TopologyOptions& options) {
+Topology build_topology(const Mesh& mesh, const TopologyOptions& options, TopologyTimings* timings) {
+  TopologyTimings tm;
+  auto last = std::chrono::steady_clock::now();
+  auto lap = [&last] {
+    auto now = std::chrono::steady_clock::now();
+    double s = std::chrono::duration<double>(now - last).count();
+    last = now;
+    return s;
+  };
   check_mesh(mesh);
+  tm.check = lap();
   Topology t;
   t.num_vertices = int32_t(mesh.num_vertices());
   t.num_tets = int32_t(mesh.num_tets());
@@ -200,6 +210,7 @@ Topology build_topology(const Mesh& mesh, const TopologyOptions& options) {
   }
   t.edge_tets_offsets.push_back(int32_t(rec.size()));
   const int32_t ne = t.num_edges();
+  tm.edges = lap();
 
   // --- vertex -> tets and vertex -> edges (counting sort keeps ascending order) ---
   {
@@ -210,6 +221,7 @@ Topology build_topology(const Mesh& mesh, const TopologyOptions& options) {
     for (size_t i = 0; i < vals.size(); ++i) vals[i] = int32_t(i / 2);
     build_csr(nv, t.edges, vals, t.vertex_edges_offsets, t.vertex_edges);
   }
+  tm.vertex_lists = lap();
 
   // --- faces: key (edge_id(a, b) << 32 | c) for the sorted triangle a < b < c ---
   rec.resize(size_t(nt) * 4);
@@ -257,6 +269,7 @@ Topology build_topology(const Mesh& mesh, const TopologyOptions& options) {
     i = j;
   }
   const int32_t ns = t.num_sfaces();
+  tm.faces = lap();
 
   // --- S-face adjacency: vertex -> S-faces, edge -> S-faces ---
   {
@@ -273,6 +286,7 @@ Topology build_topology(const Mesh& mesh, const TopologyOptions& options) {
         keys[3 * size_t(s) + k] = t.tet_edges[6 * size_t(t.sface_tet[s]) + face_edges[t.sface_local[s]][k]];
     build_csr(ne, keys, vals, t.edge_sfaces_offsets, t.edge_sfaces);
   }
+  tm.sface_lists = lap();
 
   // --- boundary flags ---
   t.vertex_boundary.assign(size_t(nv), 0);
@@ -283,12 +297,15 @@ Topology build_topology(const Mesh& mesh, const TopologyOptions& options) {
   for (int32_t e = 0; e < ne; ++e)
     for (int32_t i = t.edge_sfaces_offsets[e]; i < t.edge_sfaces_offsets[e + 1]; ++i)
       t.edge_boundary[e] |= t.sface_interface[t.edge_sfaces[i]] ? kOnInterface : kOnBoundary;
+  tm.flags = lap();
 
   // --- classification ---
   t.edge_ridge.resize(size_t(ne));
   for (int32_t e = 0; e < ne; ++e) t.edge_ridge[e] = classify_edge(t, e, options.eps_r);
   t.vertex_class.resize(size_t(nv));
   for (int32_t v = 0; v < nv; ++v) t.vertex_class[v] = classify_vertex(t, v, options.eps_f);
+  tm.classify = lap();
+  if (timings) *timings = tm;
   return t;
 }
 

@@ -95,9 +95,16 @@ struct Topology {
   int32_t num_sfaces() const { return static_cast<int32_t>(sface_tet.size()); }
 };
 
+// Wall time of each construction stage in seconds (the device version ends each stage with a
+// queue finish, so its numbers include the kernels).
+struct TopologyTimings {
+  double check = 0, edges = 0, vertex_lists = 0, faces = 0, sface_lists = 0, flags = 0, classify = 0;
+  double total() const { return check + edges + vertex_lists + faces + sface_lists + flags + classify; }
+};
+
 // Builds everything above. Throws tc::InputError (file "<mesh>") when a tet has an index out
 // of range or a repeated vertex, or when the mesh is too large for 32-bit indices.
-Topology build_topology(const Mesh& mesh, const TopologyOptions& options = {});
+Topology build_topology(const Mesh& mesh, const TopologyOptions& options = {}, TopologyTimings* timings = nullptr);
 
 // What `tetcollapse info` prints about a mesh.
 struct TopologySummary {
