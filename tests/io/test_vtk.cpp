@@ -194,6 +194,14 @@ TEST(VtkRead, NoTetsGivesEmptyTets) {
   EXPECT_EQ(notes.skipped_elements, 1);
 }
 
+TEST(VtkRead, NoTetsIsReportedByReadMesh) {
+  tc::test::TempDir dir;
+  std::string p = dir.file("notets.vtk");
+  tc::test::write_text(p, kHead + "POINTS 4 double\n0 0 0 1 0 0 0 1 0 0 0 1\nCELLS 1 5\n4 0 1 2 3\nCELL_TYPES 1\n9\n");
+  std::string e = input_error_of([&] { tc::read_mesh(p); });
+  EXPECT_NE(e.find("the mesh has no tetrahedra (1 non-tetrahedral elements were skipped)"), std::string::npos) << e;
+}
+
 // ------------------------------------------------------------ round trips
 
 void round_trip(bool binary) {

@@ -208,6 +208,15 @@ TEST(VtuRead, NoTetsGivesEmptyTets) {
   EXPECT_EQ(notes.skipped_elements, 1);
 }
 
+TEST(VtuRead, NoTetsIsReportedByReadMesh) {
+  std::string cells = kTetCells;
+  cells.replace(cells.find(">10<"), 4, ">12<");
+  tc::test::TempDir dir;
+  std::string p = write_and_path(dir, vtu(kOnePiece, kTetPoints + cells));
+  std::string e = input_error_of([&] { tc::read_mesh(p); });
+  EXPECT_NE(e.find("the mesh has no tetrahedra (1 non-tetrahedral elements were skipped)"), std::string::npos) << e;
+}
+
 // ------------------------------------------------------------ round trips
 
 void round_trip(tc::WriteOptions::VtuEncoding enc) {
