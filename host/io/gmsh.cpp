@@ -420,26 +420,25 @@ void finish_nodes(Src& s, ReaderState& st, const std::vector<int64_t>& tags) {
   st.have_nodes = true;
 }
 
-// One element of a supported kind: keeps its corners, drops the rest.
-template <class Src>
-void add_element(Src& s, ReaderState& st, Kind kind, const int64_t* node_tags, int nodes, int64_t elem_tag,
+// One element of a supported kind (node indices resolved): keeps its corners, drops the rest.
+void add_element(ReaderState& st, Kind kind, const int32_t* idx, int nodes, int64_t elem_tag,
                  int32_t physical, int32_t entity) {
   Mesh& m = st.mesh;
   switch (kind) {
     case Kind::Tet:
-      for (int k = 0; k < 4; ++k) m.tets.push_back(node_index(s, st, node_tags[k]));
+      m.tets.insert(m.tets.end(), idx, idx + 4);
       st.tet_physical.push_back(physical);
       st.tet_entity.push_back(entity);
       st.tet_element_tags.push_back(elem_tag);
       if (nodes > 4 && st.notes) ++st.notes->reduced_quadratic_tets;
       break;
     case Kind::Tri:
-      for (int k = 0; k < 3; ++k) m.tris.push_back(node_index(s, st, node_tags[k]));
+      m.tris.insert(m.tris.end(), idx, idx + 3);
       m.tri_tags.push_back(entity);
       if (nodes > 3) ++st.reduced_tris;
       break;
     case Kind::Line:
-      for (int k = 0; k < 2; ++k) m.edges.push_back(node_index(s, st, node_tags[k]));
+      m.edges.insert(m.edges.end(), idx, idx + 2);
       m.edge_tags.push_back(entity);
       if (nodes > 2) ++st.reduced_lines;
       break;
@@ -447,12 +446,6 @@ void add_element(Src& s, ReaderState& st, Kind kind, const int64_t* node_tags, i
   }
 }
 
-// Every node reference is checked (skipped nodes of high-order elements too), so that a
-// file with dangling references is rejected whatever element carries them.
-template <class Src>
-void check_nodes(Src& s, const ReaderState& st, const int64_t* node_tags, int nodes) {
-  for (int k = 0; k < nodes; ++k) node_index(s, st, node_tags[k]);
-}
 
 template <class Src>
 int64_t header_int(Src& s, const char* what) {
@@ -490,7 +483,9 @@ template <class Src>
 void read_elements_22(Src& s, ReaderState& st) {
   int64_t n = header_int(s, "the number of elements");
   if (n < 0 || n > s.max_items(8, 8)) s.fail_line("element count " + std::to_string(n) + " is more than the rest of the file can hold");
-  int64_t node_tags[1000];
+  // Every node reference is resolved as it is read (so errors point at it), the extra
+  // nodes of high-order and skipped elements too.
+  int32_t idx[1000];
   int64_t done = 0;
   auto one = [&](int64_t type, const TypeInfo& info, int64_t ntags, bool have_elem_tag, int64_t elem_tag) {
     int64_t tag_vals[2] = {0, 0};
@@ -504,8 +499,7 @@ void read_elements_22(Src& s, ReaderState& st) {
       ++st.skipped_by_type[type];
       return;
     }
-    for (int k = 0; k < info.nodes; ++k) node_tags[k] = s.integer();
-    check_nodes(s, st, node_tags, info.nodes);
+    for (int k = 0; k < info.nodes; ++k) idx[k] = node_index(s, st, s.integer());
     int32_t physical = ntags >= 1 ? to_i32(s, tag_vals[0], "physical tag") : 0;
     int32_t entity = ntags >= 2 ? to_i32(s, tag_vals[1], "elementary tag") : 0;
     if (info.kind == Kind::Other) {
@@ -515,10 +509,10 @@ void read_elements_22(Src& s, ReaderState& st) {
     if (info.kind == Kind::Tet) {
       if (physical != 0) st.tet_has_physical = true;
       if (ntags >= 2) st.tet_has_entity = true;
-      add_element(s, st, info.kind, node_tags, info.nodes, elem_tag, physical, entity);
+      add_element(st, info.kind, idx, info.nodes, elem_tag, physical, entity);
     } else {
       // Lines and triangles: the entity (elementary) tag; a lone tag is used as it is.
-      add_element(s, st, info.kind, node_tags, info.nodes, elem_tag, physical, ntags >= 2 ? entity : physical);
+      add_element(st, info.kind, idx, info.nodes, elem_tag, physical, ntags >= 2 ? entity : physical);
     }
   };
   if constexpr (!Src::binary) {
@@ -533,12 +527,12 @@ void read_elements_22(Src& s, ReaderState& st) {
     // Binary 2.2: blocks of (type, count, number of tags) followed by int32 records.
     while (done < n) {
       int64_t type = s.integer();
-      int64_t count = s.integer();
-      int64_t ntags = s.integer();
       TypeInfo info = type_info(type);
       if (info.nodes < 0) s.fail("unknown element type " + std::to_string(type));
+      int64_t count = s.integer();
       if (count <= 0 || count > n - done)
         s.fail("element block of " + std::to_string(count) + " elements does not fit the total of " + std::to_string(n));
+      int64_t ntags = s.integer();
       if (ntags < 0 || ntags > 1000) s.fail("bad number of element tags " + std::to_string(ntags));
       if (count > s.max_items(0, 4 * (1 + ntags + info.nodes)))
         s.fail("element block of " + std::to_string(count) + " elements runs past the end of the file");
@@ -557,7 +551,7 @@ template <class Src>
 void read_entities_41(Src& s, ReaderState& st) {
   int64_t counts[4];
   for (auto& c : counts) {
-    c = s.size();
+    c = s.size();  // checked one by one, so the error points at the bad count
     if (c > s.max_items(10, 28)) s.fail("entity count " + std::to_string(c) + " is more than the rest of the file can hold");
   }
   for (int dim = 0; dim < 4; ++dim) {
@@ -587,12 +581,12 @@ void read_entities_41(Src& s, ReaderState& st) {
 template <class Src>
 void read_nodes_41(Src& s, ReaderState& st, int ds) {
   int64_t blocks = s.size();
-  int64_t n = s.size();
-  s.size();  // min and max tags: computed from the tags themselves
-  s.size();
   if (blocks > s.max_items(8, 12 + ds)) s.fail("node block count " + std::to_string(blocks) + " is more than the rest of the file can hold");
+  int64_t n = s.size();
   if (n > s.max_items(8, 24 + ds)) s.fail("node count " + std::to_string(n) + " is more than the rest of the file can hold");
   if (n > std::numeric_limits<int32_t>::max()) s.fail("more than 2^31-1 nodes are not supported");
+  s.size();  // min and max tags: computed from the tags themselves
+  s.size();
   std::vector<int64_t> tags;
   tags.reserve(static_cast<size_t>(n));
   st.mesh.points.reserve(static_cast<size_t>(3 * n));
@@ -624,13 +618,13 @@ void read_nodes_41(Src& s, ReaderState& st, int ds) {
 template <class Src>
 void read_elements_41(Src& s, ReaderState& st, int ds) {
   int64_t blocks = s.size();
-  int64_t n = s.size();
-  s.size();
-  s.size();
   if (blocks > s.max_items(8, 12 + ds)) s.fail("element block count " + std::to_string(blocks) + " is more than the rest of the file can hold");
+  int64_t n = s.size();
   if (n > s.max_items(4, 2 * ds)) s.fail("element count " + std::to_string(n) + " is more than the rest of the file can hold");
+  s.size();  // min and max tags
+  s.size();
   int64_t total = 0;
-  int64_t node_tags[1000];
+  int32_t idx[1000];
   for (int64_t b = 0; b < blocks; ++b) {
     int64_t dim = s.integer();
     int32_t entity = to_i32(s, s.integer(), "entity tag");
@@ -655,13 +649,9 @@ void read_elements_41(Src& s, ReaderState& st, int ds) {
     }
     for (int64_t i = 0; i < count; ++i) {
       int64_t elem_tag = s.size();
-      for (int k = 0; k < info.nodes; ++k) node_tags[k] = s.size();
-      if (info.kind == Kind::Other) {
-        check_nodes(s, st, node_tags, info.nodes);
-        continue;
-      }
-      if (info.nodes > 4) check_nodes(s, st, node_tags, info.nodes);
-      add_element(s, st, info.kind, node_tags, info.nodes, elem_tag, physical, entity);
+      // Every reference is resolved as it is read (errors point at it), skipped ones too.
+      for (int k = 0; k < info.nodes; ++k) idx[k] = node_index(s, st, s.size());
+      if (info.kind != Kind::Other) add_element(st, info.kind, idx, info.nodes, elem_tag, physical, entity);
     }
     if (info.kind == Kind::Other && count > 0) st.skipped_by_type[type] += count;
   }
@@ -1107,6 +1097,13 @@ void write_41(Out& o, const Mesh& m) {
   EntitySet vol = volume_entities(m);
   EntitySet sur = tag_entities(m, m.tris, m.tri_tags, 3);
   EntitySet cur = tag_entities(m, m.edges, m.edge_tags, 2);
+  // When the volumes have physical groups, surfaces and curves get one too (their own
+  // tag): Gmsh saves only elements in physical groups in that case, and meshio 5.0
+  // needs every element block to have a physical tag or none to have one.
+  const bool physical = std::any_of(vol.list.begin(), vol.list.end(), [](const Entity& e) { return e.physical != 0; });
+  if (physical)
+    for (EntitySet* es : {&sur, &cur})
+      for (Entity& e : es->list) e.physical = e.tag;
   if (vol.list.empty() && nv > 0) {  // nodes need an entity to live on
     Entity e{1, 0, {}};
     for (int64_t v = 0; v < nv; ++v) e.box.add(&m.points[3 * v]);
