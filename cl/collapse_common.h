@@ -79,15 +79,17 @@ inline int tcc_face_others(__global const int* tets, __global const uint* vt_off
   return n;
 }
 
+/* tet_nbr[4 t + f]: the tet across the face of t opposite local vertex f; -1 when the face is in
+ * no other tet (boundary), -2 when in several (invalid input: each side counts as boundary). */
+
 /* Is the face of tet t opposite local vertex f an S-face owned by t (as in tc::build_topology:
  * a boundary face is owned by its only tet; an interface face by the tet of the smaller label;
  * a face in more than two tets, invalid input, counts as boundary for each)? Returns 0 when
  * not, else TCC_BOUNDARY or TCC_INTERFACE. *on_s receives the kind even when t does not own it. */
-inline uint tcc_owned_sface(__global const int* tets, __global const uint* vt_off, __global const int* vt,
-                            __global const int* labels, int use_labels, int t, int f, uint* on_s) {
-  int other;
-  int n = tcc_face_others(tets, vt_off, vt, t, f, &other);
-  if (n != 1) {
+inline uint tcc_owned_sface(__global const int* tet_nbr, __global const int* labels, int use_labels, int t, int f,
+                            uint* on_s) {
+  int other = tet_nbr[4 * t + f];
+  if (other < 0) {
     *on_s = TCC_BOUNDARY;
     return TCC_BOUNDARY;
   }

@@ -1,63 +1,115 @@
 /* Stages 4 and 5 of a collapse iteration: conflict detection (paper Sec. 3.3).
  *
- * Pass 1 over edges: an admissible edge survives when no other admissible edge at either end
- * point comes first in (cost, index) order; survivors write their id to vaff (vertAffectedByEdge)
- * at both end points. Survivors share no vertex, so those writes never race.
- * Pass 2 over tets: a tet touched by several surviving edges keeps the first in (cost, index)
- * order and flags the others in kill[]; then a pass over edges finalises: fin = p1 && !kill,
- * and the vertices of killed edges are released (vaff = -1). Pass 2 decides from the complete
- * pass-1 result, never from a partially updated one, so the outcome does not depend on the
- * order in which work items run. */
+ * Pass 1 over edges (edges sharing a vertex conflict) and pass 2 (edges touching a common tet
+ * conflict) each select, among their candidates, the greedy independent set in (cost, index)
+ * order: an edge is IN when every conflicting candidate before it is OUT, and OUT as soon as one
+ * conflicting candidate before it is IN. The paper's single sweep is the first round of this
+ * (keep an edge when nothing cheaper conflicts); repeating the sweep until every candidate is
+ * decided keeps the edges whose cheaper rivals have themselves been dropped, which the paper's
+ * version loses. The fixpoint is unique (induction over the (cost, index) order) and every
+ * decision is final when taken, so the result does not depend on the order in which work items
+ * run or on the work-group size, although states are updated in place.
+ * States: 0 undecided, 1 IN, 2 OUT (state[] per edge, uchar). */
 #include "collapse_common.h"
 
-__kernel void conflict_pass1(uint ne, __global const int* edges, __global const uint* adm,
-                             __global const double* cost, __global const uint* nb_off,
-                             __global const int* nb_edge, __global uint* p1, __global int* vaff,
-                             __global uint* counters) {
+#define TCC_UNDECIDED 0
+#define TCC_IN 1
+#define TCC_OUT 2
+
+/* Initial states: admissible edges undecided, others out. */
+__kernel void conflict_init(uint ne, __global const uint* adm, __global uchar* state) {
   uint e = get_global_id(0);
   if (e >= ne) return;
-  p1[e] = 0u;
-  if (!adm[e]) return;
+  state[e] = adm[e] ? TCC_UNDECIDED : TCC_OUT;
+}
+
+/* One round of pass 1; changes[0] counts the edges decided in this round. */
+__kernel void conflict_pass1_round(uint ne, __global const int* edges, __global const double* cost,
+                                   __global const uint* nb_off, __global const int* nb_edge,
+                                   __global uchar* state, __global uint* changes) {
+  uint e = get_global_id(0);
+  if (e >= ne || state[e] != TCC_UNDECIDED) return;
   int ends[2] = {edges[2 * e], edges[2 * e + 1]};
+  int pending = 0;
   for (int s = 0; s < 2; ++s)
     for (uint i = nb_off[ends[s]]; i < nb_off[ends[s] + 1]; ++i) {
       int f = nb_edge[i];
-      if (f != (int)e && adm[f] && tcc_before(cost, f, (int)e)) return;
+      if (f == (int)e || !tcc_before(cost, f, (int)e)) continue;
+      uchar sf = state[f];
+      if (sf == TCC_IN) {
+        state[e] = TCC_OUT;
+        atomic_inc(changes);
+        return;
+      }
+      if (sf == TCC_UNDECIDED) pending = 1;
     }
-  p1[e] = 1u;
-  vaff[ends[0]] = (int)e;
-  vaff[ends[1]] = (int)e;
-  atomic_inc(&counters[2]);
-}
-
-__kernel void conflict_pass2(uint nt, __global const int* tets, __global const int* vaff,
-                             __global const double* cost, __global uint* kill) {
-  uint t = get_global_id(0);
-  if (t >= nt) return;
-  int best = -1, n = 0;
-  int seen[4];
-  for (int k = 0; k < 4; ++k) {
-    int e = vaff[tets[4 * t + k]];
-    if (e < 0) continue;
-    int dup = 0;
-    for (int j = 0; j < n; ++j) dup |= seen[j] == e;
-    if (dup) continue;
-    seen[n++] = e;
-    if (best < 0 || tcc_before(cost, e, best)) best = e;
+  if (!pending) {
+    state[e] = TCC_IN;
+    atomic_inc(changes);
   }
-  if (n < 2) return;
-  for (int j = 0; j < n; ++j)
-    if (seen[j] != best) kill[seen[j]] = 1u; /* every writer writes the same value */
 }
 
+/* After pass 1: p1 flags, vaff (vertAffectedByEdge) of both end points of IN edges, counters[2]. */
+__kernel void conflict_pass1_finish(uint ne, __global const int* edges, __global const uchar* state,
+                                    __global uint* p1, __global int* vaff, __global uint* counters) {
+  uint e = get_global_id(0);
+  if (e >= ne) return;
+  uint in = state[e] == TCC_IN;
+  p1[e] = in;
+  if (in) {
+    vaff[edges[2 * e]] = (int)e;
+    vaff[edges[2 * e + 1]] = (int)e;
+    atomic_inc(&counters[2]);
+  }
+}
+
+/* Pass 2 initial states: pass-1 edges undecided, others out. */
+__kernel void conflict_pass2_init(uint ne, __global const uint* p1, __global uchar* state) {
+  uint e = get_global_id(0);
+  if (e >= ne) return;
+  state[e] = p1[e] ? TCC_UNDECIDED : TCC_OUT;
+}
+
+/* One round of pass 2 over the pass-1 edges: the rivals of e = (a, b) are the pass-1 edges
+ * recorded (vaff) at the vertices of the tets of ring(a) and ring(b). */
+__kernel void conflict_pass2_round(uint ne, __global const int* edges, __global const double* cost,
+                                   __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                                   __global const int* vaff, __global uchar* state, __global uint* changes) {
+  uint e = get_global_id(0);
+  if (e >= ne || state[e] != TCC_UNDECIDED) return;
+  int pending = 0;
+  for (int s = 0; s < 2; ++s) {
+    int x = edges[2 * e + s];
+    for (uint i = vt_off[x]; i < vt_off[x + 1]; ++i) {
+      __global const int* q = tets + 4 * vt[i];
+      for (int k = 0; k < 4; ++k) {
+        int f = vaff[q[k]];
+        if (f < 0 || f == (int)e || !tcc_before(cost, f, (int)e)) continue;
+        uchar sf = state[f];
+        if (sf == TCC_IN) {
+          state[e] = TCC_OUT;
+          atomic_inc(changes);
+          return;
+        }
+        if (sf == TCC_UNDECIDED) pending = 1;
+      }
+    }
+  }
+  if (!pending) {
+    state[e] = TCC_IN;
+    atomic_inc(changes);
+  }
+}
+
+/* fin = IN after pass 2; the vertices of dropped pass-1 edges are released. */
 __kernel void conflict_finalize(uint ne, __global const int* edges, __global const uint* p1,
-                                __global const uint* kill, __global uint* fin, __global int* vaff,
+                                __global const uchar* state, __global uint* fin, __global int* vaff,
                                 __global uint* counters) {
   uint e = get_global_id(0);
   if (e >= ne) return;
-  uint f = p1[e] && !kill[e];
+  uint f = p1[e] && state[e] == TCC_IN;
   fin[e] = f;
-  if (p1[e] && kill[e]) {
+  if (p1[e] && !f) {
     vaff[edges[2 * e]] = -1;
     vaff[edges[2 * e + 1]] = -1;
   }

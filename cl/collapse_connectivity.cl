@@ -114,16 +114,53 @@ __kernel void conn_lower_edges(uint nv, __global const uint* nb_off, __global co
   }
 }
 
+/* tet_nbr (see collapse_common.h): for each face, the other tets of ring(first face vertex). */
+__kernel void conn_tet_neighbours(uint nt, __global const int* tets, __global const uint* vt_off,
+                                  __global const int* vt, __global int* tet_nbr) {
+  uint t = get_global_id(0);
+  if (t >= nt) return;
+  for (int f = 0; f < 4; ++f) {
+    int other;
+    int n = tcc_face_others(tets, vt_off, vt, (int)t, f, &other);
+    tet_nbr[4 * t + f] = n == 0 ? -1 : n == 1 ? other : -2;
+  }
+}
+
+/* vflags: S membership of every vertex, from the faces around it. */
+__kernel void conn_vertex_flags(uint nv, __global const int* tets, __global const uint* vt_off,
+                                __global const int* vt, __global const int* tet_nbr, __global const int* labels,
+                                int use_labels, __global uchar* vflags) {
+  uint v = get_global_id(0);
+  if (v >= nv) return;
+  uint flags = 0;
+  for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
+    int t = vt[i];
+    int lv = tcc_local(tets, t, (int)v);
+    for (int f = 0; f < 4; ++f) {
+      if (f == lv) continue;
+      uint on_s;
+      tcc_owned_sface(tet_nbr, labels, use_labels, t, f, &on_s);
+      flags |= on_s;
+    }
+  }
+  vflags[v] = (uchar)flags;
+}
+
 /* Edge flags: S membership (boundary / interface) and the ridge rule of tc::build_topology:
  * an S-edge is a ridge when it has a number of S-faces other than two, when its two S-faces do
  * not traverse it in opposite directions, or when 1 - dot(n1, n2) > eps_r. */
 __kernel void conn_edge_flags(uint ne, __global const int* edges, __global const int* tets,
-                              __global const uint* vt_off, __global const int* vt, __global const int* labels,
-                              int use_labels, __global const double* pts, double eps_r, __global uchar* eflags) {
+                              __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
+                              __global const int* labels, int use_labels, __global const double* pts, double eps_r,
+                              __global const uchar* vflags, __global uchar* eflags) {
   uint e = get_global_id(0);
   if (e >= ne) return;
   int a = edges[2 * e], b = edges[2 * e + 1];
   uint flags = 0;
+  if (!vflags[a] || !vflags[b]) { /* an S-edge joins two S vertices */
+    eflags[e] = 0;
+    return;
+  }
   int ns = 0;
   int ft[2], ff[2];
   for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
@@ -134,7 +171,7 @@ __kernel void conn_edge_flags(uint ne, __global const int* edges, __global const
     for (int f = 0; f < 4; ++f) {
       if (f == la || f == lb) continue; /* faces containing a and b are opposite the others */
       uint on_s;
-      uint own = tcc_owned_sface(tets, vt_off, vt, labels, use_labels, t, f, &on_s);
+      uint own = tcc_owned_sface(tet_nbr, labels, use_labels, t, f, &on_s);
       flags |= on_s;
       if (own) {
         if (ns < 2) {
@@ -178,24 +215,27 @@ __kernel void conn_edge_flags(uint ne, __global const int* edges, __global const
  * S-faces form one closed fan; corner otherwise. More than TCC_MAX_VERTEX_SFACES S-faces at a
  * vertex (never seen in practice) classify it as corner, which only protects it more. */
 __kernel void conn_vertex_class(uint nv, __global const int* tets, __global const uint* vt_off,
-                                __global const int* vt, __global const int* labels, int use_labels,
+                                __global const int* vt, __global const int* tet_nbr, __global const int* labels,
+                                int use_labels,
                                 __global const double* pts, __global const uint* nb_off,
                                 __global const int* nb_edge, __global const uchar* eflags, double eps_f,
-                                __global uchar* vflags, __global uchar* vclass) {
+                                __global const uchar* vflags, __global uchar* vclass) {
   uint v = get_global_id(0);
   if (v >= nv) return;
+  if (!vflags[v]) {
+    vclass[v] = TCC_INTERIOR;
+    return;
+  }
   double3 normal[TCC_MAX_VERTEX_SFACES];
   int after[TCC_MAX_VERTEX_SFACES], before[TCC_MAX_VERTEX_SFACES];
   int fn = 0, overflow = 0;
-  uint flags = 0;
   for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
     int t = vt[i];
     int lv = tcc_local(tets, t, (int)v);
     for (int f = 0; f < 4; ++f) {
       if (f == lv) continue;
       uint on_s;
-      uint own = tcc_owned_sface(tets, vt_off, vt, labels, use_labels, t, f, &on_s);
-      flags |= on_s;
+      uint own = tcc_owned_sface(tet_nbr, labels, use_labels, t, f, &on_s);
       if (!own) continue;
       if (fn == TCC_MAX_VERTEX_SFACES) {
         overflow = 1;
@@ -210,7 +250,6 @@ __kernel void conn_vertex_class(uint nv, __global const int* tets, __global cons
       ++fn;
     }
   }
-  vflags[v] = (uchar)flags;
   uchar cls;
   if (fn == 0 && !overflow) {
     cls = TCC_INTERIOR;

@@ -170,10 +170,14 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   ensure(c.vflags, ctx, nv);
   ensure(c.vclass, ctx, nv);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
-  run(ctx, F, "conn_edge_flags", c.ne, "", U(c.ne), B(c.edges), B(dm.tets), B(c.vt_off), B(c.vt),
-      primary_labels(dm), use_labels, B(dm.points), p.eps_r, B(c.eflags));
-  run(ctx, F, "conn_vertex_class", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), primary_labels(dm), use_labels,
-      B(dm.points), B(c.nb_off), B(c.nb_edge), B(c.eflags), p.eps_f, B(c.vflags), B(c.vclass));
+  ensure(c.tet_nbr, ctx, size_t(nt) * 4);
+  run(ctx, F, "conn_tet_neighbours", nt, "", U(nt), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr));
+  run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
+      use_labels, B(c.vflags));
+  run(ctx, F, "conn_edge_flags", c.ne, "", U(c.ne), B(c.edges), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr),
+      primary_labels(dm), use_labels, B(dm.points), p.eps_r, B(c.vflags), B(c.eflags));
+  run(ctx, F, "conn_vertex_class", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
+      use_labels, B(dm.points), B(c.nb_off), B(c.nb_edge), B(c.eflags), p.eps_f, B(c.vflags), B(c.vclass));
 }
 
 namespace {
@@ -217,22 +221,46 @@ uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
   return counter(s, 1);
 }
 
+namespace {
+// Runs `round` until a round decides nothing more (every candidate is then decided: the
+// undecided candidate of smallest (cost, index) always decides).
+void until_fixpoint(Context& ctx, cl::Kernel& round, DeviceBuffer<uint32_t>& changes, size_t n, const char* what) {
+  for (;;) {
+    changes.fill(0);
+    ctx.launch(round, n, what);
+    uint32_t c = 0;
+    changes.download(&c, 1);
+    if (c == 0) break;
+  }
+}
+}  // namespace
+
 uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
+  const std::string F = "collapse_conflict.cl";
   ensure(s.p1, ctx, c.ne);
+  ensure(s.state, ctx, c.ne);
+  ensure(s.changes, ctx, 1);
   ensure(s.vaff, ctx, dm.nv);
   s.vaff.fill(-1);
-  run(ctx, "collapse_conflict.cl", "conflict_pass1", c.ne, "", U(c.ne), B(c.edges), B(s.adm), B(s.cost), B(c.nb_off),
-      B(c.nb_edge), B(s.p1), B(s.vaff), B(s.counters));
+  run(ctx, F, "conflict_init", c.ne, "", U(c.ne), B(s.adm), B(s.state));
+  cl::Kernel round = ctx.kernel(F, "conflict_pass1_round");
+  set_args(round, "conflict_pass1_round", U(c.ne), B(c.edges), B(s.cost), B(c.nb_off), B(c.nb_edge), B(s.state),
+           B(s.changes));
+  until_fixpoint(ctx, round, s.changes, c.ne, "conflict_pass1_round");
+  run(ctx, F, "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1), B(s.vaff), B(s.counters));
   return counter(s, 2);
 }
 
 uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
-  ensure(s.kill, ctx, c.ne);
+  const std::string F = "collapse_conflict.cl";
   ensure(s.fin, ctx, c.ne);
-  s.kill.fill(0);
-  run(ctx, "collapse_conflict.cl", "conflict_pass2", dm.nt, "", U(dm.nt), B(dm.tets), B(s.vaff), B(s.cost), B(s.kill));
-  run(ctx, "collapse_conflict.cl", "conflict_finalize", c.ne, "", U(c.ne), B(c.edges), B(s.p1), B(s.kill), B(s.fin),
-      B(s.vaff), B(s.counters));
+  run(ctx, F, "conflict_pass2_init", c.ne, "", U(c.ne), B(s.p1), B(s.state));
+  cl::Kernel round = ctx.kernel(F, "conflict_pass2_round");
+  set_args(round, "conflict_pass2_round", U(c.ne), B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt),
+           B(s.vaff), B(s.state), B(s.changes));
+  until_fixpoint(ctx, round, s.changes, c.ne, "conflict_pass2_round");
+  run(ctx, F, "conflict_finalize", c.ne, "", U(c.ne), B(c.edges), B(s.p1), B(s.state), B(s.fin), B(s.vaff),
+      B(s.counters));
   return counter(s, 3);
 }
 

@@ -35,6 +35,7 @@ struct Connectivity {
   DeviceBuffer<int32_t> nb_edge;   // edge id of each N(v) entry
   DeviceBuffer<uint32_t> edge_off; // nv + 1: edges owned by v (v is the smaller end)
   DeviceBuffer<int32_t> edges;     // 2 per edge, sorted lexicographically
+  DeviceBuffer<int32_t> tet_nbr;   // 4 per tet: tet across each face (collapse_common.h)
   DeviceBuffer<uint8_t> vflags, vclass, eflags;  // see collapse_common.h
   // scratch
   DeviceBuffer<uint32_t> count, cursor, up_count;
@@ -44,7 +45,9 @@ struct Connectivity {
 // Per-edge and per-vertex state of the later stages.
 struct EdgeState {
   DeviceBuffer<double> cost;
-  DeviceBuffer<uint32_t> marked, adm, p1, kill, fin;
+  DeviceBuffer<uint32_t> marked, adm, p1, fin;
+  DeviceBuffer<uint8_t> state;      // conflict passes: 0 undecided, 1 in, 2 out
+  DeviceBuffer<uint32_t> changes;   // decisions taken in a round
   DeviceBuffer<uint8_t> dir, reason;
   DeviceBuffer<int32_t> vaff;       // per vertex
   DeviceBuffer<uint32_t> counters;  // marked, admissible, pass1, pass2

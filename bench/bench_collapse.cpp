@@ -1,0 +1,135 @@
+// Workload W1 of issue 5: the robot mesh (514k tets) coarsened to 2 x its median edge length,
+// eps_c = 0 and eps_c = 700 (paper Sec. 4.4, Fig. 9, Table 2). File I/O is excluded.
+//
+//   bench_collapse [MESH] [--runs N] [--json FILE]
+// Prints a table (median of N runs of collapse(), iterations, collapses per iteration, time per
+// stage summed over the iterations of the median run, tets in/out) and the same as JSON.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/io.hpp"
+
+using namespace tc;
+
+namespace {
+
+struct Result {
+  int64_t eps_c = 0;
+  std::vector<double> walls;
+  CollapseReport report;  // of the median run
+};
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string path = std::string(TC_SHARED_MESHES) + "/gen_tetgen_thingi255172_make-robot_514k.msh";
+  std::string json_path;
+  int runs = 5;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--json") && i + 1 < argc) json_path = argv[++i];
+    else path = argv[i];
+  }
+  Mesh input;
+  auto t0 = std::chrono::steady_clock::now();
+  try {
+    input = read_mesh(path);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_collapse: cannot read %s: %s\n", path.c_str(), e.what());
+    return 1;
+  }
+  const double read_s = seconds_since(t0);
+  Context ctx;
+  std::printf("mesh %s: %lld vertices, %lld tets (read in %.3f s)\ndevice %s\n", path.c_str(),
+              (long long)input.num_vertices(), (long long)input.num_tets(), read_s, ctx.info().name.c_str());
+  {  // warm-up: kernel compilation / binary cache
+    Mesh m = input;
+    CollapseOptions o;
+    o.max_iterations = 1;
+    collapse(m, o, ctx);
+  }
+
+  std::vector<Result> results;
+  for (int64_t eps_c : {int64_t(0), int64_t(700)}) {
+    Result r;
+    r.eps_c = eps_c;
+    std::vector<std::pair<double, CollapseReport>> all;
+    for (int i = 0; i < runs; ++i) {
+      Mesh m = input;
+      CollapseOptions o;
+      o.target_factor = 2;
+      o.eps_c = eps_c;
+      auto t = std::chrono::steady_clock::now();
+      CollapseReport rep = collapse(m, o, ctx);
+      double wall = seconds_since(t);
+      r.walls.push_back(wall);
+      all.emplace_back(wall, rep);
+    }
+    std::sort(all.begin(), all.end(), [](auto& a, auto& b) { return a.first < b.first; });
+    r.report = all[all.size() / 2].second;
+    std::sort(r.walls.begin(), r.walls.end());
+    results.push_back(r);
+  }
+
+  std::ostringstream js;
+  js << "{\"mesh\": \"" << path << "\", \"device\": \"" << ctx.info().name << "\", \"runs\": " << runs
+     << ", \"vertices_in\": " << input.num_vertices() << ", \"tets_in\": " << input.num_tets() << ", \"workloads\": [";
+  for (size_t w = 0; w < results.size(); ++w) {
+    const Result& r = results[w];
+    const CollapseReport& rep = r.report;
+    double st[6] = {0, 0, 0, 0, 0, 0};
+    for (const auto& s : rep.iterations) {
+      st[0] += s.seconds_connectivity;
+      st[1] += s.seconds_cost;
+      st[2] += s.seconds_admissible;
+      st[3] += s.seconds_pass1;
+      st[4] += s.seconds_pass2;
+      st[5] += s.seconds_collapse;
+    }
+    const char* names[6] = {"connectivity", "cost", "admissible", "pass1", "pass2", "collapse"};
+    int dom = int(std::max_element(st, st + 6) - st);
+    double median = r.walls[r.walls.size() / 2];
+    std::printf("\n== eps_c = %lld: target %.6g (2 x median %.6g)\n", (long long)r.eps_c, rep.target_length,
+                rep.median_edge_length);
+    std::printf("wall time of collapse(): median %.3f s (min %.3f, max %.3f) over %d runs; upload %.3f s, download %.3f s\n",
+                median, r.walls.front(), r.walls.back(), runs, rep.seconds_upload, rep.seconds_download);
+    std::printf("tets %lld -> %lld, vertices %lld -> %lld, %zu iterations\n", (long long)rep.tets_in,
+                (long long)rep.tets_out, (long long)rep.vertices_in, (long long)rep.vertices_out, rep.iterations.size());
+    std::printf("%4s %9s %9s %9s %9s %9s %9s | %7s %7s %7s %7s %7s %7s %7s\n", "it", "tets", "marked", "admiss",
+                "pass1", "pass2", "collapsed", "conn", "cost", "adm", "p1", "p2", "coll", "total");
+    for (const auto& s : rep.iterations)
+      std::printf("%4d %9lld %9lld %9lld %9lld %9lld %9lld | %7.4f %7.4f %7.4f %7.4f %7.4f %7.4f %7.4f\n", s.iteration,
+                  (long long)s.tets, (long long)s.marked, (long long)s.admissible, (long long)s.after_pass1,
+                  (long long)s.after_pass2, (long long)s.collapsed, s.seconds_connectivity, s.seconds_cost,
+                  s.seconds_admissible, s.seconds_pass1, s.seconds_pass2, s.seconds_collapse, s.seconds_total);
+    std::printf("stage totals:");
+    for (int k = 0; k < 6; ++k) std::printf(" %s %.3f s", names[k], st[k]);
+    std::printf("\ndominant stage: %s (%.0f%% of the iterations' time)\n", names[dom],
+                100 * st[dom] / std::max(1e-12, st[0] + st[1] + st[2] + st[3] + st[4] + st[5]));
+
+    js << (w ? ", " : "") << "{\"eps_c\": " << r.eps_c << ", \"seconds_median\": " << median << ", \"seconds_runs\": [";
+    for (size_t i = 0; i < r.walls.size(); ++i) js << (i ? ", " : "") << r.walls[i];
+    js << "], \"target_length\": " << rep.target_length << ", \"tets_out\": " << rep.tets_out
+       << ", \"vertices_out\": " << rep.vertices_out << ", \"iterations\": " << rep.iterations.size()
+       << ", \"collapses_per_iteration\": [";
+    for (size_t i = 0; i < rep.iterations.size(); ++i) js << (i ? ", " : "") << rep.iterations[i].collapsed;
+    js << "], \"stage_seconds\": {";
+    for (int k = 0; k < 6; ++k) js << (k ? ", " : "") << "\"" << names[k] << "\": " << st[k];
+    js << "}, \"dominant_stage\": \"" << names[dom] << "\"}";
+  }
+  js << "]}";
+  std::printf("\nJSON: %s\n", js.str().c_str());
+  if (!json_path.empty()) std::ofstream(json_path) << js.str() << "\n";
+  return 0;
+}
