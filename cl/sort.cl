@@ -14,9 +14,10 @@
 #define TC_RADIX_BITS 4
 #endif
 #define TC_RADIX (1u << TC_RADIX_BITS)
-#define TC_RADIX_MASK (TC_RADIX - 1u)
 
-__kernel void radix_count(__global const ulong* keys, uint n, uint shift, uint chunk, uint items,
+/* mask selects the digit's bits: all TC_RADIX_BITS, or fewer in the last pass so bits above
+ * key_bits are never looked at. */
+__kernel void radix_count(__global const ulong* keys, uint n, uint shift, uint mask, uint chunk, uint items,
                           __global uint* hist) {
   uint g = get_global_id(0);
   if (g >= items) return;
@@ -24,12 +25,12 @@ __kernel void radix_count(__global const ulong* keys, uint n, uint shift, uint c
   for (uint d = 0; d < TC_RADIX; ++d) count[d] = 0u;
   uint begin = g * chunk;
   uint end = min(n, begin + chunk);
-  for (uint i = begin; i < end; ++i) count[(uint)(keys[i] >> shift) & TC_RADIX_MASK]++;
+  for (uint i = begin; i < end; ++i) count[(uint)(keys[i] >> shift) & mask]++;
   for (uint d = 0; d < TC_RADIX; ++d) hist[d * items + g] = count[d];
 }
 
 __kernel void radix_scatter(__global const ulong* keys, __global const uint* values, __global ulong* keys_out,
-                            __global uint* values_out, uint has_values, uint n, uint shift, uint chunk, uint items,
+                            __global uint* values_out, uint has_values, uint n, uint shift, uint mask, uint chunk, uint items,
                             __global const uint* offsets) {
   uint g = get_global_id(0);
   if (g >= items) return;
@@ -39,7 +40,7 @@ __kernel void radix_scatter(__global const ulong* keys, __global const uint* val
   uint end = min(n, begin + chunk);
   for (uint i = begin; i < end; ++i) {
     ulong k = keys[i];
-    uint slot = next[(uint)(k >> shift) & TC_RADIX_MASK]++;
+    uint slot = next[(uint)(k >> shift) & mask]++;
     keys_out[slot] = k;
     if (has_values) values_out[slot] = values[i];
   }

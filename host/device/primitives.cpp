@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -14,12 +15,12 @@ namespace tc::dev {
 
 namespace {
 
-constexpr unsigned kScanItems = 8;  // values per work item in a scan tile (TC_ITEMS)
-constexpr unsigned kRadixBits = 4;  // digit width (TC_RADIX_BITS): 16 private counters per item
-constexpr unsigned kSortChunk = 256;  // elements per work item in a sort pass
+constexpr unsigned kScanItems = 8;      // values per work item in a scan tile (TC_ITEMS)
+constexpr unsigned kScanChunk = 4096;   // values per work item in the chunked (CPU) scan
 
 const std::string kScanOptions = "-DTC_ITEMS=" + std::to_string(kScanItems);
-const std::string kSortOptions = "-DTC_RADIX_BITS=" + std::to_string(kRadixBits);
+
+std::optional<Tuning> g_override;
 
 void check_n(size_t n, const char* what) {
   // Kernels index with 32-bit unsigned integers; tiles may run past n by one tile.
@@ -51,8 +52,32 @@ size_t scan_group_size(Context& ctx, const cl::Kernel& k) {
   return wg;
 }
 
+uint32_t scan_chunked(Context& ctx, const cl::Buffer& in, cl::Buffer& out, size_t n, bool as_flags) {
+  size_t items = (n + kScanChunk - 1) / kScanChunk;
+  cl::Kernel apply = ctx.kernel("scan.cl", "scan_chunk_apply", kScanOptions);
+  DeviceBuffer<uint32_t> total(ctx, 1);
+  uint32_t result = 0;
+  if (items == 1) {
+    set_args(apply, "scan_chunk_apply", in, out, u32(n), u32(as_flags), u32(kScanChunk), u32(items), total.buffer(),
+             u32(0), total.buffer());
+    ctx.launch(apply, items, "clEnqueueNDRangeKernel(scan_chunk_apply)");
+    total.download(&result, 1);
+    return result;
+  }
+  cl::Kernel sums_k = ctx.kernel("scan.cl", "scan_chunk_sums", kScanOptions);
+  DeviceBuffer<uint32_t> sums(ctx, items);
+  set_args(sums_k, "scan_chunk_sums", in, u32(n), u32(as_flags), u32(kScanChunk), u32(items), sums.buffer());
+  ctx.launch(sums_k, items, "clEnqueueNDRangeKernel(scan_chunk_sums)");
+  result = scan_chunked(ctx, sums.buffer(), sums.buffer(), items, false);
+  set_args(apply, "scan_chunk_apply", in, out, u32(n), u32(as_flags), u32(kScanChunk), u32(items), sums.buffer(),
+           u32(1), total.buffer());
+  ctx.launch(apply, items, "clEnqueueNDRangeKernel(scan_chunk_apply)");
+  return result;
+}
+
 uint32_t scan_impl(Context& ctx, const cl::Buffer& in, cl::Buffer& out, size_t n, bool as_flags) {
   if (n == 0) return 0;
+  if (tuning_for(ctx).chunked_scan) return scan_chunked(ctx, in, out, n, as_flags);
   cl::Kernel reduce = ctx.kernel("scan.cl", "scan_reduce", kScanOptions);
   cl::Kernel down = ctx.kernel("scan.cl", "scan_downsweep", kScanOptions);
   size_t wg = std::min(scan_group_size(ctx, reduce), scan_group_size(ctx, down));
@@ -103,6 +128,9 @@ void radix_sort_impl(Context& ctx, DeviceBuffer<uint64_t>& keys, DeviceBuffer<ui
   check_size(keys, n, "radix_sort", "keys");
   if (values) check_size(*values, n, "radix_sort", "values");
   if (n <= 1) return;
+  Tuning t = tuning_for(ctx);
+  const unsigned kRadixBits = static_cast<unsigned>(t.radix_bits), kSortChunk = t.sort_chunk;
+  const std::string kSortOptions = "-DTC_RADIX_BITS=" + std::to_string(kRadixBits);
   size_t items = (n + kSortChunk - 1) / kSortChunk;
   size_t radix = size_t{1} << kRadixBits;
   DeviceBuffer<uint64_t> keys_tmp(ctx, n);
@@ -119,10 +147,12 @@ void radix_sort_impl(Context& ctx, DeviceBuffer<uint64_t>& keys, DeviceBuffer<ui
   int passes = (key_bits + static_cast<int>(kRadixBits) - 1) / static_cast<int>(kRadixBits);
   for (int p = 0; p < passes; ++p) {
     cl_uint shift = static_cast<cl_uint>(p * kRadixBits);
-    set_args(count, "radix_count", *kin, u32(n), shift, u32(kSortChunk), u32(items), hist.buffer());
+    cl_uint bits = std::min<cl_uint>(kRadixBits, static_cast<cl_uint>(key_bits) - shift);
+    cl_uint mask = (1u << bits) - 1u;
+    set_args(count, "radix_count", *kin, u32(n), shift, mask, u32(kSortChunk), u32(items), hist.buffer());
     ctx.launch(count, items, "clEnqueueNDRangeKernel(radix_count)");
     scan_impl(ctx, hist.buffer(), hist.buffer(), radix * items, false);
-    set_args(scatter, "radix_scatter", *kin, *vin, *kout, *vout, u32(values != nullptr), u32(n), shift,
+    set_args(scatter, "radix_scatter", *kin, *vin, *kout, *vout, u32(values != nullptr), u32(n), shift, mask,
              u32(kSortChunk), u32(items), hist.buffer());
     ctx.launch(scatter, items, "clEnqueueNDRangeKernel(radix_scatter)");
     std::swap(kin, kout);
@@ -137,6 +167,30 @@ void radix_sort_impl(Context& ctx, DeviceBuffer<uint64_t>& keys, DeviceBuffer<ui
 }
 
 }  // namespace
+
+Tuning default_tuning(const DeviceInfo& info) {
+  Tuning t;
+  if (info.type == "CPU") {
+    // Work items are loop iterations on a CPU: long serial chunks, no barriers, and 8-bit
+    // digits (half the passes; 256 counters per work item are cheap in CPU memory).
+    t.chunked_scan = true;
+    t.radix_bits = 8;
+    t.sort_chunk = 4096;
+  }
+  return t;
+}
+
+void set_tuning_override(const Tuning* tuning) {
+  if (tuning) {
+    if (tuning->radix_bits != 4 && tuning->radix_bits != 8) throw std::invalid_argument("Tuning: radix_bits must be 4 or 8");
+    if (tuning->sort_chunk == 0) throw std::invalid_argument("Tuning: sort_chunk must be positive");
+    g_override = *tuning;
+  } else {
+    g_override.reset();
+  }
+}
+
+Tuning tuning_for(const Context& ctx) { return g_override ? *g_override : default_tuning(ctx.info()); }
 
 uint32_t exclusive_scan(Context& ctx, const DeviceBuffer<uint32_t>& in, DeviceBuffer<uint32_t>& out, size_t n) {
   check_n(n, "exclusive_scan");

@@ -11,6 +11,18 @@
 
 namespace tc::dev {
 
+// How the primitives map onto a device. The default depends on the device type (see
+// default_tuning); set_tuning_override lets tests and benches run every variant on any device.
+struct Tuning {
+  bool chunked_scan = false;  // true: per-work-item serial chunks (CPU); false: local-memory tiles (GPU)
+  int radix_bits = 4;         // digit width of the radix sort: 4 (16 private counters) or 8
+  unsigned sort_chunk = 256;  // elements per work item in a radix sort pass
+};
+Tuning default_tuning(const DeviceInfo& info);
+// Process-wide; nullptr restores the per-device default.
+void set_tuning_override(const Tuning* tuning);
+Tuning tuning_for(const Context& ctx);
+
 // out[i] = in[0] + ... + in[i-1] (mod 2^32); returns the total of all n values (mod 2^32).
 // in and out may be the same buffer. out must hold at least n values.
 uint32_t exclusive_scan(Context& ctx, const DeviceBuffer<uint32_t>& in, DeviceBuffer<uint32_t>& out, size_t n);

@@ -371,6 +371,7 @@ cl::Program& Context::build(const std::string& file, const std::string& text, co
   expand_text(text, source, seen, 0);
   std::string opts = "-cl-std=CL1.2";
   if (!options.empty()) opts += " " + options;
+  if (const char* extra = std::getenv("TETCOLLAPSE_CL_OPTIONS"); extra && *extra) opts += std::string(" ") + extra;
 
   std::string cache_key = info_.name + '\n' + info_.vendor + '\n' + info_.driver_version + '\n' + info_.platform_version +
                           '\n' + opts + '\n' + source;

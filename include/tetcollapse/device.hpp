@@ -84,7 +84,8 @@ class Context {
   size_t group_size_for(const cl::Kernel& kernel) const;
 
   // The program made of the embedded file `file` (e.g. "scan.cl"); `#include "x.h"` lines are
-  // replaced by the embedded text of x.h. Options are appended to "-cl-std=CL1.2". Built from
+  // replaced by the embedded text of x.h. Options are appended to "-cl-std=CL1.2", followed by
+  // the environment variable TETCOLLAPSE_CL_OPTIONS when set (e.g. "-cl-opt-disable"). Built from
   // the cache when possible; a build failure throws DeviceError with the build log.
   cl::Program& program(const std::string& file, const std::string& options = "");
   // The same from source text given here (named `name` in messages); #include lines still refer

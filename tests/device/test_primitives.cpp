@@ -24,6 +24,28 @@ struct WorkGroup {  // restores the default work-group size when a test ends
   ~WorkGroup() { ctx().set_work_group_size(0); }
 };
 
+// Every test runs with the device's default tuning and with both explicit variants (local-memory
+// tiles with 4-bit digits, as on GPUs; serial chunks with 8-bit digits, as on CPUs), so both code
+// paths are checked on any device. The 10M cases run with the default only.
+class Tuned : public ::testing::TestWithParam<int> {
+ protected:
+  void SetUp() override {
+    tc::dev::Tuning t;
+    if (GetParam() == 1) {
+      t.chunked_scan = false;
+      t.radix_bits = 4;
+      t.sort_chunk = 256;
+    } else if (GetParam() == 2) {
+      t.chunked_scan = true;
+      t.radix_bits = 8;
+      t.sort_chunk = 4096;
+    }
+    tc::dev::set_tuning_override(GetParam() == 0 ? nullptr : &t);
+  }
+  void TearDown() override { tc::dev::set_tuning_override(nullptr); }
+  bool default_only() const { return GetParam() == 0; }
+};
+
 std::vector<size_t> sizes() {
   std::vector<size_t> s{0, 1, 2, 3, 7};
   for (int k : {4, 8, 10, 11, 13, 16, 17}) {
@@ -86,25 +108,27 @@ void expect_sort(const std::vector<uint64_t>& keys, int bits) {
   ASSERT_EQ(dk2.download(), k) << "keys-only sort, n=" << n;
 }
 
-TEST(Scan, RandomSizes) {
+TEST_P(Tuned, Scan_RandomSizes) {
   for (size_t n : sizes()) expect_scan(random_u32(n, 1000, static_cast<uint32_t>(n)));
 }
 
-TEST(Scan, WrapsModulo2To32AndMaxValues) {
+TEST_P(Tuned, Scan_WrapsModulo2To32AndMaxValues) {
   for (size_t n : {size_t{1}, size_t{5}, size_t{4097}, size_t{70001}}) {
     expect_scan(std::vector<uint32_t>(n, 0xffffffffu));
     expect_scan(random_u32(n, 0xffffffffu, 7));
   }
 }
 
-TEST(Scan, TenMillion) { expect_scan(random_u32(10'000'000, 3, 42)); }
+TEST_P(Tuned, Scan_TenMillion) {
+  if (!default_only()) GTEST_SKIP() << "10M case runs with the default tuning only";
+  expect_scan(random_u32(10'000'000, 3, 42)); }
 
-TEST(Scan, RejectsShortBuffers) {
+TEST_P(Tuned, Scan_RejectsShortBuffers) {
   tc::DeviceBuffer<uint32_t> a(ctx(), 10), b(ctx(), 5);
   EXPECT_THROW(tc::dev::exclusive_scan(ctx(), a, b, 10), std::invalid_argument);
 }
 
-TEST(Compact, MatchesCopyIf) {
+TEST_P(Tuned, Compact_MatchesCopyIf) {
   for (size_t n : sizes()) {
     auto flags = random_u32(n, 3, static_cast<uint32_t>(n) + 1);  // 0..3: non-zero means keep
     auto vals = random_u32(n, 0xffffffffu, 3);
@@ -129,7 +153,7 @@ TEST(Compact, MatchesCopyIf) {
   }
 }
 
-TEST(Compact, AllAndNone) {
+TEST_P(Tuned, Compact_AllAndNone) {
   size_t n = 5000;
   tc::DeviceBuffer<uint32_t> all(ctx(), std::vector<uint32_t>(n, 0xffffffffu)), none(ctx(), std::vector<uint32_t>(n, 0));
   tc::DeviceBuffer<uint32_t> out(ctx(), 0);
@@ -141,13 +165,13 @@ TEST(Compact, AllAndNone) {
   EXPECT_EQ(out.size(), 0u);
 }
 
-TEST(RadixSort, RandomSizesAndBitWidths) {
+TEST_P(Tuned, RadixSort_RandomSizesAndBitWidths) {
   for (size_t n : sizes()) expect_sort(random_u64(n, 64, static_cast<uint32_t>(n)), 64);
   for (int bits : {1, 3, 4, 17, 33, 63})
     for (size_t n : {size_t{1000}, size_t{65537}}) expect_sort(random_u64(n, bits, bits), bits);
 }
 
-TEST(RadixSort, Adversarial) {
+TEST_P(Tuned, RadixSort_Adversarial) {
   for (size_t n : {size_t{2}, size_t{257}, size_t{70000}}) {
     expect_sort(std::vector<uint64_t>(n, 12345), 64);               // all equal: order must stay
     expect_sort(std::vector<uint64_t>(n, ~uint64_t{0}), 64);        // all ones bits, max value
@@ -160,7 +184,7 @@ TEST(RadixSort, Adversarial) {
   }
 }
 
-TEST(RadixSort, OnlyRequestedBitsAreSorted) {
+TEST_P(Tuned, RadixSort_OnlyRequestedBitsAreSorted) {
   // Bits above key_bits are ignored: keys equal in the low 8 bits keep their input order.
   std::vector<uint64_t> keys{0x105, 0x003, 0x205, 0x001};
   tc::DeviceBuffer<uint64_t> dk(ctx(), keys);
@@ -170,13 +194,19 @@ TEST(RadixSort, OnlyRequestedBitsAreSorted) {
   tc::DeviceBuffer<uint64_t> dk2(ctx(), keys2);
   tc::dev::radix_sort(ctx(), dk2, keys2.size(), 8);
   EXPECT_EQ(dk2.download(), keys2);  // same low byte: stable, upper bits not looked at
+  std::vector<uint64_t> keys3{0b1010, 0b0001, 0b1001, 0b0011};  // bit 3 lies above key_bits = 3
+  tc::DeviceBuffer<uint64_t> dk3(ctx(), keys3);
+  tc::dev::radix_sort(ctx(), dk3, keys3.size(), 3);
+  EXPECT_EQ(dk3.download(), (std::vector<uint64_t>{0b0001, 0b1001, 0b1010, 0b0011}));
   EXPECT_THROW(tc::dev::radix_sort(ctx(), dk2, 2, 0), std::invalid_argument);
   EXPECT_THROW(tc::dev::radix_sort(ctx(), dk2, 2, 65), std::invalid_argument);
 }
 
-TEST(RadixSort, TenMillion) { expect_sort(random_u64(10'000'000, 40, 5), 40); }
+TEST_P(Tuned, RadixSort_TenMillion) {
+  if (!default_only()) GTEST_SKIP() << "10M case runs with the default tuning only";
+  expect_sort(random_u64(10'000'000, 40, 5), 40); }
 
-TEST(Segments, UniqueAndReduceByKey) {
+TEST_P(Tuned, Segments_UniqueAndReduceByKey) {
   for (size_t n : sizes()) {
     auto keys = random_u64(n, 64, 11);
     for (auto& k : keys) k %= std::max<size_t>(1, n / 3 + 1);  // runs of various lengths
@@ -217,7 +247,7 @@ TEST(Segments, UniqueAndReduceByKey) {
   }
 }
 
-TEST(Segments, OneLongSegment) {
+TEST_P(Tuned, Segments_OneLongSegment) {
   size_t n = 300000;
   tc::DeviceBuffer<uint64_t> dk(ctx(), std::vector<uint64_t>(n, ~uint64_t{0})), uk(ctx(), 0);
   tc::DeviceBuffer<uint32_t> dv(ctx(), std::vector<uint32_t>(n, 3)), out(ctx(), 0);
@@ -226,7 +256,7 @@ TEST(Segments, OneLongSegment) {
   EXPECT_EQ(out.download(), std::vector<uint32_t>{static_cast<uint32_t>(3 * n)});
 }
 
-TEST(WorkGroupSize, ResultsDoNotDependOnIt) {
+TEST_P(Tuned, WorkGroupSize_ResultsDoNotDependOnIt) {
   size_t n = 40000 + 17;
   auto keys = random_u64(n, 20, 77);
   auto vals = random_u32(n, 5, 78);
@@ -256,5 +286,10 @@ TEST(WorkGroupSize, ResultsDoNotDependOnIt) {
   }
   EXPECT_TRUE(std::is_sorted(sort_keys[0].begin(), sort_keys[0].end()));
 }
+
+INSTANTIATE_TEST_SUITE_P(Tunings, Tuned, ::testing::Values(0, 1, 2),
+                         [](const ::testing::TestParamInfo<int>& i) {
+                           return std::string(i.param == 0 ? "DeviceDefault" : i.param == 1 ? "TilesRadix4" : "ChunksRadix8");
+                         });
 
 }  // namespace
