@@ -453,11 +453,13 @@ TEST(Check, EverySharedMeshIsValid) {
       const auto* dup = r.find("duplicate_vertices");
       ASSERT_NE(dup, nullptr);
       EXPECT_EQ(dup->count, 88);
-      for (const auto& pair : dup->offenders)
+      for (const auto& pair : dup->offenders) {
         for (int a = 0; a < 3; ++a) EXPECT_EQ(m.points[3 * pair[0] + a], m.points[3 * pair[1] + a]);
+      }
       for (const auto& f : r.findings) {
-        if (f.severity == tc::Severity::Error)
+        if (f.severity == tc::Severity::Error) {
           EXPECT_TRUE(f.code == "duplicate_vertices" || f.code == "boundary_self_intersection") << f.message;
+        }
       }
       ++checked;
       continue;
