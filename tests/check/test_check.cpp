@@ -303,6 +303,24 @@ TEST(Check, DuplicatedTet) {
   EXPECT_EQ(offenders(tc::check_mesh(p), "duplicate_tet"), (std::vector<Tuple>{{2, 6}}));
 }
 
+TEST(Check, WideFaceKeysBeyondTwoMillionVertices) {
+  // With >= 2^21 vertices face keys no longer fit 64 bits: the 128-bit path must agree.
+  Mesh c = tc::test::cube_tets(1);
+  const int32_t base = (1 << 21) + 5;
+  Mesh m;
+  m.points.resize(3 * size_t(base), 0.0);
+  for (int32_t v = 0; v < base; ++v) m.points[3 * size_t(v)] = 10.0 + v;  // distinct, far away, unreferenced
+  m.points.insert(m.points.end(), c.points.begin(), c.points.end());
+  for (int32_t v : c.tets) m.tets.push_back(v + base);
+  CheckReport r = tc::check_mesh(m);
+  EXPECT_TRUE(r.valid) << tc::check_report_text(r);
+  EXPECT_EQ(r.boundary.faces, 12);
+  EXPECT_EQ(r.interior_faces, 6);
+  EXPECT_EQ(r.boundary.euler, 2);
+  m.tets.insert(m.tets.end(), m.tets.begin(), m.tets.begin() + 4);  // tet 6 = copy of tet 0
+  EXPECT_EQ(offenders(tc::check_mesh(m), "duplicate_tet"), (std::vector<Tuple>{{0, 6}}));
+}
+
 TEST(Check, RepeatedVertexInTet) {
   Mesh m = mesh_of({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1}, {0, 1, 2, 3, 0, 1, 1, 3});
   CheckReport r = tc::check_mesh(m);
