@@ -97,3 +97,50 @@ TEST(Cli, DefaultMeshInfo) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Cli, CheckExitCodesAndJson) {
+  tc::test::TempDir dir;
+  std::string out;
+  std::string json = dir.file("report.json");
+  ASSERT_EQ(run_command(cli() + " check " + q(tc::test::project_mesh("two_tets.mesh")) + " --json " + q(json), &out), 0)
+      << out;
+  std::string report = tc::test::read_text(json);
+  EXPECT_NE(report.find("\"valid\":true"), std::string::npos) << report;
+  // Two tets on the same side of their shared face: they overlap, the face has the same
+  // orientation in both; read_mesh accepts it (both positive), the checker must not.
+  std::string bad = dir.file("overlap.mesh");
+  tc::test::write_text(bad, "MeshVersionFormatted 2\nDimension 3\nVertices\n5\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\n"
+                            "0.1 0.1 2 0\nTetrahedra\n2\n1 2 3 4 1\n1 2 3 5 1\nEnd\n");
+  EXPECT_EQ(run_command(cli() + " check " + q(bad), &out), 1) << out;
+  EXPECT_NE(out.find("face_same_orientation"), std::string::npos) << out;
+}
+
+}  // namespace
+
+namespace {
+
+TEST(Cli, CoarsenWritesAValidMeshAndStats) {
+  tc::test::TempDir dir;
+  std::string out;
+  std::string result = dir.file("coarse.vtu"), stats = dir.file("stats.json");
+  ASSERT_EQ(run_command(cli() + " " + q(tc::test::project_mesh("bracket.msh")) + " " + q(result) +
+                            " --target-factor 1.5 --max-iterations 4 --check --stats " + q(stats),
+                        &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("iteration   1:"), std::string::npos) << out;  // progress lines on stderr
+  EXPECT_NE(out.find("check: valid"), std::string::npos) << out;
+  std::string s = tc::test::read_text(stats);
+  for (const char* key : {"\"tets_in\":23925", "\"vertices_in\":5580", "\"tets_out\":", "\"vertices_out\":",
+                          "\"device\":", "\"seconds_total\":", "\"seconds_collapse\":", "\"iterations\":[{",
+                          "\"collapsed\":", "\"seconds_admissible\":", "\"check\":\"valid\""})
+    EXPECT_NE(s.find(key), std::string::npos) << key << " not in " << s;
+  ASSERT_EQ(run_command(cli() + " check -q " + q(result), &out), 0) << out;
+  // Quiet mode prints nothing on success.
+  ASSERT_EQ(run_command(cli() + " -q " + q(tc::test::project_mesh("tet.mesh")) + " " + q(dir.file("t.mesh")), &out), 0);
+  EXPECT_TRUE(out.empty()) << out;
+}
+
+}  // namespace
