@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer harnesses of the mesh readers with clang (ASan + UBSan) in
+# build-fuzz/ and runs one or all of them.
+#   scripts/fuzz.sh [SECONDS] [HARNESS...]      HARNESS: gmsh medit vtk vtu tetgen (default: all)
+#   SECONDS defaults to 60; each harness runs that long, one after the other
+#   (JOBS=N runs N at a time). Environment: BUILD_DIR, MAX_LEN (default 16384), NICE (default 19).
+# Needs clang and libFuzzer (Debian: clang libclang-rt-14-dev; scripts/setup.sh --with-fuzz).
+# The working corpus grows in BUILD_DIR/corpus/<harness> (seeded from tests/fuzz/seeds/);
+# crashers land in BUILD_DIR/crashes/<harness>/, logs in BUILD_DIR/logs/. To keep a crasher
+# as a regression test, copy it to tests/data/fuzz/<harness>/ (tests/io/test_fuzz_regressions).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${BUILD_DIR:-$root/build-fuzz}
+seconds=${1:-60}
+[[ $# -gt 0 ]] && shift
+harnesses=("$@")
+((${#harnesses[@]})) || harnesses=(gmsh medit vtk vtu tetgen)
+jobs=${JOBS:-1}
+max_len=${MAX_LEN:-16384}
+nice_level=${NICE:-19}
+
+command -v clang++ >/dev/null || { echo "fuzz: clang++ not found (apt-get install clang libclang-rt-14-dev)" >&2; exit 1; }
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+      -DTETCOLLAPSE_FUZZ=ON -DTETCOLLAPSE_BUILD_BENCH=OFF >/dev/null
+targets=()
+for h in "${harnesses[@]}"; do targets+=("fuzz_$h"); done
+nice -n "$nice_level" cmake --build "$build" --target "${targets[@]}" -j "${BUILD_JOBS:-2}"
+
+run() {
+  local h=$1 corpus=$build/corpus/$1 crashes=$build/crashes/$1/ log=$build/logs/$1.log
+  mkdir -p "$corpus" "$crashes" "$build/logs"
+  # Start from the committed seeds (and keep what earlier runs found).
+  cp -n "$root/tests/fuzz/seeds/$h/"* "$corpus/" 2>/dev/null || true
+  echo "fuzz: $h for ${seconds}s -> $log"
+  local rc=0
+  nice -n "$nice_level" "$build/tests/fuzz/fuzz_$h" "$corpus" \
+      -dict="$root/tests/fuzz/dicts/$h.dict" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 \
+      -max_len="$max_len" -artifact_prefix="$crashes" -print_final_stats=1 >"$log" 2>&1 || rc=$?
+  # Summary: the last status line and the final stats.
+  grep -E '^#[0-9]+' "$log" | tail -1 || true
+  grep -E '^stat::(number_of_executed_units|average_exec_per_sec|peak_rss_mb)' "$log" || true
+  if ((rc != 0)); then
+    echo "fuzz: $h FOUND A PROBLEM (exit $rc); see $log and $crashes" >&2
+    return 1
+  fi
+}
+
+status=0
+if ((jobs <= 1)); then
+  for h in "${harnesses[@]}"; do run "$h" || status=1; done
+else
+  for h in "${harnesses[@]}"; do
+    run "$h" &
+    while (($(jobs -rp | wc -l) >= jobs)); do wait -n || status=1; done
+  done
+  while (($(jobs -rp | wc -l) > 0)); do wait -n || status=1; done
+fi
+exit $status
