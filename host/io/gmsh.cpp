@@ -699,6 +699,19 @@ void read_data(Src& s, ReaderState& st, bool node_data) {
     st.tet_lookup_built = true;
   }
   const int64_t entities = node_data ? st.mesh.num_vertices() : st.mesh.num_tets();
+  if (count < entities) {
+    // Cannot cover every node / tet: read past the values without allocating a field
+    // whose size would come from an unchecked component count.
+    for (int64_t i = 0; i < count; ++i) {
+      int64_t tag = s.integer();
+      if (node_data && st.nodes.find(tag) < 0) s.fail("$NodeData refers to node tag " + std::to_string(tag) + ", which is not in $Nodes");
+      for (int64_t k = 0; k < comps; ++k) s.real();
+    }
+    if (st.notes)
+      st.notes->notes.push_back(std::string(section) + " '" + name + "' has " + std::to_string(count) + " values for " +
+                                std::to_string(entities) + (node_data ? " nodes" : " tets") + "; skipped");
+    return;
+  }
   Field f;
   f.name = name;
   f.components = static_cast<int>(comps);

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <random>
 #include <string>
 
 #include "io/io_util.hpp"
@@ -231,6 +232,39 @@ TEST(GmshShared, FeatureCurveCountsOfTheOtherGmshMeshes) {
     SCOPED_TRACE(name);
     Mesh m = read(path);
     EXPECT_EQ(m.edge_tags.size(), lines);
+  }
+}
+
+// Files written by Gmsh itself in all four variants (converted from the shared mesh by
+// the gmsh command line): the same mesh comes back from each.
+TEST(GmshShared, GmshWrittenVariantsOfWrenchnutAgree) {
+  std::string src = tc::test::shared_mesh("gen_gmsh_wrenchnut_27k.msh");
+  if (src.empty()) GTEST_SKIP() << "gen_gmsh_wrenchnut_27k.msh is not present in ../shared/meshes";
+  std::string out;
+  if (tc::test::run_command("gmsh --version", &out) != 0) GTEST_SKIP() << "the gmsh command is not installed";
+  Mesh ref = read(src);
+  TempDir dir;
+  const char* variants[] = {"msh22", "msh22 -bin", "msh41", "msh41 -bin"};
+  for (const char* v : variants) {
+    SCOPED_TRACE(v);
+    std::string path = dir.file("w.msh");
+    ASSERT_EQ(tc::test::run_command("gmsh '" + src + "' -0 -format " + v + " -o '" + path + "'", &out), 0) << out;
+    ReadNotes notes;
+    Mesh m = read(path, &notes);
+    EXPECT_EQ(m.num_vertices(), ref.num_vertices());
+    EXPECT_EQ(m.tets, ref.tets);
+    EXPECT_EQ(m.tris, ref.tris);
+    EXPECT_EQ(m.tri_tags, ref.tri_tags);
+    EXPECT_EQ(m.edges, ref.edges);
+    EXPECT_EQ(m.edge_tags, ref.edge_tags);
+    ASSERT_NE(m.find_labels("gmsh:geometrical"), nullptr);
+    EXPECT_EQ(m.find_labels("gmsh:geometrical")->values, ref.find_labels("gmsh:geometrical")->values);
+    EXPECT_EQ(m.find_labels("gmsh:physical"), nullptr);  // 2.2: physical tag 0 everywhere
+    if (std::string(v).find("-bin") != std::string::npos)
+      EXPECT_EQ(0, std::memcmp(m.points.data(), ref.points.data(), m.points.size() * sizeof(double)));
+    else
+      for (size_t i = 0; i < m.points.size(); ++i) ASSERT_NEAR(m.points[i], ref.points[i], 1e-12 * (1 + std::fabs(ref.points[i])));
+    EXPECT_GT(notes.skipped_elements, 0);
   }
 }
 
@@ -619,6 +653,43 @@ TEST(GmshErrors, BinaryFiles) {
     int32_t count = 5;
     std::memcpy(&s[e + 4], &count, 4);
     expect_error(read_error(s), at(e + 4), "element block of 5 elements");
+  }
+}
+
+// Every prefix and many corrupted copies of valid files: an InputError or a mesh, never a
+// crash (run under the sanitizers to make this meaningful) or another exception.
+TEST(GmshErrors, TruncatedAndCorruptedFilesNeverCrash) {
+  Mesh m = rich_mesh();
+  TempDir dir;
+  std::mt19937 rng(12345);
+  for (const Variant& var : kVariants) {
+    SCOPED_TRACE(var.name);
+    tc::WriteOptions o;
+    o.gmsh_version = var.version;
+    o.binary = var.binary;
+    std::string good_path = dir.file("good.msh");
+    tc::write_gmsh(good_path, m, o);
+    const std::string good = tc::test::read_text(good_path);
+    std::string path = dir.file("mutant.msh");
+    int errors = 0, reads = 0;
+    auto attempt = [&](const std::string& text) {
+      write_text(path, text);
+      try {
+        read(path);
+        ++reads;
+      } catch (const tc::InputError& e) {
+        ++errors;
+        EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos);
+      }
+    };
+    for (size_t cut = 0; cut < good.size(); cut += 1 + good.size() / 400) attempt(good.substr(0, cut));
+    for (int i = 0; i < 300; ++i) {
+      std::string s = good;
+      for (int k = 0; k < 3; ++k) s[rng() % s.size()] = static_cast<char>(rng() % 256);
+      attempt(s);
+    }
+    EXPECT_GT(errors, 300);  // every proper prefix is an error
+    (void)reads;
   }
 }
 
