@@ -1,7 +1,7 @@
 // Workload W1 of issue 5: the robot mesh (514k tets) coarsened to 2 x its median edge length,
 // eps_c = 0 and eps_c = 700 (paper Sec. 4.4, Fig. 9, Table 2). File I/O is excluded.
 //
-//   bench_collapse [MESH] [--runs N] [--json FILE]
+//   bench_collapse [MESH] [--runs N] [--json FILE] [--wg N] [--max-iterations N]
 // Prints a table (median of N runs of collapse(), iterations, collapses per iteration, time per
 // stage summed over the iterations of the median run, tets in/out) and the same as JSON.
 #include <algorithm>
@@ -36,9 +36,13 @@ int main(int argc, char** argv) {
   std::string path = std::string(TC_SHARED_MESHES) + "/gen_tetgen_thingi255172_make-robot_514k.msh";
   std::string json_path;
   int runs = 5;
+  size_t wg = 0;
+  int max_iterations = 1000;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--json") && i + 1 < argc) json_path = argv[++i];
+    else if (!std::strcmp(argv[i], "--wg") && i + 1 < argc) wg = size_t(std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--max-iterations") && i + 1 < argc) max_iterations = std::atoi(argv[++i]);
     else path = argv[i];
   }
   Mesh input;
@@ -51,6 +55,7 @@ int main(int argc, char** argv) {
   }
   const double read_s = seconds_since(t0);
   Context ctx;
+  ctx.set_work_group_size(wg);
   std::printf("mesh %s: %lld vertices, %lld tets (read in %.3f s)\ndevice %s\n", path.c_str(),
               (long long)input.num_vertices(), (long long)input.num_tets(), read_s, ctx.info().name.c_str());
   {  // warm-up: kernel compilation / binary cache
@@ -70,6 +75,7 @@ int main(int argc, char** argv) {
       CollapseOptions o;
       o.target_factor = 2;
       o.eps_c = eps_c;
+      o.max_iterations = max_iterations;
       auto t = std::chrono::steady_clock::now();
       CollapseReport rep = collapse(m, o, ctx);
       double wall = seconds_since(t);

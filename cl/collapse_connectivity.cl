@@ -41,6 +41,10 @@ inline void tcc_sort_segment(__global int* a, uint n) {
   }
 }
 
+#ifndef TCC_MAX_NB
+#define TCC_MAX_NB 64
+#endif
+
 /* Sorts ring(v); then gathers N(v) into scratch[3 vt_off[v] ..], sorted and unique, and counts
  * it (nb_count) and its part above v (up_count). */
 __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __global const uint* vt_off,
@@ -51,13 +55,29 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
   uint b = vt_off[v], n = vt_off[v + 1] - b;
   tcc_sort_segment(vt + b, n);
   __global int* s = scratch + 3 * b;
+  /* N(v) is built by insertion into a sorted private list (short: ~15 entries), spilling to the
+   * global scratch area only when it outgrows TCC_MAX_NB */
+  int loc[TCC_MAX_NB];
   uint m = 0;
+  int big = 0;
   for (uint i = 0; i < n; ++i) {
     __global const int* q = tets + 4 * vt[b + i];
     for (int k = 0; k < 4; ++k) {
       int u = q[k];
       if (u == (int)v) continue;
-      /* insert into the sorted prefix s[0..m) unless present */
+      if (!big) {
+        uint j = m;
+        while (j > 0 && loc[j - 1] > u) --j;
+        if (j > 0 && loc[j - 1] == u) continue;
+        if (m < TCC_MAX_NB) {
+          for (uint k2 = m; k2 > j; --k2) loc[k2] = loc[k2 - 1];
+          loc[j] = u;
+          ++m;
+          continue;
+        }
+        for (uint k2 = 0; k2 < m; ++k2) s[k2] = loc[k2];
+        big = 1;
+      }
       uint j = m;
       while (j > 0 && s[j - 1] > u) --j;
       if (j > 0 && s[j - 1] == u) continue;
@@ -66,6 +86,8 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
       ++m;
     }
   }
+  if (!big)
+    for (uint k2 = 0; k2 < m; ++k2) s[k2] = loc[k2];
   uint up = 0;
   for (uint i = 0; i < m; ++i) up += s[i] > (int)v ? 1u : 0u;
   nb_count[v] = m;
@@ -114,15 +136,62 @@ __kernel void conn_lower_edges(uint nv, __global const uint* nb_off, __global co
   }
 }
 
-/* tet_nbr (see collapse_common.h): for each face, the other tets of ring(first face vertex). */
-__kernel void conn_tet_neighbours(uint nt, __global const int* tets, __global const uint* vt_off,
+#ifndef TCC_MAX_MIN_FACES
+#define TCC_MAX_MIN_FACES 128
+#endif
+
+/* tet_nbr (see collapse_common.h). Each face is matched by its smallest vertex v: the faces of
+ * ring(v) whose other two vertices are both above v are paired in private memory (about 20 per
+ * vertex), O(k^2) per vertex instead of a ring scan per face. A vertex with more such faces
+ * than TCC_MAX_MIN_FACES falls back to the ring scan for its faces. */
+__kernel void conn_tet_neighbours(uint nv, __global const int* tets, __global const uint* vt_off,
                                   __global const int* vt, __global int* tet_nbr) {
-  uint t = get_global_id(0);
-  if (t >= nt) return;
-  for (int f = 0; f < 4; ++f) {
-    int other;
-    int n = tcc_face_others(tets, vt_off, vt, (int)t, f, &other);
-    tet_nbr[4 * t + f] = n == 0 ? -1 : n == 1 ? other : -2;
+  uint v = get_global_id(0);
+  if (v >= nv) return;
+  int ft[TCC_MAX_MIN_FACES];
+  uchar ff[TCC_MAX_MIN_FACES];
+  ulong key[TCC_MAX_MIN_FACES];
+  int k = 0, overflow = 0;
+  for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
+    int t = vt[i];
+    __global const int* q = tets + 4 * t;
+    int lv = tcc_local(tets, t, (int)v);
+    for (int f = 0; f < 4; ++f) {
+      if (f == lv) continue;
+      int u = -1, w = -1, ok = 1;
+      for (int j = 0; j < 4; ++j) {
+        if (j == f || j == lv) continue;
+        if (q[j] < (int)v) ok = 0;
+        if (u < 0) u = q[j];
+        else w = q[j];
+      }
+      if (!ok) continue; /* v is not the smallest vertex of this face */
+      if (k == TCC_MAX_MIN_FACES) {
+        overflow = 1;
+        int other;
+        int n = tcc_face_others(tets, vt_off, vt, t, f, &other);
+        tet_nbr[4 * t + f] = n == 0 ? -1 : n == 1 ? other : -2;
+        continue;
+      }
+      ft[k] = t;
+      ff[k] = (uchar)f;
+      key[k] = u < w ? ((ulong)(uint)u << 32 | (uint)w) : ((ulong)(uint)w << 32 | (uint)u);
+      ++k;
+    }
+  }
+  for (int i = 0; i < k; ++i) {
+    int n = 0, other = -1;
+    for (int j = 0; j < k; ++j)
+      if (j != i && key[j] == key[i]) {
+        if (n == 0) other = ft[j];
+        ++n;
+      }
+    if (overflow) { /* faces beyond the capacity may match this one too */
+      int o2;
+      n = tcc_face_others(tets, vt_off, vt, ft[i], ff[i], &o2);
+      other = o2;
+    }
+    tet_nbr[4 * ft[i] + ff[i]] = n == 0 ? -1 : n == 1 ? other : -2;
   }
 }
 

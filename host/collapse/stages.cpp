@@ -2,6 +2,9 @@
 #include "collapse/stages.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
@@ -34,11 +37,20 @@ const cl::Buffer& B(const DeviceBuffer<T>& b) {
 cl_uint U(size_t v) { return static_cast<cl_uint>(v); }
 cl_int I(int v) { return static_cast<cl_int>(v); }
 
+// TETCOLLAPSE_PROFILE=1 prints the wall time of every kernel launch of the stages on stderr.
+const bool kProfile = std::getenv("TETCOLLAPSE_PROFILE") != nullptr;
+
 void run(Context& ctx, const std::string& file, const char* name, size_t n, const std::string& options,
          const auto&... args) {
   cl::Kernel k = ctx.kernel(file, name, options);
   set_args(k, name, args...);
+  auto t0 = std::chrono::steady_clock::now();
   ctx.launch(k, n, name);
+  if (kProfile) {
+    ctx.finish();
+    std::fprintf(stderr, "  %-28s n=%-9zu %8.4f s\n", name, n,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
 }
 
 // Exclusive scan of counts[0..n) into off[0..n], off[n] = total.
@@ -171,7 +183,7 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   ensure(c.vclass, ctx, nv);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   ensure(c.tet_nbr, ctx, size_t(nt) * 4);
-  run(ctx, F, "conn_tet_neighbours", nt, "", U(nt), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr));
+  run(ctx, F, "conn_tet_neighbours", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr));
   run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
       use_labels, B(c.vflags));
   run(ctx, F, "conn_edge_flags", c.ne, "", U(c.ne), B(c.edges), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr),
