@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
@@ -211,7 +212,9 @@ uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   } else {
     // the user's function between the shared helpers and the kernel (see collapse_cost.cl)
     const std::string src = "#include \"collapse_common.h\"\n" + p.cost_source + "\n#include \"collapse_cost.cl\"\n";
-    cl::Program& prog = ctx.build("user cost (cost_cl_source)", src, "-DTCC_USER_COST");
+    // Context caches programs by (name, options): the name carries a hash of the source
+    const std::string name = "user cost (cost_cl_source " + std::to_string(std::hash<std::string>{}(src)) + ")";
+    cl::Program& prog = ctx.build(name, src, "-DTCC_USER_COST");
     k = detail::cl_call("clCreateKernel(cost_and_mark)", [&] { return cl::Kernel(prog, "cost_and_mark"); });
   }
   const cl_int mask_mode = dm.has_mask ? p.mask_mode : 0;

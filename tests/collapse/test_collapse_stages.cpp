@@ -358,3 +358,34 @@ TEST(CollapseConflicts, FixpointKeepsEdgesWhoseRivalsWereDropped) {
   EXPECT_EQ(pass1, (std::vector<uint32_t>{0, 2, 4}));
   EXPECT_EQ(fin, (std::vector<uint32_t>{0, 4}));
 }
+
+TEST(CollapseCost, UserCostFromOpenCLSource) {
+  // A user cost that ignores length: the mean height of the edge plus the first vertex field.
+  // Exactly the edges with (z0 + z1) / 2 + (f0 + f1) < target must be marked.
+  Context ctx;
+  Mesh m = test::cube_tets(3);
+  Field f{"bump", 1, {}};
+  for (int64_t v = 0; v < m.num_vertices(); ++v) f.values.push_back(m.points[3 * v] > 0.5 ? 1.0 : 0.0);
+  m.vertex_fields.push_back(f);
+  CollapseOptions o;
+  o.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) {\n"
+                     "  return 0.5 * (p0.z + p1.z) + f0 + f1;\n}\n";
+  Staged st(ctx, m, o, 0.4);
+  std::vector<uint32_t> marked = st.s.marked.download_range(0, st.c.ne);
+  int expected_count = 0;
+  for (uint32_t e = 0; e < st.c.ne; ++e) {
+    int32_t a = st.edges[2 * e], b = st.edges[2 * e + 1];
+    double c = 0.5 * (m.points[3 * a + 2] + m.points[3 * b + 2]) + f.values[a] + f.values[b];
+    EXPECT_EQ(marked[e], c < 0.4 ? 1u : 0u) << "edge " << a << "-" << b;
+    expected_count += c < 0.4;
+  }
+  EXPECT_GT(expected_count, 0);
+  // the whole loop runs with it, and a source that does not compile is a DeviceError
+  o.target_length = 0.4;
+  Mesh r = m;
+  CollapseReport rep = collapse(r, o, ctx);
+  EXPECT_LT(rep.tets_out, rep.tets_in);
+  o.cost_cl_source = "double tc_user_cost(double3 p0) { return nonsense; }";
+  Mesh r2 = m;
+  EXPECT_THROW(collapse(r2, o, ctx), DeviceError);
+}
