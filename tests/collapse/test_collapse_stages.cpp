@@ -126,8 +126,9 @@ TEST(CollapseAdmissible, PredicateQByVertexClass) {
   Staged sp(ctx, m, paper, 10.0);
   for (int32_t e = 0; e < t.num_edges(); ++e) {
     int32_t a = t.edges[2 * e], b = t.edges[2 * e + 1];
-    if ((t.vertex_boundary[a] || t.vertex_boundary[b]) && !t.edge_boundary[e])
+    if ((t.vertex_boundary[a] || t.vertex_boundary[b]) && !t.edge_boundary[e]) {
       EXPECT_EQ(sp.reason[sp.edge(a, b)], kRefusedQ);
+    }
   }
 }
 
@@ -151,7 +152,9 @@ TEST(CollapseAdmissible, LinkConditionRefusesCollapseAcrossThinSlab) {
   // and in features mode Q refuses it first
   Staged sf(ctx, m, CollapseOptions{}, 10.0);
   for (int32_t e = 0; e < t.num_edges(); ++e)
-    if (!t.edge_boundary[e]) EXPECT_EQ(sf.reason[sf.edge(t.edges[2 * e], t.edges[2 * e + 1])], kRefusedQ);
+    if (!t.edge_boundary[e]) {
+      EXPECT_EQ(sf.reason[sf.edge(t.edges[2 * e], t.edges[2 * e + 1])], kRefusedQ);
+    }
 }
 
 TEST(CollapseAdmissible, LinkConditionRefusesTunnelClosure) {
@@ -186,7 +189,9 @@ TEST(CollapseAdmissible, LinkConditionRefusesTunnelClosure) {
   int refused = 0, ok = 0;
   for (int32_t e = 0; e < t.num_edges(); ++e) {
     int32_t d = st.edge(t.edges[2 * e], t.edges[2 * e + 1]);
-    if (!t.edge_boundary[e]) EXPECT_EQ(st.reason[d], kRefusedLink);
+    if (!t.edge_boundary[e]) {
+      EXPECT_EQ(st.reason[d], kRefusedLink);
+    }
     refused += st.reason[d] == kRefusedLink;
     ok += st.reason[d] == kOk;
   }
@@ -261,7 +266,9 @@ TEST(CollapseAdmissible, MaterialInterfaceIsProtected) {
     if (with.reason[e] == kOk) {
       int32_t removed = (with.dir[e] & 1) ? b : a;
       int32_t survivor = removed == a ? b : a;
-      if (m.points[3 * removed + 2] == 0.5) EXPECT_EQ(m.points[3 * survivor + 2], 0.5);
+      if (m.points[3 * removed + 2] == 0.5) {
+        EXPECT_EQ(m.points[3 * survivor + 2], 0.5);
+      }
     }
     // an edge from the interface's rim (on the outer boundary too) to an outer-boundary vertex
     // off the plane that is not a boundary edge... simpler: from an interface vertex inside the
