@@ -4,7 +4,8 @@
 #   scripts/fuzz.sh [SECONDS] [HARNESS...]      HARNESS: gmsh medit vtk vtu tetgen (default: all)
 #   SECONDS defaults to 60; each harness runs that long, one after the other
 #   (JOBS=N runs N at a time). Environment: BUILD_DIR, MAX_LEN (default 16384), NICE (default 19),
-#   EXTRA_SEEDS=DIR (extra read-only seeds in DIR/<harness>/, e.g. heads of local meshes).
+#   EXTRA_SEEDS=DIR (extra read-only seeds in DIR/<harness>/, e.g. heads of local meshes),
+#   TC_FUZZ_ROUNDTRIP=1 (also write every accepted mesh and read it back; see fuzz_harness.hpp).
 # Needs clang and libFuzzer: Debian packages clang and libclang-rt-14-dev (clang 14, bookworm).
 # The working corpus grows in BUILD_DIR/corpus/<harness> (seeded from tests/fuzz/seeds/);
 # crashers land in BUILD_DIR/crashes/<harness>/, logs in BUILD_DIR/logs/. To keep a crasher
