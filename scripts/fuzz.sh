@@ -4,6 +4,7 @@
 #   scripts/fuzz.sh [SECONDS] [HARNESS...]      HARNESS: gmsh medit vtk vtu tetgen (default: all)
 #   SECONDS defaults to 60; each harness runs that long, one after the other
 #   (JOBS=N runs N at a time). Environment: BUILD_DIR, MAX_LEN (default 16384), NICE (default 19),
+#   MALLOC_LIMIT_MB (default 256: a larger single allocation is a finding),
 #   EXTRA_SEEDS=DIR (extra read-only seeds in DIR/<harness>/, e.g. heads of local meshes),
 #   TC_FUZZ_ROUNDTRIP=1 (also write every accepted mesh and read it back; see fuzz_harness.hpp).
 # Needs clang and libFuzzer: Debian packages clang and libclang-rt-14-dev (clang 14, bookworm).
@@ -20,6 +21,9 @@ harnesses=("$@")
 jobs=${JOBS:-1}
 max_len=${MAX_LEN:-16384}
 nice_level=${NICE:-19}
+# A single allocation above this from an input of at most MAX_LEN bytes can only come from
+# a count taken on trust; libFuzzer reports it as an out-of-memory finding.
+malloc_limit=${MALLOC_LIMIT_MB:-256}
 
 command -v clang++ >/dev/null || { echo "fuzz: clang++ not found (apt-get install clang libclang-rt-14-dev)" >&2; exit 1; }
 cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
@@ -42,6 +46,7 @@ run() {
   nice -n "$nice_level" "$build/tests/fuzz/fuzz_$h" "$corpus" "${extra[@]}" \
       -fork=1 -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 -print_funcs=0 \
       -dict="$root/tests/fuzz/dicts/$h.dict" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 \
+      -malloc_limit_mb="$malloc_limit" \
       -max_len="$max_len" -artifact_prefix="$crashes" >"$log" 2>&1 || rc=$?
   # Summary: the last status line (executions, coverage, exec/s, oom/timeout/crash counts).
   echo "fuzz: $h: $(grep -E '^#[0-9]+' "$log" | tail -1)"
