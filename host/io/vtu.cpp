@@ -383,15 +383,28 @@ class VtuReader {
     }
     if (total != expected)
       fail_byte(where, what + " holds " + std::to_string(total) + " bytes, expected " + std::to_string(expected));
-    size_t p = 3 * hs + size_t(nblocks) * hs;
+    // Check every block's sizes before allocating anything: the header's sizes are
+    // counts taken from the file, and deflate inflates at most 1032:1, so a block that
+    // claims more than that of its compressed size is refused instead of allocated.
+    constexpr uint64_t kMaxDeflateRatio = 1032;
+    const size_t first = 3 * hs + size_t(nblocks) * hs;
+    for (size_t b = 0, p = first; b < nblocks; ++b) {
+      const uint64_t csize = header_value(bytes, 3 * hs + b * hs);
+      const uint64_t usize = b + 1 == nblocks && last ? last : block;
+      if (csize > bytes.size() - p)
+        fail_byte(where, what + ": compressed block " + std::to_string(b) + " runs past the end of the data");
+      if (usize / kMaxDeflateRatio > csize)
+        fail_byte(where, what + ": compressed block " + std::to_string(b) + " of " + std::to_string(csize) +
+                             " bytes cannot inflate to " + std::to_string(usize) + " bytes");
+      p += size_t(csize);
+    }
+    size_t p = first;
     storage.clear();
     storage.reserve(size_t(expected));
     std::string chunk;
     for (uint64_t b = 0; b < nblocks; ++b) {
       const uint64_t csize = header_value(bytes, 3 * hs + size_t(b) * hs);
       const uint64_t usize = b + 1 == nblocks && last ? last : block;
-      if (csize > bytes.size() - p)
-        fail_byte(where, what + ": compressed block " + std::to_string(b) + " runs past the end of the data");
       if (!io::zlib_inflate(bytes.substr(p, size_t(csize)), chunk, size_t(usize)))
         fail_byte(where, what + ": compressed block " + std::to_string(b) + " is not valid zlib data of " +
                              std::to_string(usize) + " bytes");
