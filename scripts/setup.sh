@@ -2,7 +2,7 @@
 # Installs every Debian package tetcollapse needs to build, test and benchmark.
 # Idempotent: when everything is there it installs nothing and does not touch apt.
 #   scripts/setup.sh              build + test dependencies
-#   scripts/setup.sh --with-tools also the mesh tools used by scripts/ (gmsh, tetgen, matplotlib)
+#   scripts/setup.sh --with-tools also the mesh tools used by scripts/ (gmsh + its Python module, tetgen, matplotlib)
 set -euo pipefail
 
 packages=(
@@ -13,7 +13,7 @@ packages=(
   python3 python3-meshio          # independent reader used by the cross-read tests
 )
 if [[ "${1:-}" == "--with-tools" ]]; then
-  packages+=(gmsh tetgen python3-matplotlib python3-numpy)
+  packages+=(gmsh python3-gmsh tetgen python3-matplotlib python3-numpy)
 fi
 
 missing=()
