@@ -426,7 +426,6 @@ def r_graded(rng, path):
             ents = gmsh.model.getEntities({"point": 0, "curve": 1, "surface": 2}[kind])
             key = {"point": "PointsList", "curve": "CurvesList", "surface": "SurfacesList"}[kind]
             f.setNumbers(2, key, [ents[0][1]])
-            f.setNumber(2, "Sampling", 40)
             f.add("Threshold", 1)
             f.setNumber(1, "InField", 2)
             f.setNumber(1, "SizeMin", fine)
