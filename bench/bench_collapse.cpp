@@ -112,11 +112,12 @@ int main(int argc, char** argv) {
                 median, r.walls.front(), r.walls.back(), runs, rep.seconds_upload, rep.seconds_download);
     std::printf("tets %lld -> %lld, vertices %lld -> %lld, %zu iterations\n", (long long)rep.tets_in,
                 (long long)rep.tets_out, (long long)rep.vertices_in, (long long)rep.vertices_out, rep.iterations.size());
-    std::printf("%4s %9s %9s %9s %9s %9s %9s | %7s %7s %7s %7s %7s %7s %7s\n", "it", "tets", "marked", "admiss",
-                "pass1", "pass2", "collapsed", "conn", "cost", "adm", "p1", "p2", "coll", "total");
+    std::printf("%4s %9s %9s %9s %9s %9s %9s %9s | %7s %7s %7s %7s %7s %7s %7s\n", "it", "tets", "marked", "passedQ",
+                "tested", "pass1", "pass2", "collapsed", "conn", "cost", "adm+p1", "p1", "p2", "coll", "total");
     for (const auto& s : rep.iterations)
-      std::printf("%4d %9lld %9lld %9lld %9lld %9lld %9lld | %7.4f %7.4f %7.4f %7.4f %7.4f %7.4f %7.4f\n", s.iteration,
-                  (long long)s.tets, (long long)s.marked, (long long)s.admissible, (long long)s.after_pass1,
+      std::printf("%4d %9lld %9lld %9lld %9lld %9lld %9lld %9lld | %7.4f %7.4f %7.4f %7.4f %7.4f %7.4f %7.4f\n",
+                  s.iteration, (long long)s.tets, (long long)s.marked, (long long)s.passed_q, (long long)s.tested,
+                  (long long)s.after_pass1,
                   (long long)s.after_pass2, (long long)s.collapsed, s.seconds_connectivity, s.seconds_cost,
                   s.seconds_admissible, s.seconds_pass1, s.seconds_pass2, s.seconds_collapse, s.seconds_total);
     std::printf("stage totals:");

@@ -59,31 +59,13 @@ inline int tcc_predicate_q(int a, int b, uint fa, uint fb, uint fe, int ca, int 
   return ca > cb ? keep_a : keep_b;
 }
 
-__kernel void admissible(uint ne, __global const int* edges, __global const uint* marked, __global const int* tets,
-                         __global const uint* vt_off, __global const int* vt, __global const uint* nb_off,
-                         __global const int* nb, __global const int* nb_edge, __global const int* labels,
-                         int use_labels, __global const double* pts, __global const uchar* vflags,
-                         __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
-                         double eps_v, __global uint* adm, __global uchar* edge_dir, __global uchar* reason,
-                         __global uint* counters) {
-  uint e = get_global_id(0);
-  if (e >= ne) return;
-  adm[e] = 0u;
-  edge_dir[e] = 0;
-  if (!marked[e]) {
-    reason[e] = TCC_NOT_MARKED;
-    return;
-  }
-  int a = edges[2 * e], b = edges[2 * e + 1];
-  uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
-
-  /* --- Q --- */
-  int dir = tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule);
-  if (dir < 0) {
-    reason[e] = TCC_REFUSED_Q;
-    return;
-  }
-
+/* The link condition and the volume test of the edge (a, b), a < b, which passed Q with the
+ * direction bits dir; returns TCC_OK or the refusal (TCC_REFUSED_LINK / TCC_REFUSED_VOLUME). */
+inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int dir, __global const int* tets,
+                                 __global const uint* vt_off, __global const int* vt, __global const uint* nb_off,
+                                 __global const int* nb, __global const int* nb_edge, __global const int* labels,
+                                 int use_labels, __global const double* pts, __global const uchar* vflags,
+                                 __global const uchar* eflags, double eps_v) {
   /* --- link condition --- */
   int cn[TCC_MAX_LINK], pc[TCC_MAX_LINK], pd[TCC_MAX_LINK];
   int ncn = 0, np = 0;
@@ -94,10 +76,7 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
       if (x < y) ++i;
       else if (y < x) ++j;
       else {
-        if (ncn == TCC_MAX_LINK) {
-          reason[e] = TCC_REFUSED_LINK;
-          return;
-        }
+        if (ncn == TCC_MAX_LINK) return TCC_REFUSED_LINK;
         cn[ncn++] = x;
         ++i;
         ++j;
@@ -107,10 +86,7 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
   for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
     int t = vt[i];
     if (!tcc_has(tets, t, b)) continue;
-    if (np == TCC_MAX_LINK) {
-      reason[e] = TCC_REFUSED_LINK;
-      return;
-    }
+    if (np == TCC_MAX_LINK) return TCC_REFUSED_LINK;
     __global const int* q = tets + 4 * t;
     int o[2], no = 0;
     for (int k = 0; k < 4; ++k)
@@ -166,10 +142,7 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
         ok = 0;
     }
   }
-  if (!ok) {
-    reason[e] = TCC_REFUSED_LINK;
-    return;
-  }
+  if (!ok) return TCC_REFUSED_LINK;
 
   /* --- volumes after the tentative collapse --- */
   double3 p = tcc_placement(pts, a, b, (uint)dir);
@@ -184,14 +157,126 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
       __global const int* q = tets + 4 * t;
       double3 c[4];
       for (int k = 0; k < 4; ++k) c[k] = q[k] == x ? p : tc_point(pts, q[k]);
-      if (!(tc_tet_volume(c[0], c[1], c[2], c[3]) >= eps_v)) {
-        reason[e] = TCC_REFUSED_VOLUME;
-        return;
-      }
+      if (!(tc_tet_volume(c[0], c[1], c[2], c[3]) >= eps_v)) return TCC_REFUSED_VOLUME;
     }
   }
+  return TCC_OK;
+}
+
+__kernel void admissible(uint ne, __global const int* edges, __global const uint* marked, __global const int* tets,
+                         __global const uint* vt_off, __global const int* vt, __global const uint* nb_off,
+                         __global const int* nb, __global const int* nb_edge, __global const int* labels,
+                         int use_labels, __global const double* pts, __global const uchar* vflags,
+                         __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
+                         double eps_v, __global uint* adm, __global uchar* edge_dir, __global uchar* reason,
+                         __global uint* counters) {
+  uint e = get_global_id(0);
+  if (e >= ne) return;
+  adm[e] = 0u;
+  edge_dir[e] = 0;
+  if (!marked[e]) {
+    reason[e] = TCC_NOT_MARKED;
+    return;
+  }
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
+  int dir = tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule);
+  if (dir < 0) {
+    reason[e] = TCC_REFUSED_Q;
+    return;
+  }
+  uchar r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, nb_off, nb, nb_edge, labels, use_labels, pts,
+                                vflags, eflags, eps_v);
+  reason[e] = r;
+  if (r != TCC_OK) return;
   adm[e] = 1u;
   edge_dir[e] = (uchar)dir;
-  reason[e] = TCC_OK;
   atomic_inc(&counters[1]);
+}
+
+/* --- Lazy admissible filter fused with conflict pass 1 ---
+ *
+ * Pass 1 keeps an admissible edge when every admissible edge before it in (cost, index) order
+ * that shares a vertex with it is dropped. Whether a cheaper rival is admissible matters only
+ * while that rival is undecided, so the expensive link and volume tests run only on edges all
+ * of whose cheaper candidate rivals are already decided: such an edge is IN when it passes the
+ * tests, OUT (refused) otherwise; an edge with a cheaper IN rival is OUT without a test. The
+ * fixpoint is the same as testing every marked edge and then running conflict pass 1 (the
+ * test result of an edge is never looked at before its own turn), at the cost of testing only
+ * the edges whose turn comes: the winners and the refused edges that would have won.
+ * States as in collapse_conflict.cl; counters[1] admissible (tested and passed), counters[4]
+ * tested, counters[5] passed Q. */
+
+/* Q for every edge: candidates (marked, passing Q) are UNDECIDED with cand[e] = 1. */
+__kernel void lazy_init(uint ne, __global const int* edges, __global const uint* marked, __global const uchar* vflags,
+                        __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
+                        __global uchar* state, __global uchar* edge_dir, __global uchar* reason, __global uint* cand,
+                        __global uint* counters) {
+  uint e = get_global_id(0);
+  if (e >= ne) return;
+  edge_dir[e] = 0;
+  cand[e] = 0u;
+  state[e] = TCC_OUT;
+  if (!marked[e]) {
+    reason[e] = TCC_NOT_MARKED;
+    return;
+  }
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  if (tcc_predicate_q(a, b, vflags[a], vflags[b], eflags[e], vclass[a], vclass[b], mode, paper_rule) < 0) {
+    reason[e] = TCC_REFUSED_Q;
+    return;
+  }
+  reason[e] = TCC_UNTESTED;
+  state[e] = TCC_UNDECIDED;
+  cand[e] = 1u;
+  atomic_inc(&counters[5]);
+}
+
+/* One round over the undecided candidates list[0..n); those still waiting for a cheaper rival
+ * are appended to next (the order of that list does not matter: every decision depends only
+ * on final decisions of cheaper edges). */
+__kernel void lazy_pass1_round(uint n, __global const uint* list, __global uint* next, __global uint* next_n,
+                               __global const int* edges, __global const double* cost, __global const int* tets,
+                               __global const uint* vt_off, __global const int* vt, __global const uint* nb_off,
+                               __global const int* nb, __global const int* nb_edge, __global const int* labels,
+                               int use_labels, __global const double* pts, __global const uchar* vflags,
+                               __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
+                               double eps_v, __global uchar* state, __global uchar* edge_dir,
+                               __global uchar* reason, __global uint* counters) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  int e = (int)list[i];
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  int pending = 0;
+  for (int s = 0; s < 2; ++s) {
+    int x = s == 0 ? a : b;
+    for (uint k = nb_off[x]; k < nb_off[x + 1]; ++k) {
+      int f = nb_edge[k];
+      if (f == e) continue;
+      uchar sf = state[f];
+      if (sf == TCC_OUT || !tcc_before(cost, f, e)) continue;
+      if (sf == TCC_IN) {
+        state[e] = TCC_OUT; /* reason stays TCC_UNTESTED */
+        return;
+      }
+      pending = 1;
+    }
+  }
+  if (pending) {
+    next[atomic_inc(next_n)] = (uint)e;
+    return;
+  }
+  uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
+  int dir = tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule);
+  uchar r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, nb_off, nb, nb_edge, labels, use_labels, pts,
+                                vflags, eflags, eps_v);
+  atomic_inc(&counters[4]);
+  reason[e] = r;
+  if (r == TCC_OK) {
+    edge_dir[e] = (uchar)dir;
+    atomic_inc(&counters[1]);
+    state[e] = TCC_IN;
+  } else {
+    state[e] = TCC_OUT;
+  }
 }

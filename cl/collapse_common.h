@@ -36,6 +36,12 @@
 #define TCC_REFUSED_Q 2
 #define TCC_REFUSED_LINK 3
 #define TCC_REFUSED_VOLUME 4
+#define TCC_UNTESTED 5 /* lazy filter: marked, passed Q, never tested (a cheaper rival won) */
+
+/* Per-edge states of the conflict passes and of the lazy admissible filter. */
+#define TCC_UNDECIDED 0
+#define TCC_IN 1
+#define TCC_OUT 2
 
 /* Does tet t contain vertex x? */
 inline int tcc_has(__global const int* tets, int t, int x) {

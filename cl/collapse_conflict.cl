@@ -12,9 +12,6 @@
  * States: 0 undecided, 1 IN, 2 OUT (state[] per edge, uchar). */
 #include "collapse_common.h"
 
-#define TCC_UNDECIDED 0
-#define TCC_IN 1
-#define TCC_OUT 2
 
 /* Initial states: admissible edges undecided, others out. */
 __kernel void conflict_init(uint ne, __global const uint* adm, __global uchar* state) {
@@ -23,30 +20,34 @@ __kernel void conflict_init(uint ne, __global const uint* adm, __global uchar* s
   state[e] = adm[e] ? TCC_UNDECIDED : TCC_OUT;
 }
 
-/* One round of pass 1; changes[0] counts the edges decided in this round. */
-__kernel void conflict_pass1_round(uint ne, __global const int* edges, __global const double* cost,
+/* The rounds run over a worklist: list[0..n) holds the undecided candidates; those still
+ * waiting for a cheaper rival are appended to next (via the counter next_n). The order of the
+ * worklist does not matter, since a decision depends only on final decisions of cheaper edges.
+ *
+ * One round of pass 1. */
+__kernel void conflict_pass1_round(uint n, __global const uint* list, __global uint* next, __global uint* next_n,
+                                   __global const int* edges, __global const double* cost,
                                    __global const uint* nb_off, __global const int* nb_edge,
-                                   __global uchar* state, __global uint* changes) {
-  uint e = get_global_id(0);
-  if (e >= ne || state[e] != TCC_UNDECIDED) return;
+                                   __global uchar* state) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  int e = (int)list[i];
   int ends[2] = {edges[2 * e], edges[2 * e + 1]};
   int pending = 0;
   for (int s = 0; s < 2; ++s)
-    for (uint i = nb_off[ends[s]]; i < nb_off[ends[s] + 1]; ++i) {
-      int f = nb_edge[i];
-      if (f == (int)e || !tcc_before(cost, f, (int)e)) continue;
+    for (uint k = nb_off[ends[s]]; k < nb_off[ends[s] + 1]; ++k) {
+      int f = nb_edge[k];
+      if (f == e) continue;
       uchar sf = state[f];
+      if (sf == TCC_OUT || !tcc_before(cost, f, e)) continue;
       if (sf == TCC_IN) {
         state[e] = TCC_OUT;
-        atomic_inc(changes);
         return;
       }
-      if (sf == TCC_UNDECIDED) pending = 1;
+      pending = 1;
     }
-  if (!pending) {
-    state[e] = TCC_IN;
-    atomic_inc(changes);
-  }
+  if (pending) next[atomic_inc(next_n)] = (uint)e;
+  else state[e] = TCC_IN;
 }
 
 /* After pass 1: p1 flags, vaff (vertAffectedByEdge) of both end points of IN edges, counters[2]. */
@@ -72,33 +73,33 @@ __kernel void conflict_pass2_init(uint ne, __global const uint* p1, __global uch
 
 /* One round of pass 2 over the pass-1 edges: the rivals of e = (a, b) are the pass-1 edges
  * recorded (vaff) at the vertices of the tets of ring(a) and ring(b). */
-__kernel void conflict_pass2_round(uint ne, __global const int* edges, __global const double* cost,
+__kernel void conflict_pass2_round(uint n, __global const uint* list, __global uint* next, __global uint* next_n,
+                                   __global const int* edges, __global const double* cost,
                                    __global const int* tets, __global const uint* vt_off, __global const int* vt,
-                                   __global const int* vaff, __global uchar* state, __global uint* changes) {
-  uint e = get_global_id(0);
-  if (e >= ne || state[e] != TCC_UNDECIDED) return;
+                                   __global const int* vaff, __global uchar* state) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  int e = (int)list[i];
   int pending = 0;
   for (int s = 0; s < 2; ++s) {
     int x = edges[2 * e + s];
-    for (uint i = vt_off[x]; i < vt_off[x + 1]; ++i) {
-      __global const int* q = tets + 4 * vt[i];
+    for (uint j = vt_off[x]; j < vt_off[x + 1]; ++j) {
+      __global const int* q = tets + 4 * vt[j];
       for (int k = 0; k < 4; ++k) {
         int f = vaff[q[k]];
-        if (f < 0 || f == (int)e || !tcc_before(cost, f, (int)e)) continue;
+        if (f < 0 || f == e) continue;
         uchar sf = state[f];
+        if (sf == TCC_OUT || !tcc_before(cost, f, e)) continue;
         if (sf == TCC_IN) {
           state[e] = TCC_OUT;
-          atomic_inc(changes);
           return;
         }
-        if (sf == TCC_UNDECIDED) pending = 1;
+        pending = 1;
       }
     }
   }
-  if (!pending) {
-    state[e] = TCC_IN;
-    atomic_inc(changes);
-  }
+  if (pending) next[atomic_inc(next_n)] = (uint)e;
+  else state[e] = TCC_IN;
 }
 
 /* fin = IN after pass 2; the vertices of dropped pass-1 edges are released. */

@@ -202,7 +202,7 @@ uint32_t counter(EdgeState& s, int i) {
 }  // namespace
 
 uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p) {
-  ensure(s.counters, ctx, 4);
+  ensure(s.counters, ctx, 6);
   s.counters.fill(0);
   ensure(s.cost, ctx, c.ne);
   ensure(s.marked, ctx, c.ne);
@@ -237,16 +237,35 @@ uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
 }
 
 namespace {
-// Runs `round` until a round decides nothing more (every candidate is then decided: the
-// undecided candidate of smallest (cost, index) always decides).
-void until_fixpoint(Context& ctx, cl::Kernel& round, DeviceBuffer<uint32_t>& changes, size_t n, const char* what) {
-  for (;;) {
-    changes.fill(0);
+// Runs `round` (arguments 0..3: n, list, next, next_n; the rest already set) over the worklist
+// s.work[0][0..n) until no candidate is left undecided. Every round decides at least the
+// undecided candidate of smallest (cost, index), so this terminates.
+void worklist_rounds(Context& ctx, cl::Kernel& round, EdgeState& s, uint32_t n, const char* what) {
+  ensure(s.work_n, ctx, 1);
+  int cur = 0;
+  while (n > 0) {
+    ensure(s.work[1 - cur], ctx, n);
+    s.work_n.fill(0);
+    set_args(round, what, U(n), B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n));
+    auto t0 = std::chrono::steady_clock::now();
     ctx.launch(round, n, what);
-    uint32_t c = 0;
-    changes.download(&c, 1);
-    if (c == 0) break;
+    uint32_t next = 0;
+    s.work_n.download(&next, 1);
+    if (kProfile)
+      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s\n", what, n,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    n = next;
+    cur = 1 - cur;
   }
+}
+
+// Sets the round kernel's arguments from index 4 on.
+template <class... A>
+void set_args_from4(cl::Kernel& k, const char* what, const A&... a) {
+  detail::cl_call(what, [&] {
+    cl_uint i = 4;
+    (k.setArg(i++, a), ...);
+  });
 }
 }  // namespace
 
@@ -254,26 +273,58 @@ uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
   const std::string F = "collapse_conflict.cl";
   ensure(s.p1, ctx, c.ne);
   ensure(s.state, ctx, c.ne);
-  ensure(s.changes, ctx, 1);
   ensure(s.vaff, ctx, dm.nv);
   s.vaff.fill(-1);
   run(ctx, F, "conflict_init", c.ne, "", U(c.ne), B(s.adm), B(s.state));
+  ensure(s.work[0], ctx, c.ne);
+  const uint32_t n = dev::compact_indices(ctx, s.adm, s.work[0], c.ne);
   cl::Kernel round = ctx.kernel(F, "conflict_pass1_round");
-  set_args(round, "conflict_pass1_round", U(c.ne), B(c.edges), B(s.cost), B(c.nb_off), B(c.nb_edge), B(s.state),
-           B(s.changes));
-  until_fixpoint(ctx, round, s.changes, c.ne, "conflict_pass1_round");
+  set_args_from4(round, "conflict_pass1_round", B(c.edges), B(s.cost), B(c.nb_off), B(c.nb_edge), B(s.state));
+  worklist_rounds(ctx, round, s, n, "conflict_pass1_round");
   run(ctx, F, "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1), B(s.vaff), B(s.counters));
   return counter(s, 2);
+}
+
+uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                               uint32_t& passed_q, uint32_t& tested) {
+  const std::string A = "collapse_admissible.cl";
+  ensure(s.dir, ctx, c.ne);
+  ensure(s.reason, ctx, c.ne);
+  ensure(s.cand, ctx, c.ne);
+  ensure(s.p1, ctx, c.ne);
+  ensure(s.state, ctx, c.ne);
+  ensure(s.vaff, ctx, dm.nv);
+  s.vaff.fill(-1);
+  const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
+  const cl_int mode = p.mode, paper_rule = p.paper_rule ? 1 : 0;
+  run(ctx, A, "lazy_init", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(c.vflags), B(c.vclass), B(c.eflags), mode,
+      paper_rule, B(s.state), B(s.dir), B(s.reason), B(s.cand), B(s.counters));
+  ensure(s.work[0], ctx, c.ne);
+  const uint32_t n = dev::compact_indices(ctx, s.cand, s.work[0], c.ne);
+  cl::Kernel round = ctx.kernel(A, "lazy_pass1_round");
+  set_args_from4(round, "lazy_pass1_round", B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt), B(c.nb_off),
+                 B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass),
+                 B(c.eflags), mode, paper_rule, p.eps_v, B(s.state), B(s.dir), B(s.reason), B(s.counters));
+  worklist_rounds(ctx, round, s, n, "lazy_pass1_round");
+  run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1),
+      B(s.vaff), B(s.counters));
+  uint32_t cnt[6];
+  s.counters.download(cnt, 6);
+  passed_q = cnt[5];
+  tested = cnt[4];
+  return cnt[2];
 }
 
 uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
   const std::string F = "collapse_conflict.cl";
   ensure(s.fin, ctx, c.ne);
   run(ctx, F, "conflict_pass2_init", c.ne, "", U(c.ne), B(s.p1), B(s.state));
+  ensure(s.work[0], ctx, c.ne);
+  const uint32_t n = dev::compact_indices(ctx, s.p1, s.work[0], c.ne);
   cl::Kernel round = ctx.kernel(F, "conflict_pass2_round");
-  set_args(round, "conflict_pass2_round", U(c.ne), B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt),
-           B(s.vaff), B(s.state), B(s.changes));
-  until_fixpoint(ctx, round, s.changes, c.ne, "conflict_pass2_round");
+  set_args_from4(round, "conflict_pass2_round", B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt), B(s.vaff),
+                 B(s.state));
+  worklist_rounds(ctx, round, s, n, "conflict_pass2_round");
   run(ctx, F, "conflict_finalize", c.ne, "", U(c.ne), B(c.edges), B(s.p1), B(s.state), B(s.fin), B(s.vaff),
       B(s.counters));
   return counter(s, 3);

@@ -47,13 +47,19 @@ struct EdgeState {
   DeviceBuffer<double> cost;
   DeviceBuffer<uint32_t> marked, adm, p1, fin;
   DeviceBuffer<uint8_t> state;      // conflict passes: 0 undecided, 1 in, 2 out
-  DeviceBuffer<uint32_t> changes;   // decisions taken in a round
+  DeviceBuffer<uint32_t> cand;      // lazy filter: marked and passing Q
+  DeviceBuffer<uint32_t> work[2];   // worklists of the conflict rounds
+  DeviceBuffer<uint32_t> work_n;    // length of the next worklist
   DeviceBuffer<uint8_t> dir, reason;
   DeviceBuffer<int32_t> vaff;       // per vertex
-  DeviceBuffer<uint32_t> counters;  // marked, admissible, pass1, pass2
+  // marked, admissible, pass1, pass2, tested (lazy), passed Q (lazy)
+  DeviceBuffer<uint32_t> counters;
 };
 
-enum Reason : uint8_t { kOk = 0, kNotMarked = 1, kRefusedQ = 2, kRefusedLink = 3, kRefusedVolume = 4 };
+enum Reason : uint8_t {
+  kOk = 0, kNotMarked = 1, kRefusedQ = 2, kRefusedLink = 3, kRefusedVolume = 4,
+  kUntested = 5  // lazy filter: passed Q, never tested because a cheaper rival won
+};
 
 struct StageParams {
   int mode = 1;  // 0 strict, 1 features, 2 free
@@ -71,8 +77,15 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
 void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const StageParams& p);
 // Returns the number of marked edges.
 uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p);
+// Tests every marked edge (adm, dir, reason); returns the number of admissible edges.
 uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p);
+// Conflict pass 1 over the admissible edges (s.adm); returns the number kept.
 uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
+// admissible() followed by conflict_pass1() with the same result (p1, vaff, dir of the kept
+// edges), testing only the edges whose turn comes (cl/collapse_admissible.cl). Returns the
+// number kept; passed_q and tested receive the number of marked edges passing Q and tested.
+uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                               uint32_t& passed_q, uint32_t& tested);
 uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
 // Applies the final collapses: dm becomes the new mesh (via `next`, swapped in); origin (input
 // vertex -> current vertex) is updated when non-empty.

@@ -7,7 +7,8 @@
 //
 // One iteration = connectivity of the current mesh (rebuilt on the device without global
 // sorts), cost and marking, the admissible filter (predicate Q, link condition, volumes),
-// conflict pass 1 over edges, conflict pass 2 over tets, collapse + compaction. Iterations stop
+// conflict pass 1 over edges (the two fused: an edge is tested only when its turn comes),
+// conflict pass 2 over tets, collapse + compaction. Iterations stop
 // when one collapses fewer than max(eps_c, 1) edges or after max_iterations.
 //
 // Boundary and material interfaces. The feature surface S is the outer boundary plus, when the
@@ -47,12 +48,18 @@ struct IterationStats {
   int iteration = 0;              // 0-based
   int64_t vertices = 0, tets = 0, edges = 0;  // of the mesh this iteration started from
   int64_t marked = 0;             // cost < target (and in the mask)
-  int64_t admissible = 0;         // passed Q, the link condition and the volume test
+  // The admissible filter is lazy (it runs inside conflict pass 1): Q is evaluated on every
+  // marked edge, but the link condition and the volume test only on the edges whose cheaper
+  // rivals are all decided, which gives the same pass-1 result as testing every edge.
+  int64_t passed_q = 0;           // marked edges passing the predicate Q
+  int64_t tested = 0;             // of those, link condition and volume test evaluated
+  int64_t admissible = 0;         // tested and passed (= after_pass1 with the lazy filter)
   int64_t after_pass1 = 0;        // survived conflict pass 1 (edges)
   int64_t after_pass2 = 0;        // survived conflict pass 2 (tets) = collapsed
   int64_t collapsed = 0;
   int64_t tets_after = 0, vertices_after = 0;
-  // Seconds per stage (wall time, the queue finished after each stage).
+  // Seconds per stage (wall time, the queue finished after each stage). seconds_admissible
+  // holds the lazy filter together with conflict pass 1; seconds_pass1 is then 0.
   double seconds_connectivity = 0, seconds_cost = 0, seconds_admissible = 0, seconds_pass1 = 0,
          seconds_pass2 = 0, seconds_collapse = 0, seconds_total = 0;
 };

@@ -7,6 +7,7 @@
 
 #include "collapse/stages.hpp"
 #include "geometry.h"
+#include "tetcollapse/io.hpp"
 #include "tetcollapse/topology.hpp"
 #include "test_support.hpp"
 
@@ -364,6 +365,84 @@ TEST(CollapseConflicts, FixpointKeepsEdgesWhoseRivalsWereDropped) {
   auto [pass1, fin] = conflicts(ctx, m, es, {1, 2, 3, 4, 5, 6});
   EXPECT_EQ(pass1, (std::vector<uint32_t>{0, 2, 4}));
   EXPECT_EQ(fin, (std::vector<uint32_t>{0, 4}));
+}
+
+namespace {
+
+// The lazy filter (lazy_admissible_pass1) against admissible() + conflict_pass1(): the same
+// pass-1 edges, directions, vaff, and the same pass-2 result; and it tests fewer edges.
+void expect_lazy_equals_full(Context& ctx, const Mesh& m, const CollapseOptions& o, double target) {
+  StageParams p = params_from(o);
+  p.target = target;
+  DeviceMesh dm;
+  Connectivity c;
+  EdgeState full, lazy;
+  upload_mesh(ctx, m, o, dm);
+  build_connectivity(ctx, dm, c, p);
+  const uint32_t marked = cost_and_mark(ctx, dm, c, full, p);
+  const uint32_t n_adm = admissible(ctx, dm, c, full, p);
+  const uint32_t n1 = conflict_pass1(ctx, dm, c, full);
+  const std::vector<int32_t> vaff_full = full.vaff.download_range(0, dm.nv);
+  const uint32_t n2 = conflict_pass2(ctx, dm, c, full);
+  EXPECT_EQ(cost_and_mark(ctx, dm, c, lazy, p), marked);
+  uint32_t passed_q = 0, tested = 0;
+  EXPECT_EQ(lazy_admissible_pass1(ctx, dm, c, lazy, p, passed_q, tested), n1);
+  const std::vector<uint8_t> reason = full.reason.download_range(0, c.ne);
+  uint32_t q_ok = 0;
+  for (uint8_t r : reason) q_ok += r != kNotMarked && r != kRefusedQ;
+  EXPECT_EQ(passed_q, q_ok);
+  EXPECT_LE(tested, passed_q);
+  EXPECT_GE(tested, n1);
+  const std::vector<uint32_t> p1_full = full.p1.download_range(0, c.ne), p1_lazy = lazy.p1.download_range(0, c.ne);
+  EXPECT_EQ(p1_lazy, p1_full);
+  const std::vector<uint8_t> dir_full = full.dir.download_range(0, c.ne), dir_lazy = lazy.dir.download_range(0, c.ne);
+  const std::vector<uint8_t> reason_lazy = lazy.reason.download_range(0, c.ne);
+  int mismatched_dir = 0, mismatched_reason = 0;
+  for (uint32_t e = 0; e < c.ne; ++e) {
+    if (p1_full[e] && dir_full[e] != dir_lazy[e]) ++mismatched_dir;
+    // a tested edge gets the verdict admissible() gives it
+    if (reason_lazy[e] != kUntested && reason_lazy[e] != reason[e]) ++mismatched_reason;
+  }
+  EXPECT_EQ(mismatched_dir, 0);
+  EXPECT_EQ(mismatched_reason, 0);
+  EXPECT_EQ(lazy.vaff.download_range(0, dm.nv), vaff_full);
+  EXPECT_EQ(conflict_pass2(ctx, dm, c, lazy), n2);
+  EXPECT_EQ(lazy.fin.download_range(0, c.ne), full.fin.download_range(0, c.ne));
+  std::printf("marked %u, passed Q %u, admissible %u, tested lazily %u, pass 1 %u, pass 2 %u\n", marked, passed_q,
+              n_adm, tested, n1, n2);
+  EXPECT_GT(n1, 0u);
+}
+
+}  // namespace
+
+TEST(CollapseLazyFilter, SameAsTestingEveryEdgeOnCube) {
+  Context ctx;
+  Mesh m = test::cube_tets(6);  // many equal lengths: the index breaks the ties
+  const double h = 1.0 / 6;
+  for (auto mode : {CollapseOptions::Features, CollapseOptions::Strict, CollapseOptions::Free}) {
+    SCOPED_TRACE(int(mode));
+    CollapseOptions o;
+    o.boundary = mode;
+    expect_lazy_equals_full(ctx, m, o, 2 * h);
+    o.paper_boundary_rule = true;
+    expect_lazy_equals_full(ctx, m, o, 2 * h);
+  }
+}
+
+TEST(CollapseLazyFilter, SameAsTestingEveryEdgeOnSharedMesh) {
+  TC_SKIP_IF_NO_SHARED();
+  Context ctx;
+  for (const char* name : {"polyfem_bimetal.msh", "libigl_octopus-low.mesh"}) {
+    std::string path = test::shared_mesh(name);
+    if (path.empty()) {
+      std::printf("skipping %s: absent\n", name);
+      continue;
+    }
+    SCOPED_TRACE(name);
+    Mesh m = read_mesh(path);
+    CollapseOptions o;
+    expect_lazy_equals_full(ctx, m, o, 2 * median_edge_length(m));
+  }
 }
 
 TEST(CollapseCost, UserCostFromOpenCLSource) {
