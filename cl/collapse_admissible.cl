@@ -232,38 +232,29 @@ __kernel void lazy_init(uint ne, __global const int* edges, __global const uint*
   atomic_inc(&counters[5]);
 }
 
-/* One round over the undecided candidates list[0..n); those still waiting for a cheaper rival
- * are appended to next (the order of that list does not matter: every decision depends only
- * on final decisions of cheaper edges). */
-__kernel void lazy_pass1_round(uint n, __global const uint* list, __global uint* next, __global uint* next_n,
-                               __global const int* edges, __global const double* cost, __global const int* tets,
-                               __global const uint* vt_off, __global const int* vt, __global const uint* nb_off,
-                               __global const int* nb, __global const int* nb_edge, __global const int* labels,
-                               int use_labels, __global const double* pts, __global const uchar* vflags,
-                               __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
-                               double eps_v, __global uchar* state, __global uchar* edge_dir,
-                               __global uchar* reason, __global uint* counters) {
+/* One round over the undecided candidates (worklists as in collapse_conflict.cl). */
+__kernel void lazy_pass1_round(uint n, int first, __global const uint* list, __global uint* next,
+                               __global uint* next_n, __global const uint* cand, __global uint* rivals,
+                               __global uint* rcount, __global const int* edges, __global const double* cost,
+                               __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                               __global const uint* nb_off, __global const int* nb, __global const int* nb_edge,
+                               __global const int* labels, int use_labels, __global const double* pts,
+                               __global const uchar* vflags, __global const uchar* vclass,
+                               __global const uchar* eflags, int mode, int paper_rule, double eps_v,
+                               __global uchar* state, __global uchar* edge_dir, __global uchar* reason,
+                               __global uint* counters) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  int e = (int)list[i];
+  uint c = first ? i : list[i];
+  int e = (int)cand[c];
   int a = edges[2 * e], b = edges[2 * e + 1];
-  int pending = 0;
-  for (int s = 0; s < 2; ++s) {
-    int x = s == 0 ? a : b;
-    for (uint k = nb_off[x]; k < nb_off[x + 1]; ++k) {
-      int f = nb_edge[k];
-      if (f == e) continue;
-      uchar sf = state[f];
-      if (sf == TCC_OUT || !tcc_before(cost, f, e)) continue;
-      if (sf == TCC_IN) {
-        state[e] = TCC_OUT; /* reason stays TCC_UNTESTED */
-        return;
-      }
-      pending = 1;
-    }
+  int w = tcc_pass1_wait(e, a, b, nb_off, nb_edge, cost, state, rivals + c * TCC_RIVALS, rcount + c);
+  if (w < 0) {
+    state[e] = TCC_OUT; /* reason stays TCC_UNTESTED */
+    return;
   }
-  if (pending) {
-    next[atomic_inc(next_n)] = (uint)e;
+  if (w > 0) {
+    next[atomic_inc(next_n)] = c;
     return;
   }
   uint fa = vflags[a], fb = vflags[b], fe = eflags[e];

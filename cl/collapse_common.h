@@ -158,10 +158,90 @@ inline double3 tcc_placement(__global const double* pts, int v0, int v1, uint di
   return (dir & TCC_DIR_REMOVE_V1) ? p0 : p1;
 }
 
+/* Worklists of the conflict rounds (collapse_conflict.cl, collapse_admissible.cl): slot c of
+ * the candidate list cand[] keeps, after its first visit, the cheaper rivals that were still
+ * undecided (at most TCC_RIVALS, in rivals[c TCC_RIVALS ..]; their count in rcount[c]), so a
+ * later visit looks only at those and drops the ones decided OUT meanwhile. rcount[c] is
+ * TCC_UNSCANNED before the first visit and TCC_RIVALS + 1 when they did not fit (every visit
+ * then scans all rivals). */
+#define TCC_RIVALS 16
+#define TCC_UNSCANNED 0xffffffffu
+
+/* Waiting test over the stored rivals: -1 when one is IN, 1 while some are undecided, 0 when
+ * all are OUT. Keeps only the undecided ones. */
+inline int tcc_stored_rivals(__global uint* rv, __global uint* rcount, __global const uchar* state) {
+  uint n = *rcount, m = 0;
+  for (uint j = 0; j < n; ++j) {
+    uint f = rv[j];
+    uchar sf = state[f];
+    if (sf == TCC_IN) return -1;
+    if (sf == TCC_UNDECIDED) rv[m++] = f;
+  }
+  *rcount = m;
+  return m > 0 ? 1 : 0;
+}
+
+/* Records rival f (undecided, before e) at the first visit; m counts the distinct ones. */
+inline void tcc_store_rival(__global uint* rv, uint* m, uint f) {
+  uint n = *m < TCC_RIVALS ? *m : TCC_RIVALS;
+  for (uint j = 0; j < n; ++j)
+    if (rv[j] == f) return;
+  if (*m < TCC_RIVALS) rv[*m] = f;
+  ++*m;
+}
+
 /* (cost, index) order used by both conflict passes. */
 inline int tcc_before(__global const double* cost, int f, int e) {
   double cf = cost[f], ce = cost[e];
   return cf < ce || (cf == ce && f < e);
+}
+
+/* Pass-1 rivals of e = (a, b): the candidate edges at a or b before e. Returns as
+ * tcc_stored_rivals; the first visit (and every visit after an overflow) scans N(a) and N(b). */
+inline int tcc_pass1_wait(int e, int a, int b, __global const uint* nb_off, __global const int* nb_edge,
+                          __global const double* cost, __global const uchar* state, __global uint* rv,
+                          __global uint* rcount) {
+  if (*rcount <= TCC_RIVALS) return tcc_stored_rivals(rv, rcount, state);
+  uint m = 0;
+  for (int s = 0; s < 2; ++s) {
+    int x = s == 0 ? a : b;
+    for (uint k = nb_off[x]; k < nb_off[x + 1]; ++k) {
+      int f = nb_edge[k];
+      if (f == e) continue;
+      uchar sf = state[f];
+      if (sf == TCC_OUT || !tcc_before(cost, f, e)) continue;
+      if (sf == TCC_IN) return -1;
+      if (m < TCC_RIVALS) rv[m] = (uint)f; /* edges (a, x) and (b, y) are all distinct */
+      ++m;
+    }
+  }
+  *rcount = m <= TCC_RIVALS ? m : TCC_RIVALS + 1;
+  return m > 0 ? 1 : 0;
+}
+
+/* Pass-2 rivals of e = (a, b): the pass-1 edges recorded (vaff) at a vertex of a tet of
+ * ring(a) or ring(b), before e. Returns as tcc_stored_rivals. */
+inline int tcc_pass2_wait(int e, int a, int b, __global const int* tets, __global const uint* vt_off,
+                          __global const int* vt, __global const int* vaff, __global const double* cost,
+                          __global const uchar* state, __global uint* rv, __global uint* rcount) {
+  if (*rcount <= TCC_RIVALS) return tcc_stored_rivals(rv, rcount, state);
+  uint m = 0;
+  for (int s = 0; s < 2; ++s) {
+    int x = s == 0 ? a : b;
+    for (uint j = vt_off[x]; j < vt_off[x + 1]; ++j) {
+      __global const int* q = tets + 4 * vt[j];
+      for (int k = 0; k < 4; ++k) {
+        int f = vaff[q[k]];
+        if (f < 0 || f == e) continue;
+        uchar sf = state[f];
+        if (sf == TCC_OUT || !tcc_before(cost, f, e)) continue;
+        if (sf == TCC_IN) return -1;
+        tcc_store_rival(rv, &m, (uint)f); /* the same rival shows up in several tets */
+      }
+    }
+  }
+  *rcount = m <= TCC_RIVALS ? m : TCC_RIVALS + 1;
+  return m > 0 ? 1 : 0;
 }
 
 #endif

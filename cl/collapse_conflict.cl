@@ -20,33 +20,26 @@ __kernel void conflict_init(uint ne, __global const uint* adm, __global uchar* s
   state[e] = adm[e] ? TCC_UNDECIDED : TCC_OUT;
 }
 
-/* The rounds run over a worklist: list[0..n) holds the undecided candidates; those still
- * waiting for a cheaper rival are appended to next (via the counter next_n). The order of the
- * worklist does not matter, since a decision depends only on final decisions of cheaper edges.
+/* The rounds run over worklists of slots of cand[] (the candidate edges): list[0..n) holds
+ * the undecided ones (the first round, first != 0, takes slot i for work item i); those
+ * still waiting for a cheaper rival are appended to next (via the counter next_n). The order
+ * of a worklist does not matter, since a decision depends only on final decisions of cheaper
+ * edges. rivals / rcount: see collapse_common.h.
  *
  * One round of pass 1. */
-__kernel void conflict_pass1_round(uint n, __global const uint* list, __global uint* next, __global uint* next_n,
-                                   __global const int* edges, __global const double* cost,
+__kernel void conflict_pass1_round(uint n, int first, __global const uint* list, __global uint* next,
+                                   __global uint* next_n, __global const uint* cand, __global uint* rivals,
+                                   __global uint* rcount, __global const int* edges, __global const double* cost,
                                    __global const uint* nb_off, __global const int* nb_edge,
                                    __global uchar* state) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  int e = (int)list[i];
-  int ends[2] = {edges[2 * e], edges[2 * e + 1]};
-  int pending = 0;
-  for (int s = 0; s < 2; ++s)
-    for (uint k = nb_off[ends[s]]; k < nb_off[ends[s] + 1]; ++k) {
-      int f = nb_edge[k];
-      if (f == e) continue;
-      uchar sf = state[f];
-      if (sf == TCC_OUT || !tcc_before(cost, f, e)) continue;
-      if (sf == TCC_IN) {
-        state[e] = TCC_OUT;
-        return;
-      }
-      pending = 1;
-    }
-  if (pending) next[atomic_inc(next_n)] = (uint)e;
+  uint c = first ? i : list[i];
+  int e = (int)cand[c];
+  int w = tcc_pass1_wait(e, edges[2 * e], edges[2 * e + 1], nb_off, nb_edge, cost, state, rivals + c * TCC_RIVALS,
+                         rcount + c);
+  if (w < 0) state[e] = TCC_OUT;
+  else if (w > 0) next[atomic_inc(next_n)] = c;
   else state[e] = TCC_IN;
 }
 
@@ -73,32 +66,19 @@ __kernel void conflict_pass2_init(uint ne, __global const uint* p1, __global uch
 
 /* One round of pass 2 over the pass-1 edges: the rivals of e = (a, b) are the pass-1 edges
  * recorded (vaff) at the vertices of the tets of ring(a) and ring(b). */
-__kernel void conflict_pass2_round(uint n, __global const uint* list, __global uint* next, __global uint* next_n,
-                                   __global const int* edges, __global const double* cost,
+__kernel void conflict_pass2_round(uint n, int first, __global const uint* list, __global uint* next,
+                                   __global uint* next_n, __global const uint* cand, __global uint* rivals,
+                                   __global uint* rcount, __global const int* edges, __global const double* cost,
                                    __global const int* tets, __global const uint* vt_off, __global const int* vt,
                                    __global const int* vaff, __global uchar* state) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  int e = (int)list[i];
-  int pending = 0;
-  for (int s = 0; s < 2; ++s) {
-    int x = edges[2 * e + s];
-    for (uint j = vt_off[x]; j < vt_off[x + 1]; ++j) {
-      __global const int* q = tets + 4 * vt[j];
-      for (int k = 0; k < 4; ++k) {
-        int f = vaff[q[k]];
-        if (f < 0 || f == e) continue;
-        uchar sf = state[f];
-        if (sf == TCC_OUT || !tcc_before(cost, f, e)) continue;
-        if (sf == TCC_IN) {
-          state[e] = TCC_OUT;
-          return;
-        }
-        pending = 1;
-      }
-    }
-  }
-  if (pending) next[atomic_inc(next_n)] = (uint)e;
+  uint c = first ? i : list[i];
+  int e = (int)cand[c];
+  int w = tcc_pass2_wait(e, edges[2 * e], edges[2 * e + 1], tets, vt_off, vt, vaff, cost, state,
+                         rivals + c * TCC_RIVALS, rcount + c);
+  if (w < 0) state[e] = TCC_OUT;
+  else if (w > 0) next[atomic_inc(next_n)] = c;
   else state[e] = TCC_IN;
 }
 

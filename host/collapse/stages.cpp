@@ -237,16 +237,32 @@ uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
 }
 
 namespace {
-// Runs `round` (arguments 0..3: n, list, next, next_n; the rest already set) over the worklist
-// s.work[0][0..n) until no candidate is left undecided. Every round decides at least the
-// undecided candidate of smallest (cost, index), so this terminates.
+// The first arguments of every round kernel: n, first, list, next, next_n, cand, rivals, rcount.
+constexpr cl_uint kRoundArgs = 8;
+
+// Compacts the candidate edges (flags[e] != 0) into s.cand_edges and prepares the per-slot
+// rival storage; returns their number.
+uint32_t prepare_candidates(Context& ctx, EdgeState& s, const DeviceBuffer<uint32_t>& flags, uint32_t ne) {
+  ensure(s.cand_edges, ctx, ne);
+  const uint32_t n = dev::compact_indices(ctx, flags, s.cand_edges, ne);
+  ensure(s.rcount, ctx, n);
+  ensure(s.rivals, ctx, size_t(n) * 16);  // TCC_RIVALS
+  s.rcount.fill(0xffffffffu);             // TCC_UNSCANNED
+  return n;
+}
+
+// Runs `round` (its arguments from kRoundArgs on already set) over all n candidate slots,
+// then over the worklist of those still waiting, until none is left undecided. Every round
+// decides at least the undecided candidate of smallest (cost, index), so this terminates.
 void worklist_rounds(Context& ctx, cl::Kernel& round, EdgeState& s, uint32_t n, const char* what) {
   ensure(s.work_n, ctx, 1);
+  ensure(s.work[0], ctx, n);
+  ensure(s.work[1], ctx, n);
   int cur = 0;
-  while (n > 0) {
-    ensure(s.work[1 - cur], ctx, n);
+  for (cl_int first = 1; n > 0; first = 0) {
     s.work_n.fill(0);
-    set_args(round, what, U(n), B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n));
+    set_args(round, what, U(n), first, B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n), B(s.cand_edges),
+             B(s.rivals), B(s.rcount));
     auto t0 = std::chrono::steady_clock::now();
     ctx.launch(round, n, what);
     uint32_t next = 0;
@@ -259,11 +275,11 @@ void worklist_rounds(Context& ctx, cl::Kernel& round, EdgeState& s, uint32_t n, 
   }
 }
 
-// Sets the round kernel's arguments from index 4 on.
+// Sets the round kernel's arguments from kRoundArgs on.
 template <class... A>
-void set_args_from4(cl::Kernel& k, const char* what, const A&... a) {
+void set_round_args(cl::Kernel& k, const char* what, const A&... a) {
   detail::cl_call(what, [&] {
-    cl_uint i = 4;
+    cl_uint i = kRoundArgs;
     (k.setArg(i++, a), ...);
   });
 }
@@ -276,10 +292,9 @@ uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
   ensure(s.vaff, ctx, dm.nv);
   s.vaff.fill(-1);
   run(ctx, F, "conflict_init", c.ne, "", U(c.ne), B(s.adm), B(s.state));
-  ensure(s.work[0], ctx, c.ne);
-  const uint32_t n = dev::compact_indices(ctx, s.adm, s.work[0], c.ne);
+  const uint32_t n = prepare_candidates(ctx, s, s.adm, c.ne);
   cl::Kernel round = ctx.kernel(F, "conflict_pass1_round");
-  set_args_from4(round, "conflict_pass1_round", B(c.edges), B(s.cost), B(c.nb_off), B(c.nb_edge), B(s.state));
+  set_round_args(round, "conflict_pass1_round", B(c.edges), B(s.cost), B(c.nb_off), B(c.nb_edge), B(s.state));
   worklist_rounds(ctx, round, s, n, "conflict_pass1_round");
   run(ctx, F, "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1), B(s.vaff), B(s.counters));
   return counter(s, 2);
@@ -299,10 +314,9 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   const cl_int mode = p.mode, paper_rule = p.paper_rule ? 1 : 0;
   run(ctx, A, "lazy_init", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(c.vflags), B(c.vclass), B(c.eflags), mode,
       paper_rule, B(s.state), B(s.dir), B(s.reason), B(s.cand), B(s.counters));
-  ensure(s.work[0], ctx, c.ne);
-  const uint32_t n = dev::compact_indices(ctx, s.cand, s.work[0], c.ne);
+  const uint32_t n = prepare_candidates(ctx, s, s.cand, c.ne);
   cl::Kernel round = ctx.kernel(A, "lazy_pass1_round");
-  set_args_from4(round, "lazy_pass1_round", B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt), B(c.nb_off),
+  set_round_args(round, "lazy_pass1_round", B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt), B(c.nb_off),
                  B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass),
                  B(c.eflags), mode, paper_rule, p.eps_v, B(s.state), B(s.dir), B(s.reason), B(s.counters));
   worklist_rounds(ctx, round, s, n, "lazy_pass1_round");
@@ -319,10 +333,9 @@ uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
   const std::string F = "collapse_conflict.cl";
   ensure(s.fin, ctx, c.ne);
   run(ctx, F, "conflict_pass2_init", c.ne, "", U(c.ne), B(s.p1), B(s.state));
-  ensure(s.work[0], ctx, c.ne);
-  const uint32_t n = dev::compact_indices(ctx, s.p1, s.work[0], c.ne);
+  const uint32_t n = prepare_candidates(ctx, s, s.p1, c.ne);
   cl::Kernel round = ctx.kernel(F, "conflict_pass2_round");
-  set_args_from4(round, "conflict_pass2_round", B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt), B(s.vaff),
+  set_round_args(round, "conflict_pass2_round", B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt), B(s.vaff),
                  B(s.state));
   worklist_rounds(ctx, round, s, n, "conflict_pass2_round");
   run(ctx, F, "conflict_finalize", c.ne, "", U(c.ne), B(c.edges), B(s.p1), B(s.state), B(s.fin), B(s.vaff),

@@ -48,8 +48,9 @@ struct EdgeState {
   DeviceBuffer<uint32_t> marked, adm, p1, fin;
   DeviceBuffer<uint8_t> state;      // conflict passes: 0 undecided, 1 in, 2 out
   DeviceBuffer<uint32_t> cand;      // lazy filter: marked and passing Q
-  DeviceBuffer<uint32_t> work[2];   // worklists of the conflict rounds
-  DeviceBuffer<uint32_t> work_n;    // length of the next worklist
+  // Conflict rounds (collapse_conflict.cl): candidate edges, worklists of their slots, the
+  // length of the next worklist, stored rivals per slot and their count.
+  DeviceBuffer<uint32_t> cand_edges, work[2], work_n, rivals, rcount;
   DeviceBuffer<uint8_t> dir, reason;
   DeviceBuffer<int32_t> vaff;       // per vertex
   // marked, admissible, pass1, pass2, tested (lazy), passed Q (lazy)
