@@ -144,3 +144,43 @@ TEST(Cli, CoarsenWritesAValidMeshAndStats) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(Cli, DeviceErrorsExitWithThree) {
+  tc::test::TempDir dir;
+  std::string out;
+  EXPECT_EQ(run_command(cli() + " " + q(tc::test::project_mesh("tet.mesh")) + " " + q(dir.file("o.mesh")) +
+                            " --device no-such-device-xyz",
+                        &out),
+            3)
+      << out;
+  EXPECT_NE(out.find("no-such-device-xyz"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("o.mesh")));
+  // The environment variable is used when --device is absent.
+  EXPECT_EQ(run_command("TETCOLLAPSE_DEVICE=no-such-device-xyz " + cli() + " " + q(tc::test::project_mesh("tet.mesh")) +
+                            " " + q(dir.file("o.mesh")),
+                        &out),
+            3)
+      << out;
+  EXPECT_EQ(run_command(cli() + " devices --json", &out), 0) << out;
+  EXPECT_NE(out.find("\"fp64\":true"), std::string::npos) << out;
+}
+
+TEST(Cli, FeaturesWritesTheClassificationAsFields) {
+  tc::test::TempDir dir;
+  std::string out, vtu = dir.file("features.vtu");
+  ASSERT_EQ(run_command(cli() + " features " + q(tc::test::project_mesh("bracket.msh")) + " " + q(vtu), &out), 0)
+      << out;
+  EXPECT_NE(out.find("2320 face, 408 ridge, 571 corner vertices, 432 ridge edges"), std::string::npos) << out;
+  std::string text = tc::test::read_text(vtu);
+  EXPECT_NE(text.find("Name=\"vertex_class\""), std::string::npos);
+  EXPECT_NE(text.find("Name=\"on_surface\""), std::string::npos);
+  // The same counts as info --json reports.
+  ASSERT_EQ(run_command(cli() + " info --json " + q(tc::test::project_mesh("bracket.msh")), &out), 0);
+  EXPECT_NE(out.find("\"face_vertices\":2320,\"ridge_vertices\":408,\"corner_vertices\":571,\"ridge_edges\":432"),
+            std::string::npos)
+      << out;
+}
+
+}  // namespace
