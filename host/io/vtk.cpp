@@ -201,7 +201,10 @@ class LegacyReader {
                                 what + ": " + std::to_string(n) + " values of " + std::to_string(size) +
                                     " bytes run past the end of the file");
     out.resize(static_cast<size_t>(n));
-    io::vtk::convert_raw(data_.data() + start, t, static_cast<size_t>(n), io::vtk::kHostLittle, out.data());
+    const int64_t bad = io::vtk::convert_raw(data_.data() + start, t, static_cast<size_t>(n), io::vtk::kHostLittle, out.data());
+    if (bad >= 0)
+      throw InputError::at_byte(file_, int64_t(start + static_cast<size_t>(bad) * size),
+                                what + ": value " + std::to_string(bad + 1) + " is not an integer");
     base_ = start + static_cast<size_t>(n) * size;
     cur_ = TextCursor(std::string_view(data_).substr(base_), file_);
   }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <type_traits>
 
 #include "io/io_util.hpp"
 
@@ -64,32 +65,40 @@ bool parse_xml_type(std::string_view name, NumType& out) {
 }
 
 template <class S, class T>
-static void convert_as(const char* bytes, size_t n, bool swap, T* out) {
+static int64_t convert_as(const char* bytes, size_t n, bool swap, T* out) {
   for (size_t i = 0; i < n; ++i) {
     S v;
     std::memcpy(&v, bytes + i * sizeof(S), sizeof(S));
     if (swap) v = BinaryCursor::byteswap_value(v);
+    if constexpr (std::is_floating_point_v<S> && std::is_integral_v<T>) {
+      // Integer data (cells, offsets, labels) stored as floats: a value with a fraction,
+      // NaN, or outside T has no integer value (converting it would be undefined).
+      const double d = static_cast<double>(v);
+      if (!(d == std::floor(d) && d >= -0x1p63 && d < 0x1p63)) return static_cast<int64_t>(i);
+    }
     out[i] = static_cast<T>(v);
   }
+  return -1;
 }
 
 template <class T>
-void convert_raw(const char* bytes, NumType t, size_t n, bool swap, T* out) {
+int64_t convert_raw(const char* bytes, NumType t, size_t n, bool swap, T* out) {
   switch (t) {
-    case NumType::Int8: convert_as<int8_t>(bytes, n, swap, out); break;
-    case NumType::UInt8: convert_as<uint8_t>(bytes, n, swap, out); break;
-    case NumType::Int16: convert_as<int16_t>(bytes, n, swap, out); break;
-    case NumType::UInt16: convert_as<uint16_t>(bytes, n, swap, out); break;
-    case NumType::Int32: convert_as<int32_t>(bytes, n, swap, out); break;
-    case NumType::UInt32: convert_as<uint32_t>(bytes, n, swap, out); break;
-    case NumType::Int64: convert_as<int64_t>(bytes, n, swap, out); break;
-    case NumType::UInt64: convert_as<uint64_t>(bytes, n, swap, out); break;
-    case NumType::Float32: convert_as<float>(bytes, n, swap, out); break;
-    case NumType::Float64: convert_as<double>(bytes, n, swap, out); break;
+    case NumType::Int8: return convert_as<int8_t>(bytes, n, swap, out);
+    case NumType::UInt8: return convert_as<uint8_t>(bytes, n, swap, out);
+    case NumType::Int16: return convert_as<int16_t>(bytes, n, swap, out);
+    case NumType::UInt16: return convert_as<uint16_t>(bytes, n, swap, out);
+    case NumType::Int32: return convert_as<int32_t>(bytes, n, swap, out);
+    case NumType::UInt32: return convert_as<uint32_t>(bytes, n, swap, out);
+    case NumType::Int64: return convert_as<int64_t>(bytes, n, swap, out);
+    case NumType::UInt64: return convert_as<uint64_t>(bytes, n, swap, out);
+    case NumType::Float32: return convert_as<float>(bytes, n, swap, out);
+    case NumType::Float64: return convert_as<double>(bytes, n, swap, out);
   }
+  return -1;
 }
-template void convert_raw<double>(const char*, NumType, size_t, bool, double*);
-template void convert_raw<int64_t>(const char*, NumType, size_t, bool, int64_t*);
+template int64_t convert_raw<double>(const char*, NumType, size_t, bool, double*);
+template int64_t convert_raw<int64_t>(const char*, NumType, size_t, bool, int64_t*);
 
 int64_t first_non_finite(const std::vector<double>& v) {
   for (size_t i = 0; i < v.size(); ++i)

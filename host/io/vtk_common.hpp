@@ -24,9 +24,11 @@ bool parse_legacy_type(std::string_view name, NumType& out);
 // XML names: Int8 ... UInt64, Float32, Float64 (also the old "Int", "Float" spellings are not VTK's).
 bool parse_xml_type(std::string_view name, NumType& out);
 
-// Converts n values of type t stored at `bytes` (native order unless swap) to T.
+// Converts n values of type t stored at `bytes` (native order unless swap) to T. Returns
+// the index of the first value T cannot hold (when T is an integer type: a floating-point
+// value with a fraction, NaN, or out of range), after which `out` is incomplete; else -1.
 template <class T>
-void convert_raw(const char* bytes, NumType t, size_t n, bool swap, T* out);
+int64_t convert_raw(const char* bytes, NumType t, size_t n, bool swap, T* out);
 
 inline constexpr bool kHostLittle = std::endian::native == std::endian::little;
 

@@ -464,7 +464,8 @@ class VtuReader {
       fail_byte(where, what + ": impossible number of values");
     std::string_view payload = block_payload(a, bytes, where, expected_bytes, storage);
     out.resize(size_t(expected_values));
-    io::vtk::convert_raw(payload.data(), a.type, size_t(expected_values), swap_, out.data());
+    const int64_t bad = io::vtk::convert_raw(payload.data(), a.type, size_t(expected_values), swap_, out.data());
+    if (bad >= 0) fail_byte(where, what + ": value " + std::to_string(bad + 1) + " is not an integer");
   }
 
   const ArrayDesc* find(Where w, std::string_view name) const {

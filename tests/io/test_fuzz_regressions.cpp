@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
+#include <limits>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -108,5 +110,92 @@ TEST(FuzzRegressions, PartsBecomeFiles) {
     ADD_FAILURE() << "a truncated .sol was accepted";
   } catch (const tc::InputError& e) {
     EXPECT_EQ(e.file(), dir.file("x.sol"));
+  }
+}
+
+// Found by fuzz_vtk (tests/data/fuzz/vtk/float-offsets-*): integer data stored as floats
+// was cast to int64 unchecked, undefined for 1e300 or NaN (UBSan) and silently truncated for
+// 4.5. Now such a value is refused, in VTK legacy BINARY and in VTU alike.
+namespace {
+std::string be_doubles(std::initializer_list<double> values) {
+  std::string out;
+  for (double v : values) {
+    unsigned char b[8];
+    std::memcpy(b, &v, 8);
+    for (int i = 7; i >= 0; --i) out += static_cast<char>(b[i]);
+  }
+  return out;
+}
+std::string be_int64s(std::initializer_list<int64_t> values) {
+  std::string out;
+  for (int64_t v : values)
+    for (int i = 7; i >= 0; --i) out += static_cast<char>((static_cast<uint64_t>(v) >> (8 * i)) & 0xff);
+  return out;
+}
+std::string vtk_with_offsets(double last_offset) {
+  return "# vtk DataFile Version 5.1\nfloat offsets\nBINARY\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 double\n" +
+         be_doubles({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1}) + "\nCELLS 2 4\nOFFSETS double\n" + be_doubles({0, last_offset}) +
+         "\nCONNECTIVITY vtktypeint64\n" + be_int64s({0, 1, 2, 3}) + "\nCELL_TYPES 1\n" + std::string("\0\0\0\x0a", 4) + "\n";
+}
+}  // namespace
+
+TEST(FuzzRegressions, VtkFloatOffsetsMustBeIntegers) {
+  tc::test::TempDir dir;
+  // Integral floats are integer data like any other.
+  const std::string ok = tc::fuzz::materialize(dir.path(), Format::Vtk, vtk_with_offsets(4.0));
+  EXPECT_EQ(tc::fuzz::read_input(ok, Format::Vtk).num_tets(), 1);
+  for (double bad : {4.5, 1e300, std::numeric_limits<double>::quiet_NaN(), -0x1p64}) {
+    SCOPED_TRACE(bad);
+    const std::string path = tc::fuzz::materialize(dir.path(), Format::Vtk, vtk_with_offsets(bad));
+    try {
+      tc::fuzz::read_input(path, Format::Vtk);
+      ADD_FAILURE() << "offset " << bad << " was accepted";
+    } catch (const tc::InputError& e) {
+      EXPECT_NE(e.reason().find("OFFSETS: value 2 is not an integer"), std::string::npos) << e.what();
+      EXPECT_GE(e.byte_offset(), 0) << e.what();
+    }
+  }
+}
+
+TEST(FuzzRegressions, VtuFloatConnectivityMustBeIntegers) {
+  auto vtu = [](const std::string& conn) {
+    return "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\">\n"
+           "<UnstructuredGrid><Piece NumberOfPoints=\"4\" NumberOfCells=\"1\">\n"
+           "<Points><DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">0 0 0 1 0 0 0 1 0 0 0 1</DataArray></Points>\n"
+           "<Cells><DataArray type=\"Float64\" Name=\"connectivity\" format=\"binary\">" + conn + "</DataArray>\n"
+           "<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">4</DataArray>\n"
+           "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">10</DataArray></Cells>\n"
+           "</Piece></UnstructuredGrid></VTKFile>\n";
+  };
+  // Base64 of a UInt32 byte count (32) and four little-endian doubles.
+  auto encoded = [](double last) {
+    std::string raw(4, '\0');
+    raw[0] = 32;
+    for (double v : {0.0, 1.0, 2.0, last}) raw.append(reinterpret_cast<const char*>(&v), 8);
+    static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    std::string out;
+    for (size_t i = 0; i < raw.size(); i += 3) {
+      uint32_t n = uint8_t(raw[i]) << 16;
+      if (i + 1 < raw.size()) n |= uint8_t(raw[i + 1]) << 8;
+      if (i + 2 < raw.size()) n |= uint8_t(raw[i + 2]);
+      out += k[(n >> 18) & 63];
+      out += k[(n >> 12) & 63];
+      out += i + 1 < raw.size() ? k[(n >> 6) & 63] : '=';
+      out += i + 2 < raw.size() ? k[n & 63] : '=';
+    }
+    return out;
+  };
+  tc::test::TempDir dir;
+  const std::string ok = tc::fuzz::materialize(dir.path(), Format::Vtu, vtu(encoded(3.0)));
+  EXPECT_EQ(tc::fuzz::read_input(ok, Format::Vtu).num_tets(), 1);
+  for (double bad : {2.5, 1e300}) {
+    SCOPED_TRACE(bad);
+    const std::string path = tc::fuzz::materialize(dir.path(), Format::Vtu, vtu(encoded(bad)));
+    try {
+      tc::fuzz::read_input(path, Format::Vtu);
+      ADD_FAILURE() << "connectivity " << bad << " was accepted";
+    } catch (const tc::InputError& e) {
+      EXPECT_NE(e.reason().find("value 4 is not an integer"), std::string::npos) << e.what();
+    }
   }
 }
