@@ -2,6 +2,8 @@
 # Builds the libFuzzer harnesses of the mesh readers with clang (ASan + UBSan) in
 # build-fuzz/ and runs one or all of them.
 #   scripts/fuzz.sh [SECONDS] [HARNESS...]      HARNESS: gmsh medit vtk vtu tetgen (default: all)
+#   scripts/fuzz.sh --coverage [HARNESS...]     line coverage of each reader reached by the
+#                                               corpus of earlier runs (build-fuzzcov/, llvm-cov)
 #   SECONDS defaults to 60; each harness runs that long, one after the other
 #   (JOBS=N runs N at a time). Environment: BUILD_DIR, MAX_LEN (default 16384), NICE (default 19),
 #   MALLOC_LIMIT_MB (default 256: a larger single allocation is a finding),
@@ -14,6 +16,47 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build-fuzz}
+
+# Source files of each reader, for the coverage report.
+reader_files() {
+  case $1 in
+    gmsh) echo host/io/gmsh.cpp ;;
+    medit) echo host/io/medit.cpp ;;
+    vtk) echo host/io/vtk.cpp host/io/vtk_common.cpp ;;
+    vtu) echo host/io/vtu.cpp host/io/vtk_common.cpp ;;
+    tetgen) echo host/io/tetgen.cpp ;;
+  esac
+}
+
+if [[ "${1:-}" == "--coverage" ]]; then
+  shift
+  harnesses=("$@")
+  ((${#harnesses[@]})) || harnesses=(gmsh medit vtk vtu tetgen)
+  cov=${COV_BUILD_DIR:-$root/build-fuzzcov}
+  v=$(clang++ --version | sed -n 's/.*clang version \([0-9]*\).*/\1/p')
+  cmake -S "$root" -B "$cov" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_C_COMPILER=clang -DCMAKE_CXX_COMPILER=clang++ \
+        -DTETCOLLAPSE_FUZZ=ON -DTETCOLLAPSE_FUZZ_COVERAGE=ON -DTETCOLLAPSE_BUILD_BENCH=OFF >/dev/null
+  targets=()
+  for h in "${harnesses[@]}"; do targets+=("fuzz_$h"); done
+  nice -n "${NICE:-19}" cmake --build "$cov" --target "${targets[@]}" -j "${BUILD_JOBS:-2}" >/dev/null
+  for h in "${harnesses[@]}"; do
+    corpus=$build/corpus/$h
+    [[ -d "$corpus" ]] || corpus=$root/tests/fuzz/seeds/$h
+    rm -f "$cov/$h".profraw "$cov/$h".profdata
+    # -runs=0: execute every corpus input once, no fuzzing.
+    LLVM_PROFILE_FILE="$cov/$h.profraw" nice -n "${NICE:-19}" "$cov/tests/fuzz/fuzz_$h" "$corpus" -runs=0 >/dev/null 2>&1
+    "llvm-profdata-$v" merge -sparse "$cov/$h.profraw" -o "$cov/$h.profdata"
+    echo "coverage of $h by $(find "$corpus" -type f | wc -l) inputs in $corpus:"
+    # shellcheck disable=SC2046
+    "llvm-cov-$v" report "$cov/tests/fuzz/fuzz_$h" -instr-profile="$cov/$h.profdata" \
+        $(for f in $(reader_files "$h"); do echo "$root/$f"; done) | sed 's/^/  /'
+    # The same files without their writing functions (the harnesses only read).
+    # shellcheck disable=SC2046
+    "llvm-cov-$v" export -format=lcov "$cov/tests/fuzz/fuzz_$h" -instr-profile="$cov/$h.profdata" \
+        $(for f in $(reader_files "$h"); do echo "$root/$f"; done) | python3 "$root/scripts/fuzz_reader_coverage.py"
+  done
+  exit 0
+fi
 seconds=${1:-60}
 [[ $# -gt 0 ]] && shift
 harnesses=("$@")
