@@ -26,7 +26,7 @@ Needs Debian's gmsh Python module (python3-gmsh), tetgen, numpy and meshio
 import argparse
 import json
 import math
-import multiprocessing
+import concurrent.futures
 import os
 import random
 import shutil
@@ -68,6 +68,7 @@ class Skip(Exception):
 
 def gmsh_start():
     gmsh.initialize(readConfigFiles=False)
+    gmsh.option.setNumber("General.AbortOnError", 0)
     gmsh.option.setNumber("General.Terminal", 0)
     gmsh.option.setNumber("General.NumThreads", 1)  # one thread: deterministic
 
@@ -410,7 +411,9 @@ def r_graded(rng, path):
                 f.remove(tag)
             except Exception:
                 pass
-        fine, coarse = h / ratio ** (1 / 2), h * ratio ** (1 / 2)
+        # Most of the volume is far from the feature: the fine end is nearer h than the coarse end,
+        # so the tet count stays near the target (fine = h / ratio would multiply it).
+        fine, coarse = h / ratio ** (1 / 3), h * ratio ** (2 / 3)
         xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(-1, -1)
         diag = math.dist((xmin, ymin, zmin), (xmax, ymax, zmax))
         if kind == "box":
@@ -666,25 +669,43 @@ def seed_of(name, attempt):
     return int.from_bytes(name.encode(), "little") % (2**31 - 1) + 7919 * attempt
 
 
+def make_one_attempt(name, attempt, out_dir):
+    """Makes one mesh with the seed of `attempt`, in this process. Returns the manifest entry,
+    or raises Skip / gmsh's Exception."""
+    recipes = {r[0]: r for r in all_recipes()}
+    _, category, fn, extra = recipes[name]
+    path = os.path.join(out_dir, name + ".msh")
+    rng = random.Random(seed_of(name, attempt))
+    gmsh_start()
+    try:
+        new_model(name)
+        what, _ = fn(rng, path, *extra)
+        return dict(name=name, file=name + ".msh", category=category, what=what, attempt=attempt, **gmsh_info(path))
+    finally:
+        gmsh.finalize()
+
+
 def make_one(task):
-    name, category, fn, extra, out_dir = task
+    """Each attempt runs in a child process: gmsh can abort on a C++ exception (seen with some
+    size fields), which must cost one attempt, not the whole run. A random layout that defeats
+    OCC or gmsh moves on to the next seed."""
+    name, category, out_dir, timeout = task
     path = os.path.join(out_dir, name + ".msh")
     last = ""
-    for attempt in range(4):  # a random layout may defeat OCC or gmsh: try the next seed
-        rng = random.Random(seed_of(name, attempt))
+    for attempt in range(4):
         try:
-            new_model(name)
-            what, tets = fn(rng, path, *extra)
-            info = gmsh_info(path)
-            return dict(name=name, file=name + ".msh", category=category, what=what, attempt=attempt, **info)
-        except Skip as e:
-            last = str(e); print(name, attempt, last, file=sys.stderr) if os.environ.get("CORPUS_DEBUG") else None
-        except Exception as e:  # gmsh raises plain Exception on meshing/boolean failures
-            last = f"{type(e).__name__}: {str(e)[:200]}"; print(name, attempt, last, file=sys.stderr) if os.environ.get("CORPUS_DEBUG") else None
+            r = subprocess.run([sys.executable, os.path.abspath(__file__), out_dir, "--one", name, "--attempt", str(attempt)],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=timeout)
+            if r.returncode == 0:
+                return json.loads(r.stdout.strip().splitlines()[-1])
+            tail = (r.stdout + r.stderr).strip().splitlines()
+            last = tail[-1][:200] if tail else f"exit {r.returncode}"
+        except subprocess.TimeoutExpired:
+            last = f"took more than {timeout} s"
+        if os.environ.get("CORPUS_DEBUG"):
+            print(name, attempt, last, file=sys.stderr)
         if os.path.exists(path):
             os.remove(path)
-        gmsh.finalize()  # a failed OCC operation can leave state behind: start afresh
-        gmsh_start()
     return dict(name=name, category=category, skipped=last)
 
 
@@ -695,10 +716,6 @@ def gmsh_info(path):
     return dict(tets=count_tets(), nodes=len(tags), bytes=os.path.getsize(path))
 
 
-def worker_init():
-    gmsh_start()
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("out", nargs="?", default=os.path.join(HERE, "..", "build", "corpus"))
@@ -706,7 +723,19 @@ def main():
     ap.add_argument("--only", help="comma-separated names")
     ap.add_argument("--ci-sample", action="store_true", help="only the meshes committed in meshes/corpus/")
     ap.add_argument("--list", action="store_true", help="print the names and exit")
+    ap.add_argument("--timeout", type=int, default=600, help="seconds per attempt at one mesh")
+    ap.add_argument("--one", help=argparse.SUPPRESS)  # internal: make this mesh in this process
+    ap.add_argument("--attempt", type=int, default=0, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.one:
+        try:
+            print(json.dumps(make_one_attempt(args.one, args.attempt, os.path.abspath(args.out))))
+            return 0
+        except Skip as e:
+            print(f"skip: {e}")
+        except Exception as e:  # gmsh raises plain Exception on meshing/boolean failures
+            print(f"{type(e).__name__}: {str(e)[:200]}")
+        return 1
     if shutil.which("tetgen") is None:
         sys.exit("make_corpus.py: tetgen is not installed (apt-get install tetgen)")
     recipes = all_recipes()
@@ -725,10 +754,10 @@ def main():
         recipes = [r for r in recipes if r[0] in wanted]
     out_dir = os.path.abspath(args.out)
     os.makedirs(out_dir, exist_ok=True)
-    tasks = [(name, cat, fn, extra, out_dir) for name, cat, fn, extra in recipes]
+    tasks = [(name, cat, out_dir, args.timeout) for name, cat, _, _ in recipes]
     results = []
-    with multiprocessing.Pool(args.jobs, initializer=worker_init) as pool:
-        for r in pool.imap(make_one, tasks):
+    with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
+        for r in pool.map(make_one, tasks):
             results.append(r)
             if "skipped" in r:
                 print(f"{r['name']}: skipped ({r['skipped']})", flush=True)
