@@ -65,7 +65,8 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
                                  __global const uint* vt_off, __global const int* vt, __global const uint* nb_off,
                                  __global const int* nb, __global const int* nb_edge, __global const int* labels,
                                  int use_labels, __global const double* pts, __global const uchar* vflags,
-                                 __global const uchar* eflags, double eps_v) {
+                                 __global const uchar* eflags, double eps_v,
+                                 double q_min) {
   /* --- link condition --- */
   int cn[TCC_MAX_LINK], pc[TCC_MAX_LINK], pd[TCC_MAX_LINK];
   int ncn = 0, np = 0;
@@ -147,6 +148,10 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
   /* --- volumes after the tentative collapse --- */
   double3 p = tcc_placement(pts, a, b, (uint)dir);
   double3 pa = tc_point(pts, a), pb = tc_point(pts, b);
+  /* Quality guard (q_min > 0): the worst mean ratio among the tets that change shape may not
+   * fall below min(its value before the collapse, q_min): a collapse never makes a good
+   * neighbourhood bad, nor a bad one worse. */
+  double q_old = 1.0, q_new = 1.0;
   for (int side = 0; side < 2; ++side) {
     int x = side == 0 ? a : b, y = side == 0 ? b : a;
     double3 px = side == 0 ? pa : pb;
@@ -158,8 +163,15 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
       double3 c[4];
       for (int k = 0; k < 4; ++k) c[k] = q[k] == x ? p : tc_point(pts, q[k]);
       if (!(tc_tet_volume(c[0], c[1], c[2], c[3]) >= eps_v)) return TCC_REFUSED_VOLUME;
+      if (q_min > 0.0) {
+        double qn = tc_tet_quality(c[0], c[1], c[2], c[3]);
+        double qo = tc_tet_quality(tc_point(pts, q[0]), tc_point(pts, q[1]), tc_point(pts, q[2]), tc_point(pts, q[3]));
+        q_new = qn < q_new ? qn : q_new;
+        q_old = qo < q_old ? qo : q_old;
+      }
     }
   }
+  if (q_min > 0.0 && q_new < (q_old < q_min ? q_old : q_min)) return TCC_REFUSED_QUALITY;
   return TCC_OK;
 }
 
@@ -168,7 +180,7 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
                          __global const int* nb, __global const int* nb_edge, __global const int* labels,
                          int use_labels, __global const double* pts, __global const uchar* vflags,
                          __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
-                         double eps_v, __global uint* adm, __global uchar* edge_dir, __global uchar* reason,
+                         double eps_v, double q_min, __global uint* adm, __global uchar* edge_dir, __global uchar* reason,
                          __global uint* counters) {
   uint e = get_global_id(0);
   if (e >= ne) return;
@@ -186,7 +198,7 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
     return;
   }
   uchar r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, nb_off, nb, nb_edge, labels, use_labels, pts,
-                                vflags, eflags, eps_v);
+                                vflags, eflags, eps_v, q_min);
   reason[e] = r;
   if (r != TCC_OK) return;
   adm[e] = 1u;
@@ -241,7 +253,7 @@ __kernel void lazy_pass1_round(uint n, int first, __global const uint* list, __g
                                __global const int* labels, int use_labels, __global const double* pts,
                                __global const uchar* vflags, __global const uchar* vclass,
                                __global const uchar* eflags, int mode, int paper_rule, double eps_v,
-                               __global uchar* state, __global uchar* edge_dir, __global uchar* reason,
+                               double q_min, __global uchar* state, __global uchar* edge_dir, __global uchar* reason,
                                __global uint* counters) {
   uint i = get_global_id(0);
   if (i >= n) return;
@@ -260,7 +272,7 @@ __kernel void lazy_pass1_round(uint n, int first, __global const uint* list, __g
   uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
   int dir = tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule);
   uchar r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, nb_off, nb, nb_edge, labels, use_labels, pts,
-                                vflags, eflags, eps_v);
+                                vflags, eflags, eps_v, q_min);
   atomic_inc(&counters[4]);
   reason[e] = r;
   if (r == TCC_OK) {

@@ -36,6 +36,7 @@
 #define TCC_REFUSED_Q 2
 #define TCC_REFUSED_LINK 3
 #define TCC_REFUSED_VOLUME 4
+#define TCC_REFUSED_QUALITY 6 /* 5 is the host's "untested" */
 #define TCC_UNTESTED 5 /* lazy filter: marked, passed Q, never tested (a cheaper rival won) */
 
 /* Per-edge states of the conflict passes and of the lazy admissible filter. */

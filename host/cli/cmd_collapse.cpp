@@ -112,6 +112,7 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, double sec
       .field("median_edge_length", r.median_edge_length)
       .field("eps_c", c.opt.eps_c)
       .field("eps_v", r.eps_v)
+      .field("min_quality", c.opt.min_quality)
       .field("boundary", c.boundary)
       .field("seconds_total", seconds_total)
       .field("seconds_collapse", r.seconds_total)
@@ -181,6 +182,11 @@ void register_collapse(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   app.add_option("--eps-v", c->opt.eps_v, "Refuse collapses leaving a tet with volume below this (paper: 2e-12)")
       ->capture_default_str();
+  app.add_option("--min-quality", c->opt.min_quality,
+                 "Quality guard: refuse a collapse that makes the worst reshaped tet's mean ratio\n"
+                 "(1 regular, 0 flat) fall below min(its value before, Q); 0 = off, as the paper")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--eps-v-relative", c->opt.eps_v_relative,
                "Read --eps-v relative to the cube of the bounding-box diagonal");
   app.add_option("--region", c->region,

@@ -74,6 +74,7 @@ StageParams params_from(const CollapseOptions& o) {
   p.eps_f = o.eps_f;
   p.eps_r = o.eps_r;
   p.eps_v = o.eps_v;
+  p.min_quality = o.min_quality;
   p.mask_mode = o.vertex_mask.empty() ? 0 : o.mask_either ? 2 : 1;
   p.cost_source = o.cost_cl_source;
   return p;
@@ -231,7 +232,7 @@ uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   run(ctx, "collapse_admissible.cl", "admissible", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(dm.tets),
       B(c.vt_off), B(c.vt), B(c.nb_off), B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points),
-      B(c.vflags), B(c.vclass), B(c.eflags), I(p.mode), I(p.paper_rule ? 1 : 0), p.eps_v, B(s.adm), B(s.dir),
+      B(c.vflags), B(c.vclass), B(c.eflags), I(p.mode), I(p.paper_rule ? 1 : 0), p.eps_v, p.min_quality, B(s.adm), B(s.dir),
       B(s.reason), B(s.counters));
   return counter(s, 1);
 }
@@ -318,7 +319,7 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   cl::Kernel round = ctx.kernel(A, "lazy_pass1_round");
   set_round_args(round, "lazy_pass1_round", B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt), B(c.nb_off),
                  B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass),
-                 B(c.eflags), mode, paper_rule, p.eps_v, B(s.state), B(s.dir), B(s.reason), B(s.counters));
+                 B(c.eflags), mode, paper_rule, p.eps_v, p.min_quality, B(s.state), B(s.dir), B(s.reason), B(s.counters));
   worklist_rounds(ctx, round, s, n, "lazy_pass1_round");
   run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1),
       B(s.vaff), B(s.counters));

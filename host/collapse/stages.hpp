@@ -58,7 +58,7 @@ struct EdgeState {
 };
 
 enum Reason : uint8_t {
-  kOk = 0, kNotMarked = 1, kRefusedQ = 2, kRefusedLink = 3, kRefusedVolume = 4,
+  kOk = 0, kNotMarked = 1, kRefusedQ = 2, kRefusedLink = 3, kRefusedVolume = 4, kRefusedQuality = 6,
   kUntested = 5  // lazy filter: passed Q, never tested because a cheaper rival won
 };
 
@@ -67,6 +67,7 @@ struct StageParams {
   bool paper_rule = false;
   bool use_labels = true;
   double eps_f = 0.01, eps_r = 0.1, eps_v = 2e-12;
+  double min_quality = 0;  // quality guard, 0 = off
   double target = 0;
   int mask_mode = 0;  // 0 none, 1 both, 2 either
   std::string cost_source;  // user cost, "" for the edge length

@@ -95,6 +95,10 @@ struct CollapseOptions {
   // threshold is eps_v x (bounding-box diagonal of the input)^3.
   double eps_v = 2e-12;
   bool eps_v_relative = false;
+  // Quality guard: a collapse is refused when the worst mean-ratio quality (tc_tet_quality:
+  // 1 regular, -> 0 sliver) of the tets it reshapes would fall below min(their worst quality
+  // before, min_quality). 0 turns it off (the paper's behaviour: only eps_v is checked).
+  double min_quality = 0.1;
 
   // Adaptive marking: with a non-empty mask (one byte per input vertex, non-zero = selected),
   // only edges whose both end points are selected are marked, or either end point with
