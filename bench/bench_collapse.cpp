@@ -2,6 +2,9 @@
 // eps_c = 0 and eps_c = 700 (paper Sec. 4.4, Fig. 9, Table 2). File I/O is excluded.
 //
 //   bench_collapse [MESH] [--runs N] [--json FILE] [--wg N] [--max-iterations N]
+//                  [--eps-c N[,N...]] [--min-quality Q[,Q...]]
+// Defaults: eps_c 0 and 700, min_quality 0 (the paper: no quality guard) and 0.1 (the library's
+// default); every combination is run.
 // Prints a table (median of N runs of collapse(), iterations, collapses per iteration, time per
 // stage summed over the iterations of the median run, tets in/out) and the same as JSON.
 #include <algorithm>
@@ -22,12 +25,21 @@ namespace {
 
 struct Result {
   int64_t eps_c = 0;
+  double min_quality = 0;
   std::vector<double> walls;
   CollapseReport report;  // of the median run
 };
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+std::vector<double> parse_list(const char* s) {
+  std::vector<double> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ',')) out.push_back(std::atof(item.c_str()));
+  return out;
 }
 
 }  // namespace
@@ -38,11 +50,14 @@ int main(int argc, char** argv) {
   int runs = 5;
   size_t wg = 0;
   int max_iterations = 1000;
+  std::vector<double> eps_cs = {0, 700}, qualities = {0, CollapseOptions{}.min_quality};
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--json") && i + 1 < argc) json_path = argv[++i];
     else if (!std::strcmp(argv[i], "--wg") && i + 1 < argc) wg = size_t(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--max-iterations") && i + 1 < argc) max_iterations = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--eps-c") && i + 1 < argc) eps_cs = parse_list(argv[++i]);
+    else if (!std::strcmp(argv[i], "--min-quality") && i + 1 < argc) qualities = parse_list(argv[++i]);
     else path = argv[i];
   }
   Mesh input;
@@ -66,15 +81,19 @@ int main(int argc, char** argv) {
   }
 
   std::vector<Result> results;
-  for (int64_t eps_c : {int64_t(0), int64_t(700)}) {
+  for (double q : qualities)
+  for (double ec : eps_cs) {
+    const int64_t eps_c = int64_t(ec);
     Result r;
     r.eps_c = eps_c;
+    r.min_quality = q;
     std::vector<std::pair<double, CollapseReport>> all;
     for (int i = 0; i < runs; ++i) {
       Mesh m = input;
       CollapseOptions o;
       o.target_factor = 2;
       o.eps_c = eps_c;
+      o.min_quality = q;
       o.max_iterations = max_iterations;
       auto t = std::chrono::steady_clock::now();
       CollapseReport rep = collapse(m, o, ctx);
@@ -106,7 +125,8 @@ int main(int argc, char** argv) {
     const char* names[6] = {"connectivity", "cost", "admissible", "pass1", "pass2", "collapse"};
     int dom = int(std::max_element(st, st + 6) - st);
     double median = r.walls[r.walls.size() / 2];
-    std::printf("\n== eps_c = %lld: target %.6g (2 x median %.6g)\n", (long long)r.eps_c, rep.target_length,
+    std::printf("\n== eps_c = %lld, min_quality %g: target %.6g (2 x median %.6g)\n", (long long)r.eps_c,
+                r.min_quality, rep.target_length,
                 rep.median_edge_length);
     std::printf("wall time of collapse(): median %.3f s (min %.3f, max %.3f) over %d runs; upload %.3f s, download %.3f s\n",
                 median, r.walls.front(), r.walls.back(), runs, rep.seconds_upload, rep.seconds_download);
@@ -125,7 +145,7 @@ int main(int argc, char** argv) {
     std::printf("\ndominant stage: %s (%.0f%% of the iterations' time)\n", names[dom],
                 100 * st[dom] / std::max(1e-12, st[0] + st[1] + st[2] + st[3] + st[4] + st[5]));
 
-    js << (w ? ", " : "") << "{\"eps_c\": " << r.eps_c << ", \"seconds_median\": " << median << ", \"seconds_runs\": [";
+    js << (w ? ", " : "") << "{\"eps_c\": " << r.eps_c << ", \"min_quality\": " << r.min_quality << ", \"seconds_median\": " << median << ", \"seconds_runs\": [";
     for (size_t i = 0; i < r.walls.size(); ++i) js << (i ? ", " : "") << r.walls[i];
     js << "], \"target_length\": " << rep.target_length << ", \"tets_out\": " << rep.tets_out
        << ", \"vertices_out\": " << rep.vertices_out << ", \"iterations\": " << rep.iterations.size()

@@ -254,7 +254,7 @@ __kernel void lazy_pass1_round(uint n, int first, __global const uint* list, __g
                                __global const uchar* vflags, __global const uchar* vclass,
                                __global const uchar* eflags, int mode, int paper_rule, double eps_v,
                                double q_min, __global uchar* state, __global uchar* edge_dir, __global uchar* reason,
-                               __global uint* counters) {
+                               __global uint* counters, __global uchar* verdict) {
   uint i = get_global_id(0);
   if (i >= n) return;
   uint c = first ? i : list[i];
@@ -271,9 +271,14 @@ __kernel void lazy_pass1_round(uint n, int first, __global const uint* list, __g
   }
   uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
   int dir = tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule);
-  uchar r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, nb_off, nb, nb_edge, labels, use_labels, pts,
-                                vflags, eflags, eps_v, q_min);
-  atomic_inc(&counters[4]);
+  /* a verdict carried from an earlier iteration (the rings of a and b are unchanged since) */
+  uchar r = verdict[e];
+  if (r == TCC_VERDICT_UNKNOWN) {
+    r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, nb_off, nb, nb_edge, labels, use_labels, pts,
+                            vflags, eflags, eps_v, q_min);
+    verdict[e] = r;
+    atomic_inc(&counters[4]);
+  }
   reason[e] = r;
   if (r == TCC_OK) {
     edge_dir[e] = (uchar)dir;

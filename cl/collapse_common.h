@@ -38,6 +38,7 @@
 #define TCC_REFUSED_VOLUME 4
 #define TCC_REFUSED_QUALITY 6 /* 5 is the host's "untested" */
 #define TCC_UNTESTED 5 /* lazy filter: marked, passed Q, never tested (a cheaper rival won) */
+#define TCC_VERDICT_UNKNOWN 0xff /* collapse_verdicts.cl: no test result kept for the edge */
 
 /* Per-edge states of the conflict passes and of the lazy admissible filter. */
 #define TCC_UNDECIDED 0

@@ -49,12 +49,28 @@ inline void tcc_sort_segment(__global int* a, uint n) {
  * it (nb_count) and its part above v (up_count). */
 __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __global const uint* vt_off,
                                         __global int* vt, __global int* scratch, __global uint* nb_count,
-                                        __global uint* up_count) {
+                                        __global uint* up_count, int carry, __global const uchar* ndirty,
+                                        __global const int* vold, __global const int* vmap,
+                                        __global const uint* prev_nb_off, __global const int* prev_nb) {
   uint v = get_global_id(0);
   if (v >= nv) return;
   uint b = vt_off[v], n = vt_off[v + 1] - b;
   tcc_sort_segment(vt + b, n);
   __global int* s = scratch + 3 * b;
+  if (carry && !ndirty[v]) {
+    /* ring(v) unchanged (collapse_verdicts.cl): N(v) is the previous one renumbered; none of
+     * its vertices was removed and compaction keeps their order, so it stays sorted */
+    int o = vold[v];
+    uint pb = prev_nb_off[o], m = prev_nb_off[o + 1] - pb, up = 0;
+    for (uint i = 0; i < m; ++i) {
+      int u = vmap[prev_nb[pb + i]];
+      s[i] = u;
+      up += u > (int)v ? 1u : 0u;
+    }
+    nb_count[v] = m;
+    up_count[v] = up;
+    return;
+  }
   /* N(v) is built by insertion into a sorted private list (short: ~15 entries), spilling to the
    * global scratch area only when it outgrows TCC_MAX_NB */
   int loc[TCC_MAX_NB];
@@ -145,9 +161,31 @@ __kernel void conn_lower_edges(uint nv, __global const uint* nb_off, __global co
  * vertex), O(k^2) per vertex instead of a ring scan per face. A vertex with more such faces
  * than TCC_MAX_MIN_FACES falls back to the ring scan for its faces. */
 __kernel void conn_tet_neighbours(uint nv, __global const int* tets, __global const uint* vt_off,
-                                  __global const int* vt, __global int* tet_nbr) {
+                                  __global const int* vt, __global int* tet_nbr, int carry,
+                                  __global const uchar* ndirty, __global const int* told,
+                                  __global const uint* tnew, __global const int* prev_tet_nbr) {
   uint v = get_global_id(0);
   if (v >= nv) return;
+  if (carry && !ndirty[v]) {
+    /* ring(v) is unchanged since the previous iteration (collapse_verdicts.cl): the tet across
+     * each face of it is a kept tet of ring(v), its new index tnew[previous index]; compaction
+     * keeps the order of the vertices of every tet, so the local face numbers are the same */
+    for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
+      int t = vt[i];
+      __global const int* q = tets + 4 * t;
+      int lv = tcc_local(tets, t, (int)v);
+      for (int f = 0; f < 4; ++f) {
+        if (f == lv) continue;
+        int ok = 1;
+        for (int j = 0; j < 4; ++j)
+          if (j != f && j != lv && q[j] < (int)v) ok = 0;
+        if (!ok) continue; /* v is not the smallest vertex of this face */
+        int o = prev_tet_nbr[4 * told[t] + f];
+        tet_nbr[4 * t + f] = o < 0 ? o : (int)tnew[o];
+      }
+    }
+    return;
+  }
   int ft[TCC_MAX_MIN_FACES];
   uchar ff[TCC_MAX_MIN_FACES];
   ulong key[TCC_MAX_MIN_FACES];
@@ -198,9 +236,14 @@ __kernel void conn_tet_neighbours(uint nv, __global const int* tets, __global co
 /* vflags: S membership of every vertex, from the faces around it. */
 __kernel void conn_vertex_flags(uint nv, __global const int* tets, __global const uint* vt_off,
                                 __global const int* vt, __global const int* tet_nbr, __global const int* labels,
-                                int use_labels, __global uchar* vflags) {
+                                int use_labels, __global uchar* vflags, int carry, __global const uchar* ndirty,
+                                __global const int* vold, __global const uchar* prev_vflags) {
   uint v = get_global_id(0);
   if (v >= nv) return;
+  if (carry && !ndirty[v]) { /* ring(v) unchanged */
+    vflags[v] = prev_vflags[vold[v]];
+    return;
+  }
   uint flags = 0;
   for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
     int t = vt[i];
@@ -221,10 +264,20 @@ __kernel void conn_vertex_flags(uint nv, __global const int* tets, __global cons
 __kernel void conn_edge_flags(uint ne, __global const int* edges, __global const int* tets,
                               __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
                               __global const int* labels, int use_labels, __global const double* pts, double eps_r,
-                              __global const uchar* vflags, __global uchar* eflags) {
+                              __global const uchar* vflags, __global uchar* eflags, int carry,
+                              __global const uchar* ndirty, __global const int* vold,
+                              __global const uint* prev_nb_off, __global const int* prev_nb,
+                              __global const int* prev_nb_edge, __global const uchar* prev_eflags) {
   uint e = get_global_id(0);
   if (e >= ne) return;
   int a = edges[2 * e], b = edges[2 * e + 1];
+  if (carry && !ndirty[a]) { /* ring(a), which decides the flags, is unchanged */
+    int eo = tcc_edge_id(prev_nb_off, prev_nb, prev_nb_edge, vold[a], vold[b]);
+    if (eo >= 0) {
+      eflags[e] = prev_eflags[eo];
+      return;
+    }
+  }
   uint flags = 0;
   if (!vflags[a] || !vflags[b]) { /* an S-edge joins two S vertices */
     eflags[e] = 0;
@@ -288,9 +341,15 @@ __kernel void conn_vertex_class(uint nv, __global const int* tets, __global cons
                                 int use_labels,
                                 __global const double* pts, __global const uint* nb_off,
                                 __global const int* nb_edge, __global const uchar* eflags, double eps_f,
-                                __global const uchar* vflags, __global uchar* vclass) {
+                                __global const uchar* vflags, __global uchar* vclass, int carry,
+                                __global const uchar* ndirty, __global const int* vold,
+                                __global const uchar* prev_vclass) {
   uint v = get_global_id(0);
   if (v >= nv) return;
+  if (carry && !ndirty[v]) { /* ring(v) unchanged */
+    vclass[v] = prev_vclass[vold[v]];
+    return;
+  }
   if (!vflags[v]) {
     vclass[v] = TCC_INTERIOR;
     return;

@@ -124,11 +124,12 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     s.vertices = dm.nv;
     s.tets = dm.nt;
     double t0 = now();
-    build_connectivity(ctx, dm, conn, p);
+    build_connectivity(ctx, dm, conn, p, options.reuse_across_iterations ? &st : nullptr);
     ctx.finish();
     double t1 = now();
     s.seconds_connectivity = t1 - t0;
     s.edges = conn.ne;
+    if (options.reuse_across_iterations) carry_verdicts(ctx, dm, conn, st);
     if (it == 0 && !(p.target > 0)) {
       // the target from the input's median edge length, on the device's edge list
       StageParams q = p;
@@ -153,7 +154,11 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     s.collapsed = s.after_pass2;
     double t5 = now();
     s.seconds_pass2 = t5 - t4;
-    if (s.collapsed > 0) collapse_and_compact(ctx, dm, next, conn, st, origin, n_origin);
+    if (s.collapsed > 0) {
+      if (options.reuse_across_iterations) remember_for_carry(ctx, dm, conn, st);
+      collapse_and_compact(ctx, dm, next, conn, st, origin, n_origin);
+      if (options.reuse_across_iterations) note_compaction(ctx, dm, conn, st);
+    }
     ctx.finish();
     double t6 = now();
     s.seconds_collapse = t6 - t5;

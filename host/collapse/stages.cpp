@@ -138,6 +138,42 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
   dm.vmask = DeviceBuffer<uint8_t>(ctx, o.vertex_mask);
 }
 
+void remember_for_carry(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
+  ensure(s.vdirty, ctx, dm.nv);
+  run(ctx, "collapse_verdicts.cl", "verdict_dirty", dm.nv, "", U(dm.nv), B(s.vaff), B(c.nb_off), B(c.nb),
+      B(s.vdirty));
+  s.prev_nv = dm.nv;
+  s.prev_nt = dm.nt;
+}
+
+void note_compaction(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
+  // collapse_and_compact left keep flags in c.count and new indices in c.cursor (old numbering)
+  ensure(s.vold, ctx, dm.nv);
+  ensure(s.ndirty, ctx, dm.nv);
+  run(ctx, "collapse_verdicts.cl", "verdict_vertex_old", s.prev_nv, "", U(s.prev_nv), B(c.count), B(c.cursor),
+      B(s.vdirty), B(s.vold), B(s.ndirty));
+  ensure(s.told, ctx, dm.nt);
+  run(ctx, "collapse_verdicts.cl", "verdict_tet_old", s.prev_nt, "", U(s.prev_nt), B(s.tkeep), B(s.tnew), B(s.told));
+  std::swap(s.prev_nb_off, c.nb_off);
+  std::swap(s.prev_nb, c.nb);
+  std::swap(s.prev_nb_edge, c.nb_edge);
+  std::swap(s.prev_tet_nbr, c.tet_nbr);
+  std::swap(s.prev_vflags, c.vflags);
+  std::swap(s.prev_vclass, c.vclass);
+  std::swap(s.prev_eflags, c.eflags);
+  std::swap(s.prev_verdict, s.verdict);
+  s.has_prev = true;
+}
+
+void carry_verdicts(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s) {
+  ensure(s.verdict, ctx, c.ne);
+  s.verdict_ready = s.has_prev;
+  if (!s.has_prev) return;
+  run(ctx, "collapse_verdicts.cl", "verdict_carry", c.ne, "", U(c.ne), B(c.edges), B(s.vold), B(s.vdirty),
+      B(s.prev_nb_off), B(s.prev_nb), B(s.prev_nb_edge), B(s.prev_verdict), B(s.verdict));
+  s.has_prev = false;
+}
+
 void download_mesh(const DeviceMesh& dm, Mesh& mesh) {
   mesh.points = dm.points.download_range(0, size_t(dm.nv) * 3);
   mesh.tets = dm.tets.download_range(0, size_t(dm.nt) * 4);
@@ -156,7 +192,7 @@ void download_mesh(const DeviceMesh& dm, Mesh& mesh) {
   unpack(mesh.tet_fields, dm.tfields, dm.tfield_comps, dm.nt);
 }
 
-void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const StageParams& p) {
+void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const StageParams& p, const EdgeState* carry) {
   const std::string F = "collapse_connectivity.cl";
   const uint32_t nv = dm.nv, nt = dm.nt;
   ensure(c.count, ctx, nv);
@@ -170,8 +206,16 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   ensure(c.scratch, ctx, size_t(nt) * 12);
   ensure(c.up_count, ctx, nv);
   // c.count is reused for |N(v)|
+  const bool cy = carry && carry->has_prev;
+  const cl_int ci = cy ? 1 : 0;
+  // carried data when cy (collapse_verdicts.cl), placeholders otherwise
+  const cl::Buffer& nd = cy ? B(carry->ndirty) : B(c.count);
+  const cl::Buffer& vo = cy ? B(carry->vold) : B(c.count);
+  const cl::Buffer& vm = cy ? B(carry->vmap) : B(c.count);
+  const cl::Buffer& pno = cy ? B(carry->prev_nb_off) : B(c.count);
+  const cl::Buffer& pnb = cy ? B(carry->prev_nb) : B(c.count);
   run(ctx, F, "conn_ring_sort_and_gather", nv, "", B(dm.tets), U(nv), B(c.vt_off), B(c.vt), B(c.scratch),
-      B(c.count), B(c.up_count));
+      B(c.count), B(c.up_count), ci, nd, vo, vm, pno, pnb);
   uint32_t nnb = scan_offsets(ctx, c.count, c.nb_off, nv);
   c.ne = scan_offsets(ctx, c.up_count, c.edge_off, nv);
   ensure(c.nb, ctx, nnb);
@@ -185,13 +229,22 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   ensure(c.vclass, ctx, nv);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   ensure(c.tet_nbr, ctx, size_t(nt) * 4);
-  run(ctx, F, "conn_tet_neighbours", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr));
+  // carried boundary data
+  const cl::Buffer& to = cy ? B(carry->told) : B(c.vt);
+  const cl::Buffer& tn = cy ? B(carry->tnew) : B(c.vt_off);
+  const cl::Buffer& pt = cy ? B(carry->prev_tet_nbr) : B(c.vt);
+  const cl::Buffer& pvf = cy ? B(carry->prev_vflags) : B(c.vflags);
+  const cl::Buffer& pvc = cy ? B(carry->prev_vclass) : B(c.vflags);
+  const cl::Buffer& pef = cy ? B(carry->prev_eflags) : B(c.vflags);
+  const cl::Buffer& pne = cy ? B(carry->prev_nb_edge) : B(c.nb_edge);
+  run(ctx, F, "conn_tet_neighbours", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), ci, nd, to, tn, pt);
   run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
-      use_labels, B(c.vflags));
+      use_labels, B(c.vflags), ci, nd, vo, pvf);
   run(ctx, F, "conn_edge_flags", c.ne, "", U(c.ne), B(c.edges), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr),
-      primary_labels(dm), use_labels, B(dm.points), p.eps_r, B(c.vflags), B(c.eflags));
+      primary_labels(dm), use_labels, B(dm.points), p.eps_r, B(c.vflags), B(c.eflags), ci, nd, vo, pno, pnb, pne, pef);
   run(ctx, F, "conn_vertex_class", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
-      use_labels, B(dm.points), B(c.nb_off), B(c.nb_edge), B(c.eflags), p.eps_f, B(c.vflags), B(c.vclass));
+      use_labels, B(dm.points), B(c.nb_off), B(c.nb_edge), B(c.eflags), p.eps_f, B(c.vflags), B(c.vclass), ci, nd, vo,
+      pvc);
 }
 
 namespace {
@@ -313,13 +366,17 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   s.vaff.fill(-1);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   const cl_int mode = p.mode, paper_rule = p.paper_rule ? 1 : 0;
+  ensure(s.verdict, ctx, c.ne);
+  if (!s.verdict_ready) s.verdict.fill(0xff);  // TCC_VERDICT_UNKNOWN
+  s.verdict_ready = false;
   run(ctx, A, "lazy_init", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(c.vflags), B(c.vclass), B(c.eflags), mode,
       paper_rule, B(s.state), B(s.dir), B(s.reason), B(s.cand), B(s.counters));
   const uint32_t n = prepare_candidates(ctx, s, s.cand, c.ne);
   cl::Kernel round = ctx.kernel(A, "lazy_pass1_round");
   set_round_args(round, "lazy_pass1_round", B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt), B(c.nb_off),
                  B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass),
-                 B(c.eflags), mode, paper_rule, p.eps_v, p.min_quality, B(s.state), B(s.dir), B(s.reason), B(s.counters));
+                 B(c.eflags), mode, paper_rule, p.eps_v, p.min_quality, B(s.state), B(s.dir), B(s.reason), B(s.counters),
+                 B(s.verdict));
   worklist_rounds(ctx, round, s, n, "lazy_pass1_round");
   run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1),
       B(s.vaff), B(s.counters));
@@ -353,7 +410,8 @@ void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connec
   DeviceBuffer<uint32_t>& vnew = c.cursor;
   run(ctx, F, "vertex_keep", nv, "", U(nv), B(s.vaff), B(c.edges), B(s.dir), B(vkeep));
   const uint32_t nv2 = dev::exclusive_scan(ctx, vkeep, vnew, nv);
-  DeviceBuffer<int32_t> vmap(ctx, nv);
+  DeviceBuffer<int32_t>& vmap = s.vmap;  // kept for build_connectivity's carry
+  ensure(vmap, ctx, nv);
   run(ctx, F, "vertex_map", nv, "", U(nv), B(s.vaff), B(c.edges), B(s.dir), B(vnew), B(vkeep), B(vmap));
   next.nv = nv2;
   ensure(next.points, ctx, size_t(nv2) * 3);
@@ -367,7 +425,10 @@ void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connec
       B(next.points), U(dm.vfield_comps), B(dm.vfields), B(next.vfields), I(dm.has_mask ? 1 : 0), B(dm.vmask),
       B(next.vmask));
   // tets
-  DeviceBuffer<uint32_t> tkeep(ctx, nt), tnew(ctx, nt);
+  DeviceBuffer<uint32_t>& tkeep = s.tkeep;  // kept for note_compaction
+  DeviceBuffer<uint32_t>& tnew = s.tnew;
+  ensure(tkeep, ctx, nt);
+  ensure(tnew, ctx, nt);
   run(ctx, F, "tet_keep", nt, "", U(nt), B(dm.tets), B(s.vaff), B(c.edges), B(tkeep));
   const uint32_t nt2 = dev::exclusive_scan(ctx, tkeep, tnew, nt);
   next.nt = nt2;

@@ -55,6 +55,23 @@ struct EdgeState {
   DeviceBuffer<int32_t> vaff;       // per vertex
   // marked, admissible, pass1, pass2, tested (lazy), passed Q (lazy)
   DeviceBuffer<uint32_t> counters;
+  // Verdicts of the link and volume tests kept across iterations (collapse_verdicts.cl):
+  // verdict[e] is the reason of a test of e (TCC_OK or a refusal) or TCC_VERDICT_UNKNOWN.
+  // Carried to the next iteration for the edges whose end points' rings did not change.
+  DeviceBuffer<uint8_t> verdict;
+  bool verdict_ready = false;  // verdict holds carried values (else lazy_admissible_pass1 clears it)
+  // what carry_verdicts needs from the previous iteration
+  bool has_prev = false;
+  uint32_t prev_nv = 0, prev_nt = 0;
+  DeviceBuffer<uint8_t> prev_verdict, vdirty;  // vdirty per previous vertex
+  DeviceBuffer<uint8_t> ndirty;                // per current vertex: vdirty of its previous self
+  DeviceBuffer<int32_t> vold;                  // current vertex -> previous vertex
+  DeviceBuffer<int32_t> vmap;                  // previous vertex -> current (collapse_and_compact)
+  DeviceBuffer<int32_t> told;                  // current tet -> previous tet
+  DeviceBuffer<uint32_t> tkeep, tnew;          // previous tet: kept, new index (collapse_and_compact)
+  DeviceBuffer<uint32_t> prev_nb_off;
+  DeviceBuffer<int32_t> prev_nb, prev_nb_edge, prev_tet_nbr;
+  DeviceBuffer<uint8_t> prev_vflags, prev_vclass, prev_eflags;
 };
 
 enum Reason : uint8_t {
@@ -76,7 +93,11 @@ StageParams params_from(const CollapseOptions& o);
 
 void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm);
 
-void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const StageParams& p);
+// With carry (an EdgeState after note_compaction), the boundary data (tet_nbr, vflags, vclass,
+// eflags) of the vertices whose rings did not change is copied from the previous iteration
+// instead of recomputed.
+void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const StageParams& p,
+                        const EdgeState* carry = nullptr);
 // Returns the number of marked edges.
 uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p);
 // Tests every marked edge (adm, dir, reason); returns the number of admissible edges.
@@ -93,6 +114,14 @@ uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
 // vertex -> current vertex) is updated when non-empty.
 void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connectivity& c, EdgeState& s,
                           DeviceBuffer<int32_t>& origin, uint32_t n_origin);
+
+// Verdict carrying around collapse_and_compact: remember_for_carry() before it (dirty vertices:
+// the end points of the final edges and their neighbours), note_compaction() right after it
+// (previous connectivity and verdicts kept, current -> previous vertex map), carry_verdicts()
+// after the next build_connectivity (fills s.verdict for the next lazy_admissible_pass1).
+void remember_for_carry(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
+void note_compaction(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
+void carry_verdicts(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
 
 void download_mesh(const DeviceMesh& dm, Mesh& mesh);
 

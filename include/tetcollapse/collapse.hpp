@@ -99,6 +99,9 @@ struct CollapseOptions {
   // 1 regular, -> 0 sliver) of the tets it reshapes would fall below min(their worst quality
   // before, min_quality). 0 turns it off (the paper's behaviour: only eps_v is checked).
   double min_quality = 0.1;
+  // Reuse work across iterations: verdicts of the link and volume tests of edges whose rings
+  // did not change. Same result either way (a test compares both); false recomputes everything.
+  bool reuse_across_iterations = true;
 
   // Adaptive marking: with a non-empty mask (one byte per input vertex, non-zero = selected),
   // only edges whose both end points are selected are marked, or either end point with

@@ -1,6 +1,7 @@
 // Stage 1 (device connectivity of an iteration) against the CPU reference tc::build_topology.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "collapse/stages.hpp"
@@ -120,5 +121,63 @@ TEST(CollapseConnectivity, SharedMeshesMatchBuildTopology) {
     }
     SCOPED_TRACE(name);
     compare_with_reference(ctx, m);
+  }
+}
+
+// Connectivity carried from the previous iteration (build_connectivity with the EdgeState after
+// note_compaction) equals a fresh build of the coarsened mesh, through several iterations.
+TEST(CollapseConnectivity, CarriedAfterCollapsesEqualsFreshBuild) {
+  Context ctx;
+  std::vector<std::pair<std::string, Mesh>> inputs{{"two materials", two_materials(6)}};
+  std::string path = test::shared_mesh("polyfem_bimetal.msh");
+  if (!path.empty()) {
+    try {
+      inputs.emplace_back("polyfem_bimetal.msh", read_mesh(path));
+    } catch (const std::exception&) {
+    }
+  }
+  for (const auto& [name, mesh] : inputs) {
+    SCOPED_TRACE(name);
+    CollapseOptions o;
+    StageParams p = params_from(o);
+    DeviceMesh dm, next;
+    upload_mesh(ctx, mesh, o, dm);
+    Connectivity c;
+    EdgeState s;
+    DeviceBuffer<int32_t> origin(ctx, 0);
+    build_connectivity(ctx, dm, c, p);
+    std::vector<double> len = [&] {
+      StageParams q = p;
+      q.target = 1e300;  // every edge marked: cost = length
+      cost_and_mark(ctx, dm, c, s, q);
+      return s.cost.download_range(0, c.ne);
+    }();
+    std::nth_element(len.begin(), len.begin() + len.size() / 2, len.end());
+    p.target = 2 * len[len.size() / 2];
+    int carried_iterations = 0;
+    for (int it = 0; it < 4; ++it) {
+      cost_and_mark(ctx, dm, c, s, p);
+      uint32_t passed_q = 0, tested = 0;
+      lazy_admissible_pass1(ctx, dm, c, s, p, passed_q, tested);
+      if (conflict_pass2(ctx, dm, c, s) == 0) break;
+      remember_for_carry(ctx, dm, c, s);
+      collapse_and_compact(ctx, dm, next, c, s, origin, 0);
+      note_compaction(ctx, dm, c, s);
+      Connectivity fresh;
+      build_connectivity(ctx, dm, fresh, p);
+      build_connectivity(ctx, dm, c, p, &s);
+      carry_verdicts(ctx, dm, c, s);
+      ASSERT_EQ(c.ne, fresh.ne);
+      EXPECT_EQ(c.edges.download_range(0, 2 * size_t(c.ne)), fresh.edges.download_range(0, 2 * size_t(c.ne)));
+      EXPECT_EQ(c.tet_nbr.download_range(0, 4 * size_t(dm.nt)), fresh.tet_nbr.download_range(0, 4 * size_t(dm.nt)));
+      EXPECT_EQ(c.vflags.download_range(0, dm.nv), fresh.vflags.download_range(0, dm.nv));
+      EXPECT_EQ(c.vclass.download_range(0, dm.nv), fresh.vclass.download_range(0, dm.nv));
+      EXPECT_EQ(c.eflags.download_range(0, c.ne), fresh.eflags.download_range(0, c.ne));
+      // some vertices were carried, not recomputed (else this test would test nothing)
+      std::vector<uint8_t> nd = s.ndirty.download_range(0, dm.nv);
+      EXPECT_GT(std::count(nd.begin(), nd.end(), uint8_t(0)), 0) << "iteration " << it;
+      ++carried_iterations;
+    }
+    EXPECT_GE(carried_iterations, 2);
   }
 }

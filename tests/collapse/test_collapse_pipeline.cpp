@@ -215,3 +215,60 @@ TEST(CollapsePipeline, SharedMeshesCoarsenedToMedianStayValid) {
     EXPECT_FALSE(c.reference.topology_changed);
   }
 }
+
+// Work kept across iterations (carried verdicts, and what else reuse_across_iterations covers)
+// changes nothing: same mesh bit for bit and the same decisions per iteration as recomputing
+// everything, in every boundary mode, with and without the quality guard.
+TEST(CollapsePipeline, ReuseAcrossIterationsGivesTheSameResult) {
+  Context ctx;
+  std::vector<std::pair<std::string, Mesh>> inputs;
+  {
+    Mesh cube = test::cube_tets(6);
+    Labels l{"material", {}};
+    for (int64_t t = 0; t < cube.num_tets(); ++t) l.values.push_back(cube.points[3 * cube.tets[4 * t] + 1] < 0.4 ? 1 : 2);
+    cube.tet_labels.push_back(l);
+    inputs.emplace_back("cube", cube);
+  }
+  for (const char* name : {"polyfem_screw.msh", "polyfem_bimetal.msh"}) {
+    std::string path = test::shared_mesh(name);
+    if (path.empty()) continue;  // the cube alone still compares both ways
+    try {
+      inputs.emplace_back(name, read_mesh(path));
+    } catch (const std::exception&) {
+    }
+  }
+  int compared = 0;
+  int64_t all_tested_a = 0, all_tested_b = 0;
+  for (const auto& [name, in] : inputs)
+    for (auto mode : {CollapseOptions::Strict, CollapseOptions::Features, CollapseOptions::Free})
+      for (double q : {0.0, 0.1}) {
+        if (name != "cube" && mode != CollapseOptions::Features) continue;  // keeps the test short
+        SCOPED_TRACE(name + " mode " + std::to_string(int(mode)) + " min_quality " + std::to_string(q));
+        CollapseOptions o;
+        o.target_factor = 2;
+        o.boundary = mode;
+        o.min_quality = q;
+        Mesh a = in, b = in;
+        o.reuse_across_iterations = true;
+        CollapseReport ra = collapse(a, o, ctx);
+        o.reuse_across_iterations = false;
+        CollapseReport rb = collapse(b, o, ctx);
+        EXPECT_EQ(a.points, b.points);
+        EXPECT_EQ(a.tets, b.tets);
+        ASSERT_EQ(ra.iterations.size(), rb.iterations.size());
+        int64_t tested_a = 0, tested_b = 0;
+        for (size_t i = 0; i < ra.iterations.size(); ++i) {
+          EXPECT_EQ(ra.iterations[i].after_pass1, rb.iterations[i].after_pass1) << "iteration " << i;
+          EXPECT_EQ(ra.iterations[i].collapsed, rb.iterations[i].collapsed) << "iteration " << i;
+          tested_a += ra.iterations[i].tested;
+          tested_b += rb.iterations[i].tested;
+        }
+        EXPECT_LE(tested_a, tested_b);  // carried verdicts are not tested again
+        all_tested_a += tested_a;
+        all_tested_b += tested_b;
+        EXPECT_GT(ra.iterations.size(), 2u);
+        ++compared;
+      }
+  EXPECT_GE(compared, 6);  // the cube alone: 3 modes x 2 guards
+  EXPECT_LT(all_tested_a, all_tested_b);
+}

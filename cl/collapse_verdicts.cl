@@ -1,0 +1,54 @@
+/* Verdicts of the link and volume tests kept across iterations.
+ *
+ * The verdict of edge (a, b) depends only on ring(a) U ring(b): the tets, their vertices'
+ * positions, labels and flags, and vflags of the common neighbours of a and b (a surviving
+ * vertex keeps its S membership: collapses preserve the boundary's topology). A collapse of
+ * (u, s) changes exactly the rings of the vertices of ring(u) U ring(s) = {u, s} U N(u) U N(s),
+ * so an edge neither of whose end points is such a vertex keeps its verdict. Such an edge exists
+ * in the previous mesh as (vold[a], vold[b]) (compaction keeps the order of the kept vertices).
+ */
+#include "collapse_common.h"
+
+/* vdirty[v]: v is an end point of a final edge (vaff[v] >= 0 after conflict_finalize) or a
+ * neighbour of one. */
+__kernel void verdict_dirty(uint nv, __global const int* vaff, __global const uint* nb_off, __global const int* nb,
+                            __global uchar* vdirty) {
+  uint v = get_global_id(0);
+  if (v >= nv) return;
+  uchar d = vaff[v] >= 0;
+  for (uint i = nb_off[v]; i < nb_off[v + 1] && !d; ++i) d = vaff[nb[i]] >= 0;
+  vdirty[v] = d;
+}
+
+/* vold[new index] = previous index and ndirty[new index] = vdirty, for the kept vertices (all
+ * vertices of the new mesh are kept vertices). */
+__kernel void verdict_vertex_old(uint nv_prev, __global const uint* keep, __global const uint* newidx,
+                                 __global const uchar* vdirty, __global int* vold, __global uchar* ndirty) {
+  uint v = get_global_id(0);
+  if (v >= nv_prev || !keep[v]) return;
+  vold[newidx[v]] = (int)v;
+  ndirty[newidx[v]] = vdirty[v];
+}
+
+/* told[new index] = previous index, for the kept tets. */
+__kernel void verdict_tet_old(uint nt_prev, __global const uint* keep, __global const uint* newidx,
+                              __global int* told) {
+  uint t = get_global_id(0);
+  if (t >= nt_prev || !keep[t]) return;
+  told[newidx[t]] = (int)t;
+}
+
+__kernel void verdict_carry(uint ne, __global const int* edges, __global const int* vold,
+                            __global const uchar* vdirty, __global const uint* prev_nb_off,
+                            __global const int* prev_nb, __global const int* prev_nb_edge,
+                            __global const uchar* prev_verdict, __global uchar* verdict) {
+  uint e = get_global_id(0);
+  if (e >= ne) return;
+  int oa = vold[edges[2 * e]], ob = vold[edges[2 * e + 1]];
+  uchar r = TCC_VERDICT_UNKNOWN;
+  if (!vdirty[oa] && !vdirty[ob]) {
+    int eo = tcc_edge_id(prev_nb_off, prev_nb, prev_nb_edge, oa, ob);
+    if (eo >= 0) r = prev_verdict[eo];
+  }
+  verdict[e] = r;
+}
