@@ -86,6 +86,8 @@ def coarsen(cli, mesh, method, strict, tmp):
                    seconds=s.get("seconds_total"), seconds_collapse=s.get("seconds_collapse"),
                    check=s.get("check"), device=s.get("device"))
     verdict = "valid" if code == 0 and s.get("check") == "valid" else ("invalid" if code == 1 else "error")
+    if verdict == "invalid" and "reference_invalid" in se + so:
+        verdict = "input_invalid"  # the checker says the input already had the defect
     if verdict != "valid":
         rec["message"] = first_error_lines(se + so)
     if strict and verdict == "valid":
@@ -117,8 +119,11 @@ def one(task):
                 dest = os.path.join(failures, f"{name}.{method}.{mode}")
                 os.makedirs(dest, exist_ok=True)
                 shutil.copy(mesh, dest)
-                if os.path.exists(out):
-                    shutil.copy(out, os.path.join(dest, "out.msh"))
+                # --check does not write an invalid result: write it again without --check.
+                cmd = [a for a in rec["command"].split() if a != "--check"]
+                cmd = [cli, mesh, os.path.join(dest, "out.msh")] + cmd[3:cmd.index("--stats")] + \
+                    cmd[cmd.index("--stats") + 2:]
+                run(cmd)
                 with open(os.path.join(dest, "record.json"), "w") as f:
                     json.dump(rec, f, indent=1)
             if os.path.exists(out):
@@ -164,7 +169,8 @@ def write_readme(path, doc):
              "(`tetcollapse check OUT --reference IN --json -`). Any invalid output fails the campaign.", "",
              "## Summary", "",
              f"- **{s['meshes']} meshes, {s['runs']} runs: {s['valid']} valid, {s['invalid']} invalid, "
-             f"{s['error']} errors** (crash, refused input or timeout)",
+             f"{s['error']} errors** (crash, refused input or timeout), {s['input_invalid']} runs on inputs the checker "
+             "finds invalid (not counted as failures)",
              f"- methods run: {', '.join(doc['methods_run'])}"]
     for m, why in doc["methods_skipped"].items():
         lines.append(f"- method `{m}` skipped: the CLI rejects its option (`{why}`)")
@@ -224,6 +230,7 @@ def main():
     ap.add_argument("--sample", type=int, default=0, help="only N meshes spread evenly over the sorted corpus")
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--out", default=os.path.join(ROOT, "bench", "robustness"))
+    ap.add_argument("--commit", help="the commit the CLI was built from (default: this checkout's HEAD)")
     args = ap.parse_args()
 
     cli = os.path.abspath(args.cli)
@@ -252,7 +259,7 @@ def main():
         sys.exit("robustness.py: no method left to run")
 
     out_dir = os.path.abspath(args.out)
-    failures = os.path.join(os.path.dirname(out_dir), "robustness-failures")
+    failures = os.path.join(ROOT, "build", "robustness-failures")
     if os.path.isdir(failures):
         shutil.rmtree(failures)
     tasks = [(cli, os.path.join(args.corpus, manifest[n]["file"]), n, m, failures) for n in names for m in methods]
@@ -268,7 +275,7 @@ def main():
     wall = time.monotonic() - t0
 
     runs = [r[mode] for r in results for mode in ("features", "strict")]
-    count = {v: sum(1 for x in runs if x["verdict"] == v) for v in ("valid", "invalid", "error")}
+    count = {v: sum(1 for x in runs if x["verdict"] == v) for v in ("valid", "invalid", "error", "input_invalid")}
     cats = {}
     for r in results:
         c = cats.setdefault(r["category"], [])
@@ -289,7 +296,7 @@ def main():
         "command": cmd,
         "corpus_command": f"scripts/make_corpus.py {os.path.relpath(args.corpus, ROOT)}",
         "cli": os.path.relpath(cli, ROOT),
-        "machine": machine(), "device": device, "commit": commit(),
+        "machine": machine(), "device": device, "commit": args.commit or commit(),
         "date": datetime.datetime.now().strftime("%Y-%m-%d %H:%M"),
         "jobs": args.jobs, "wall_seconds": wall,
         "methods_run": methods, "methods_skipped": skipped,
