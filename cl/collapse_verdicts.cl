@@ -23,11 +23,13 @@ __kernel void verdict_dirty(uint nv, __global const int* vaff, __global const ui
 /* vold[new index] = previous index and ndirty[new index] = vdirty, for the kept vertices (all
  * vertices of the new mesh are kept vertices). */
 __kernel void verdict_vertex_old(uint nv_prev, __global const uint* keep, __global const uint* newidx,
-                                 __global const uchar* vdirty, __global int* vold, __global uchar* ndirty) {
+                                 __global const uchar* vdirty, __global int* vold, __global uchar* ndirty,
+                                 __global uint* dirty_flags) {
   uint v = get_global_id(0);
   if (v >= nv_prev || !keep[v]) return;
   vold[newidx[v]] = (int)v;
   ndirty[newidx[v]] = vdirty[v];
+  dirty_flags[newidx[v]] = vdirty[v];
 }
 
 /* told[new index] = previous index, for the kept tets. */

@@ -150,8 +150,9 @@ void note_compaction(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s
   // collapse_and_compact left keep flags in c.count and new indices in c.cursor (old numbering)
   ensure(s.vold, ctx, dm.nv);
   ensure(s.ndirty, ctx, dm.nv);
+  ensure(s.dirty_flags, ctx, dm.nv);
   run(ctx, "collapse_verdicts.cl", "verdict_vertex_old", s.prev_nv, "", U(s.prev_nv), B(c.count), B(c.cursor),
-      B(s.vdirty), B(s.vold), B(s.ndirty));
+      B(s.vdirty), B(s.vold), B(s.ndirty), B(s.dirty_flags));
   ensure(s.told, ctx, dm.nt);
   run(ctx, "collapse_verdicts.cl", "verdict_tet_old", s.prev_nt, "", U(s.prev_nt), B(s.tkeep), B(s.tnew), B(s.told));
   std::swap(s.prev_nb_off, c.nb_off);
@@ -237,7 +238,18 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   const cl::Buffer& pvc = cy ? B(carry->prev_vclass) : B(c.vflags);
   const cl::Buffer& pef = cy ? B(carry->prev_eflags) : B(c.vflags);
   const cl::Buffer& pne = cy ? B(carry->prev_nb_edge) : B(c.nb_edge);
-  run(ctx, F, "conn_tet_neighbours", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), ci, nd, to, tn, pt);
+  if (cy) {
+    run(ctx, F, "conn_tet_neighbours_carry", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), nd, to, tn,
+        pt);
+    // the full matching only for the dirty vertices
+    ensure(c.dirty_list, ctx, nv);
+    const uint32_t nd_count = dev::compact_indices(ctx, carry->dirty_flags, c.dirty_list, nv);
+    run(ctx, F, "conn_tet_neighbours", nd_count, "", U(nd_count), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr),
+        cl_int(1), B(c.dirty_list));
+  } else {
+    run(ctx, F, "conn_tet_neighbours", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), cl_int(0),
+        B(c.vt_off));
+  }
   run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
       use_labels, B(c.vflags), ci, nd, vo, pvf);
   run(ctx, F, "conn_edge_flags", c.ne, "", U(c.ne), B(c.edges), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr),

@@ -40,6 +40,7 @@ struct Connectivity {
   // scratch
   DeviceBuffer<uint32_t> count, cursor, up_count;
   DeviceBuffer<int32_t> scratch;
+  DeviceBuffer<uint32_t> dirty_list;  // vertices recomputed when carrying (build_connectivity)
 };
 
 // Per-edge and per-vertex state of the later stages.
@@ -65,6 +66,7 @@ struct EdgeState {
   uint32_t prev_nv = 0, prev_nt = 0;
   DeviceBuffer<uint8_t> prev_verdict, vdirty;  // vdirty per previous vertex
   DeviceBuffer<uint8_t> ndirty;                // per current vertex: vdirty of its previous self
+  DeviceBuffer<uint32_t> dirty_flags;          // the same as 0/1 words (for compact_indices)
   DeviceBuffer<int32_t> vold;                  // current vertex -> previous vertex
   DeviceBuffer<int32_t> vmap;                  // previous vertex -> current (collapse_and_compact)
   DeviceBuffer<int32_t> told;                  // current tet -> previous tet
