@@ -223,7 +223,7 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
 __kernel void lazy_init(uint ne, __global const int* edges, __global const uint* marked, __global const uchar* vflags,
                         __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
                         __global uchar* state, __global uchar* edge_dir, __global uchar* reason, __global uint* cand,
-                        __global uint* counters) {
+                        __global uint* counters, int restrict_clean, __global const uchar* vdirty) {
   uint e = get_global_id(0);
   if (e >= ne) return;
   edge_dir[e] = 0;
@@ -234,6 +234,8 @@ __kernel void lazy_init(uint ne, __global const int* edges, __global const uint*
     return;
   }
   int a = edges[2 * e], b = edges[2 * e + 1];
+  /* a later selection round: only edges away from the collapses chosen so far */
+  if (restrict_clean && (vdirty[a] || vdirty[b])) return;
   if (tcc_predicate_q(a, b, vflags[a], vflags[b], eflags[e], vclass[a], vclass[b], mode, paper_rule) < 0) {
     reason[e] = TCC_REFUSED_Q;
     return;

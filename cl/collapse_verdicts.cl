@@ -54,3 +54,18 @@ __kernel void verdict_carry(uint ne, __global const int* edges, __global const i
   }
   verdict[e] = r;
 }
+
+/* Merges an earlier selection round (fin1, dir1, vaff1) into the current one: the edges of the
+ * two rounds touch disjoint stars (the later round only takes edges with clean end points). */
+__kernel void merge_rounds_edges(uint ne, __global const uint* fin1, __global const uchar* dir1, __global uint* fin,
+                                 __global uchar* dir) {
+  uint e = get_global_id(0);
+  if (e >= ne || !fin1[e]) return;
+  fin[e] = 1u;
+  dir[e] = dir1[e];
+}
+__kernel void merge_rounds_vertices(uint nv, __global const int* vaff1, __global int* vaff) {
+  uint v = get_global_id(0);
+  if (v >= nv || vaff1[v] < 0) return;
+  vaff[v] = vaff1[v];
+}

@@ -80,6 +80,7 @@ double median_edge_length(const Mesh& mesh) {
 
 CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
   if (options.max_iterations < 0) throw std::invalid_argument("max_iterations must be >= 0");
+  if (options.selection_rounds < 1) throw std::invalid_argument("selection_rounds must be >= 1");
   if (!options.cost_cl_source.empty() && !(options.target_length > 0))
     throw std::invalid_argument("a user cost (cost_cl_source) needs an explicit target_length > 0");
   if (!(options.target_length > 0) && !(options.target_factor > 0))
@@ -151,6 +152,11 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     s.seconds_admissible = t4 - t2;
     s.seconds_pass1 = 0;
     s.after_pass2 = conflict_pass2(ctx, dm, conn, st);
+    for (int r = 1; r < options.selection_rounds && s.after_pass2 > 0; ++r) {
+      const uint32_t total = next_selection_round(ctx, dm, conn, st, p);
+      if (total == s.after_pass2) break;  // nothing more
+      s.after_pass2 = total;
+    }
     s.collapsed = s.after_pass2;
     double t5 = now();
     s.seconds_pass2 = t5 - t4;

@@ -138,6 +138,21 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
   dm.vmask = DeviceBuffer<uint8_t>(ctx, o.vertex_mask);
 }
 
+uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p) {
+  remember_for_carry(ctx, dm, c, s);  // s.vdirty: the stars of the collapses chosen so far
+  std::swap(s.fin, s.fin1);
+  std::swap(s.dir, s.dir1);
+  std::swap(s.vaff, s.vaff1);
+  s.restrict_clean = true;
+  s.verdict_ready = true;  // this iteration's verdicts still hold (same connectivity)
+  uint32_t passed_q = 0, tested = 0;
+  lazy_admissible_pass1(ctx, dm, c, s, p, passed_q, tested);
+  const uint32_t total = conflict_pass2(ctx, dm, c, s);  // counters[3] counts both rounds
+  run(ctx, "collapse_verdicts.cl", "merge_rounds_edges", c.ne, "", U(c.ne), B(s.fin1), B(s.dir1), B(s.fin), B(s.dir));
+  run(ctx, "collapse_verdicts.cl", "merge_rounds_vertices", dm.nv, "", U(dm.nv), B(s.vaff1), B(s.vaff));
+  return total;
+}
+
 void remember_for_carry(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
   ensure(s.vdirty, ctx, dm.nv);
   run(ctx, "collapse_verdicts.cl", "verdict_dirty", dm.nv, "", U(dm.nv), B(s.vaff), B(c.nb_off), B(c.nb),
@@ -381,8 +396,11 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   ensure(s.verdict, ctx, c.ne);
   if (!s.verdict_ready) s.verdict.fill(0xff);  // TCC_VERDICT_UNKNOWN
   s.verdict_ready = false;
+  const bool restrict_clean = s.restrict_clean;
+  s.restrict_clean = false;
   run(ctx, A, "lazy_init", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(c.vflags), B(c.vclass), B(c.eflags), mode,
-      paper_rule, B(s.state), B(s.dir), B(s.reason), B(s.cand), B(s.counters));
+      paper_rule, B(s.state), B(s.dir), B(s.reason), B(s.cand), B(s.counters), cl_int(restrict_clean ? 1 : 0),
+      restrict_clean ? B(s.vdirty) : B(c.vflags));
   const uint32_t n = prepare_candidates(ctx, s, s.cand, c.ne);
   cl::Kernel round = ctx.kernel(A, "lazy_pass1_round");
   set_round_args(round, "lazy_pass1_round", B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt), B(c.nb_off),

@@ -60,7 +60,13 @@ struct EdgeState {
   // verdict[e] is the reason of a test of e (TCC_OK or a refusal) or TCC_VERDICT_UNKNOWN.
   // Carried to the next iteration for the edges whose end points' rings did not change.
   DeviceBuffer<uint8_t> verdict;
-  bool verdict_ready = false;  // verdict holds carried values (else lazy_admissible_pass1 clears it)
+  bool verdict_ready = false;
+  // later selection rounds (next_selection_round): the previous rounds' results, and the flag
+  // that restricts lazy_admissible_pass1's candidates to edges with clean end points (vdirty)
+  DeviceBuffer<uint32_t> fin1;
+  DeviceBuffer<uint8_t> dir1;
+  DeviceBuffer<int32_t> vaff1;
+  bool restrict_clean = false;  // verdict holds carried values (else lazy_admissible_pass1 clears it)
   // what carry_verdicts needs from the previous iteration
   bool has_prev = false;
   uint32_t prev_nv = 0, prev_nt = 0;
@@ -116,6 +122,13 @@ uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
 // vertex -> current vertex) is updated when non-empty.
 void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connectivity& c, EdgeState& s,
                           DeviceBuffer<int32_t>& origin, uint32_t n_origin);
+
+// A further selection round in the same connectivity after conflict_pass2: edges whose end
+// points are neither end points of the collapses chosen so far nor their neighbours (their
+// stars are disjoint from those collapses, which change nothing the edges' tests look at) go
+// through the lazy filter and both conflict passes again; the result is merged (fin, dir,
+// vaff). Returns the total number of collapses chosen.
+uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p);
 
 // Verdict carrying around collapse_and_compact: remember_for_carry() before it (dirty vertices:
 // the end points of the final edges and their neighbours), note_compaction() right after it

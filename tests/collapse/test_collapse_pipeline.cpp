@@ -272,3 +272,29 @@ TEST(CollapsePipeline, ReuseAcrossIterationsGivesTheSameResult) {
   EXPECT_GE(compared, 6);  // the cube alone: 3 modes x 2 guards
   EXPECT_LT(all_tested_a, all_tested_b);
 }
+
+// A second selection round per iteration (edges away from the first round's collapses): valid
+// output, deterministic, and iteration 0 collapses at least as much as with one round.
+TEST(CollapsePipeline, SecondSelectionRoundStaysValid) {
+  Context ctx;
+  Mesh in = test::cube_tets(6);
+  CollapseOptions o;
+  o.target_factor = 2;
+  Mesh one = in, two = in, again = in;
+  CollapseReport r1 = collapse(one, o, ctx);
+  o.selection_rounds = 2;
+  CollapseReport r2 = collapse(two, o, ctx);
+  collapse(again, o, ctx);
+  ASSERT_FALSE(r1.iterations.empty());
+  ASSERT_FALSE(r2.iterations.empty());
+  EXPECT_GE(r2.iterations[0].collapsed, r1.iterations[0].collapsed);
+  EXPECT_LT(r2.tets_out, r2.tets_in);
+  CheckReport c = check(two, &in);
+  EXPECT_TRUE(c.valid) << check_report_text(c);
+  EXPECT_FALSE(c.reference.topology_changed);
+  EXPECT_EQ(two.points, again.points);
+  EXPECT_EQ(two.tets, again.tets);
+  o.selection_rounds = 0;
+  Mesh bad = in;
+  EXPECT_THROW(collapse(bad, o, ctx), std::invalid_argument);
+}
