@@ -160,30 +160,24 @@ __kernel void conn_lower_edges(uint nv, __global const uint* nb_off, __global co
  * ring(v) whose other two vertices are both above v are paired in private memory (about 20 per
  * vertex), O(k^2) per vertex instead of a ring scan per face. A vertex with more such faces
  * than TCC_MAX_MIN_FACES falls back to the ring scan for its faces. */
-/* Carried tet_nbr for the faces owned by the clean vertices (ndirty[v] == 0): ring(v) is
- * unchanged since the previous iteration (collapse_verdicts.cl), so the tet across each of its
- * faces is a kept tet of ring(v), at its new index tnew[previous index]; compaction keeps the
- * order of the vertices of every tet, so the local face numbers are the same. A kernel of its
- * own: the private arrays of conn_tet_neighbours make every work item expensive on CPUs. */
-__kernel void conn_tet_neighbours_carry(uint nv, __global const int* tets, __global const uint* vt_off,
-                                        __global const int* vt, __global int* tet_nbr,
+/* Carried tet_nbr for the faces owned by (whose smallest vertex is) a clean vertex v
+ * (ndirty[v] == 0): ring(v) is unchanged since the previous iteration (collapse_verdicts.cl),
+ * so the tet across the face is a kept tet of ring(v), at its new index tnew[previous index];
+ * compaction keeps the order of the vertices of every tet, so the local face numbers are the
+ * same. One work item per tet; conn_tet_neighbours then matches the dirty vertices' faces. */
+__kernel void conn_tet_neighbours_carry(uint nt, __global const int* tets, __global int* tet_nbr,
                                         __global const uchar* ndirty, __global const int* told,
                                         __global const uint* tnew, __global const int* prev_tet_nbr) {
-  uint v = get_global_id(0);
-  if (v >= nv || ndirty[v]) return;
-  for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
-    int t = vt[i];
-    __global const int* q = tets + 4 * t;
-    int lv = tcc_local(tets, t, (int)v);
-    for (int f = 0; f < 4; ++f) {
-      if (f == lv) continue;
-      int ok = 1;
-      for (int j = 0; j < 4; ++j)
-        if (j != f && j != lv && q[j] < (int)v) ok = 0;
-      if (!ok) continue; /* v is not the smallest vertex of this face */
-      int o = prev_tet_nbr[4 * told[t] + f];
-      tet_nbr[4 * t + f] = o < 0 ? o : (int)tnew[o];
-    }
+  uint t = get_global_id(0);
+  if (t >= nt) return;
+  __global const int* q = tets + 4 * t;
+  for (int f = 0; f < 4; ++f) {
+    int owner = -1;
+    for (int j = 0; j < 4; ++j)
+      if (j != f && (owner < 0 || q[j] < owner)) owner = q[j];
+    if (ndirty[owner]) continue;
+    int o = prev_tet_nbr[4 * told[t] + f];
+    tet_nbr[4 * t + f] = o < 0 ? o : (int)tnew[o];
   }
 }
 

@@ -254,8 +254,7 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   const cl::Buffer& pef = cy ? B(carry->prev_eflags) : B(c.vflags);
   const cl::Buffer& pne = cy ? B(carry->prev_nb_edge) : B(c.nb_edge);
   if (cy) {
-    run(ctx, F, "conn_tet_neighbours_carry", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), nd, to, tn,
-        pt);
+    run(ctx, F, "conn_tet_neighbours_carry", nt, "", U(nt), B(dm.tets), B(c.tet_nbr), nd, to, tn, pt);
     // the full matching only for the dirty vertices
     ensure(c.dirty_list, ctx, nv);
     const uint32_t nd_count = dev::compact_indices(ctx, carry->dirty_flags, c.dirty_list, nv);
