@@ -235,29 +235,28 @@ __kernel void conn_tet_neighbours(uint n, __global const int* tets, __global con
   }
 }
 
-/* vflags: S membership of every vertex, from the faces around it. */
-__kernel void conn_vertex_flags(uint nv, __global const int* tets, __global const uint* vt_off,
-                                __global const int* vt, __global const int* tet_nbr, __global const int* labels,
-                                int use_labels, __global uchar* vflags, int carry, __global const uchar* ndirty,
-                                __global const int* vold, __global const uchar* prev_vflags) {
+/* vflags: S membership of every vertex, from the faces around it, in two steps: every tet ORs
+ * the S kind of each of its faces into the face's vertices (few faces are on S, so the atomics
+ * are rare; OR is order-independent), then the bits become vflags. Per tet rather than per
+ * vertex ring: each face is looked at from 2 tets instead of from 3 vertices x 2 tets. */
+__kernel void conn_vertex_flags_faces(uint nt, __global const int* tets, __global const int* tet_nbr,
+                                      __global const int* labels, int use_labels, __global uint* bits) {
+  uint t = get_global_id(0);
+  if (t >= nt) return;
+  __global const int* q = tets + 4 * t;
+  for (int f = 0; f < 4; ++f) {
+    uint on_s;
+    tcc_owned_sface(tet_nbr, labels, use_labels, (int)t, f, &on_s);
+    if (!on_s) continue;
+    for (int j = 0; j < 4; ++j)
+      if (j != f) atomic_or(&bits[q[j]], on_s);
+  }
+}
+
+__kernel void conn_vertex_flags(uint nv, __global const uint* bits, __global uchar* vflags) {
   uint v = get_global_id(0);
   if (v >= nv) return;
-  if (carry && !ndirty[v]) { /* ring(v) unchanged */
-    vflags[v] = prev_vflags[vold[v]];
-    return;
-  }
-  uint flags = 0;
-  for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
-    int t = vt[i];
-    int lv = tcc_local(tets, t, (int)v);
-    for (int f = 0; f < 4; ++f) {
-      if (f == lv) continue;
-      uint on_s;
-      tcc_owned_sface(tet_nbr, labels, use_labels, t, f, &on_s);
-      flags |= on_s;
-    }
-  }
-  vflags[v] = (uchar)flags;
+  vflags[v] = (uchar)bits[v];
 }
 
 /* Edge flags: S membership (boundary / interface) and the ridge rule of tc::build_topology:

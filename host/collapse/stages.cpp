@@ -174,7 +174,6 @@ void note_compaction(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s
   std::swap(s.prev_nb, c.nb);
   std::swap(s.prev_nb_edge, c.nb_edge);
   std::swap(s.prev_tet_nbr, c.tet_nbr);
-  std::swap(s.prev_vflags, c.vflags);
   std::swap(s.prev_vclass, c.vclass);
   std::swap(s.prev_eflags, c.eflags);
   std::swap(s.prev_verdict, s.verdict);
@@ -249,7 +248,6 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   const cl::Buffer& to = cy ? B(carry->told) : B(c.vt);
   const cl::Buffer& tn = cy ? B(carry->tnew) : B(c.vt_off);
   const cl::Buffer& pt = cy ? B(carry->prev_tet_nbr) : B(c.vt);
-  const cl::Buffer& pvf = cy ? B(carry->prev_vflags) : B(c.vflags);
   const cl::Buffer& pvc = cy ? B(carry->prev_vclass) : B(c.vflags);
   const cl::Buffer& pef = cy ? B(carry->prev_eflags) : B(c.vflags);
   const cl::Buffer& pne = cy ? B(carry->prev_nb_edge) : B(c.nb_edge);
@@ -264,8 +262,10 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
     run(ctx, F, "conn_tet_neighbours", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), cl_int(0),
         B(c.vt_off));
   }
-  run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
-      use_labels, B(c.vflags), ci, nd, vo, pvf);
+  c.up_count.fill(0);  // scratch reuse (its scan is done): S bits per vertex
+  run(ctx, F, "conn_vertex_flags_faces", nt, "", U(nt), B(dm.tets), B(c.tet_nbr), primary_labels(dm), use_labels,
+      B(c.up_count));
+  run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(c.up_count), B(c.vflags));
   run(ctx, F, "conn_edge_flags", c.ne, "", U(c.ne), B(c.edges), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr),
       primary_labels(dm), use_labels, B(dm.points), p.eps_r, B(c.vflags), B(c.eflags), ci, nd, vo, pno, pnb, pne, pef);
   run(ctx, F, "conn_vertex_class", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),

@@ -79,7 +79,7 @@ struct EdgeState {
   DeviceBuffer<uint32_t> tkeep, tnew;          // previous tet: kept, new index (collapse_and_compact)
   DeviceBuffer<uint32_t> prev_nb_off;
   DeviceBuffer<int32_t> prev_nb, prev_nb_edge, prev_tet_nbr;
-  DeviceBuffer<uint8_t> prev_vflags, prev_vclass, prev_eflags;
+  DeviceBuffer<uint8_t> prev_vclass, prev_eflags;
 };
 
 enum Reason : uint8_t {
@@ -101,7 +101,7 @@ StageParams params_from(const CollapseOptions& o);
 
 void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm);
 
-// With carry (an EdgeState after note_compaction), the boundary data (tet_nbr, vflags, vclass,
+// With carry (an EdgeState after note_compaction), the data (N(v), tet_nbr, vclass,
 // eflags) of the vertices whose rings did not change is copied from the previous iteration
 // instead of recomputed.
 void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const StageParams& p,
