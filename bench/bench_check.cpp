@@ -2,7 +2,7 @@
 //
 //   bench_check [MESH] [RUNS]
 // MESH defaults to the shared gen_tetgen_rocker-arm_964k.msh; when it cannot be read, a
-// generated cube of 6 * 55^3 = 998,250 Kuhn tets is used instead. Prints the median over
+// generated cube of 6 * 55^3 = 998,250 Kuhn tets (tc::make_cube_mesh) is used instead. Prints the median over
 // RUNS (default 5) of the total and of every phase the report times, then one run against
 // a slightly scaled copy as reference, with the Hausdorff distance.
 #include <algorithm>
@@ -19,31 +19,6 @@
 
 namespace {
 
-// [0,1]^3 split into n^3 cubes of 6 Kuhn tets (positively oriented), as tests/support does.
-tc::Mesh cube_tets(int n) {
-  tc::Mesh m;
-  auto id = [n](int i, int j, int k) { return int32_t((k * (n + 1) + j) * (n + 1) + i); };
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) m.points.insert(m.points.end(), {double(i) / n, double(j) / n, double(k) / n});
-  static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        for (const auto& p : perms) {
-          std::array<int, 3> c = {i, j, k};
-          int32_t v[4];
-          v[0] = id(c[0], c[1], c[2]);
-          for (int s = 0; s < 3; ++s) {
-            c[p[s]] += 1;
-            v[s + 1] = id(c[0], c[1], c[2]);
-          }
-          bool odd = (p[0] == 0 && p[1] == 2) || (p[0] == 1 && p[1] == 0) || (p[0] == 2 && p[1] == 1);
-          if (odd) std::swap(v[2], v[3]);
-          m.tets.insert(m.tets.end(), v, v + 4);
-        }
-  return m;
-}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -63,8 +38,8 @@ int main(int argc, char** argv) {
     std::printf("mesh: %s (read in %.2f s)\n", path.c_str(), s);
   } catch (const std::exception& e) {
     std::printf("cannot read %s (%s); using a generated cube instead\n", path.c_str(), e.what());
-    mesh = cube_tets(55);
-    path = "cube_tets(55)";
+    mesh = tc::make_cube_mesh(55);
+    path = "make_cube_mesh(55)";
   }
   std::printf("%lld vertices, %lld tets; %d runs, check without Hausdorff (no reference)\n",
               (long long)mesh.num_vertices(), (long long)mesh.num_tets(), runs);

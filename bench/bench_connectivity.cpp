@@ -53,32 +53,6 @@ bool reset_peak_rss() {
   return bool(o);
 }
 
-Mesh kuhn_cube(int n) {
-  Mesh m;
-  auto id = [n](int i, int j, int k) { return int32_t((int64_t(k) * (n + 1) + j) * (n + 1) + i); };
-  m.points.reserve(size_t(n + 1) * (n + 1) * (n + 1) * 3);
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) m.points.insert(m.points.end(), {double(i) / n, double(j) / n, double(k) / n});
-  static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  m.tets.reserve(size_t(n) * n * n * 24);
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        for (const auto& p : perms) {
-          std::array<int, 3> c = {i, j, k};
-          int32_t v[4];
-          v[0] = id(c[0], c[1], c[2]);
-          for (int s = 0; s < 3; ++s) {
-            c[p[s]] += 1;
-            v[s + 1] = id(c[0], c[1], c[2]);
-          }
-          bool odd = (p[0] == 0 && p[1] == 2) || (p[0] == 1 && p[1] == 0) || (p[0] == 2 && p[1] == 1);
-          if (odd) std::swap(v[2], v[3]);
-          m.tets.insert(m.tets.end(), v, v + 4);
-        }
-  return m;
-}
 
 bool equal(const Topology& a, const Topology& b) {
   return a.edges == b.edges && a.tet_edges == b.tet_edges && a.vertex_tets_offsets == b.vertex_tets_offsets &&
@@ -199,7 +173,7 @@ int main(int argc, char** argv) {
     std::printf("device: %s (%s), %u compute units\n", ctx.info().name.c_str(), ctx.info().platform_name.c_str(),
                 ctx.info().compute_units);
     // compile (or load from the cache) every kernel on a tiny mesh before measuring
-    dev::build_device_topology(ctx, kuhn_cube(2));
+    dev::build_device_topology(ctx, tc::make_cube_mesh(2));
     for (const auto& f : files) {
       auto t0 = std::chrono::steady_clock::now();
       Mesh m = read_mesh(f);
@@ -207,7 +181,7 @@ int main(int argc, char** argv) {
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
       bench(ctx, f.substr(f.find_last_of('/') + 1), m, runs);
     }
-    for (int n : generated) bench(ctx, "generated Kuhn cube n=" + std::to_string(n), kuhn_cube(n), runs);
+    for (int n : generated) bench(ctx, "generated Kuhn cube n=" + std::to_string(n), tc::make_cube_mesh(n), runs);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_connectivity: %s\n", e.what());
     return 1;

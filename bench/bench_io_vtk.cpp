@@ -26,28 +26,6 @@ double median_seconds(const std::function<void()>& f, int runs = 5) {
   return t[t.size() / 2];
 }
 
-// [0,1]^3 as n^3 cubes of 6 Kuhn tets, with one vertex field and one label.
-tc::Mesh cube(int n) {
-  tc::Mesh m;
-  auto id = [n](int i, int j, int k) { return int32_t((k * (n + 1) + j) * (n + 1) + i); };
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) m.points.insert(m.points.end(), {double(i) / n, double(j) / n, double(k) / n});
-  static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        for (const auto& p : perms) {
-          int c[3] = {i, j, k};
-          int32_t v[4] = {id(i, j, k), 0, 0, 0};
-          for (int s = 0; s < 3; ++s) {
-            c[p[s]] += 1;
-            v[s + 1] = id(c[0], c[1], c[2]);
-          }
-          m.tets.insert(m.tets.end(), v, v + 4);
-        }
-  return m;
-}
 
 }  // namespace
 
@@ -59,7 +37,7 @@ int main(int argc, char** argv) {
   } else {
     std::printf("%s not found; using a generated cube of 50^3*6 tets\n", src.c_str());
     src = "cube 50^3*6";
-    mesh = cube(50);
+    mesh = tc::make_cube_mesh(50);
   }
   if (mesh.vertex_fields.empty()) {
     tc::Field f{"x", 1, {}};

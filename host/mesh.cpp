@@ -11,11 +11,23 @@ namespace tc {
 
 // ---------------------------------------------------------------- errors
 
+namespace {
+// "FILE:LINE: reason", "FILE: byte OFFSET: reason" or "FILE: reason". Built with append
+// (GCC 12 warns falsely about -Wrestrict on the equivalent operator+ chain).
+std::string input_error_text(const std::string& file, int64_t line, int64_t offset, const std::string& reason) {
+  std::string s = file;
+  if (line >= 0) {
+    s.append(":").append(std::to_string(line));
+  } else if (offset >= 0) {
+    s.append(": byte ").append(std::to_string(offset));
+  }
+  s.append(": ").append(reason);
+  return s;
+}
+}  // namespace
+
 InputError::InputError(const std::string& file, int64_t line, int64_t offset, const std::string& reason)
-    : std::runtime_error(file + (line >= 0 ? ":" + std::to_string(line)
-                                 : offset >= 0 ? ": byte " + std::to_string(offset)
-                                               : std::string()) +
-                         ": " + reason),
+    : std::runtime_error(input_error_text(file, line, offset, reason)),
       file_(file), line_(line), offset_(offset), reason_(reason) {}
 InputError::InputError(const std::string& file, const std::string& reason) : InputError(file, -1, -1, reason) {}
 InputError::InputError(const std::string& file, int64_t line, const std::string& reason)
@@ -87,6 +99,37 @@ OrientationReport normalize_orientation(Mesh& mesh, OrientationPolicy policy) {
       ++r.flipped;
     }
   return r;
+}
+
+Mesh make_cube_mesh(int n) {
+  Mesh m;
+  if (n < 1) return m;
+  auto id = [n](int64_t i, int64_t j, int64_t k) { return int32_t((k * (n + 1) + j) * (n + 1) + i); };
+  m.points.reserve(size_t(n + 1) * (n + 1) * (n + 1) * 3);
+  for (int k = 0; k <= n; ++k)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) m.points.insert(m.points.end(), {double(i) / n, double(j) / n, double(k) / n});
+  // Each cell is cut into the 6 tets along its main diagonal: one per order in which the
+  // path from corner (i,j,k) to (i+1,j+1,k+1) steps along x, y and z. Odd orders give
+  // negatively oriented paths, so their last two vertices are swapped.
+  static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  m.tets.reserve(size_t(n) * n * n * 24);
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i)
+        for (const auto& p : perms) {
+          int c[3] = {i, j, k};
+          int32_t v[4];
+          v[0] = id(i, j, k);
+          for (int s = 0; s < 3; ++s) {
+            c[p[s]] += 1;
+            v[s + 1] = id(c[0], c[1], c[2]);
+          }
+          bool odd = (p[0] == 0 && p[1] == 2) || (p[0] == 1 && p[1] == 0) || (p[0] == 2 && p[1] == 1);
+          if (odd) std::swap(v[2], v[3]);
+          m.tets.insert(m.tets.end(), v, v + 4);
+        }
+  return m;
 }
 
 void validate_structure(const Mesh& mesh, const std::string& source) {

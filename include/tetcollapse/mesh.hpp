@@ -81,6 +81,10 @@ enum class OrientationPolicy {
 // tc::InputError naming the counts; with Fix, flips the negative tets.
 OrientationReport normalize_orientation(Mesh& mesh, OrientationPolicy policy);
 
+// The unit cube [0,1]^3 cut into n^3 cells of 6 positively oriented Kuhn tets: a mesh with
+// a known answer for tests, benchmarks and examples ((n+1)^3 vertices, 6 n^3 tets).
+Mesh make_cube_mesh(int n);
+
 // Basic structural validation used by every reader before returning a mesh:
 // indices in range, finite coordinates, field/label sizes consistent.
 // Throws tc::InputError with `source` as the file name.

@@ -69,36 +69,7 @@ Mesh single_tet() {
   return m;
 }
 
-Mesh cube_tets(int n) {
-  Mesh m;
-  auto id = [n](int i, int j, int k) { return int32_t((k * (n + 1) + j) * (n + 1) + i); };
-  for (int k = 0; k <= n; ++k)
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i <= n; ++i) {
-        m.points.push_back(double(i) / n);
-        m.points.push_back(double(j) / n);
-        m.points.push_back(double(k) / n);
-      }
-  // Kuhn subdivision: 6 tets around the main diagonal, all positively oriented.
-  static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  for (int k = 0; k < n; ++k)
-    for (int j = 0; j < n; ++j)
-      for (int i = 0; i < n; ++i)
-        for (const auto& p : perms) {
-          std::array<int, 3> c = {i, j, k};
-          int32_t v[4];
-          v[0] = id(c[0], c[1], c[2]);
-          for (int s = 0; s < 3; ++s) {
-            c[p[s]] += 1;
-            v[s + 1] = id(c[0], c[1], c[2]);
-          }
-          // Orientation of the path tet depends on the parity of the permutation.
-          bool odd = (p[0] == 0 && p[1] == 2) || (p[0] == 1 && p[1] == 0) || (p[0] == 2 && p[1] == 1);
-          if (odd) std::swap(v[2], v[3]);
-          m.tets.insert(m.tets.end(), v, v + 4);
-        }
-  return m;
-}
+Mesh cube_tets(int n) { return make_cube_mesh(n); }
 
 int run_command(const std::string& cmd, std::string* output) {
   std::string full = cmd + " 2>&1";
