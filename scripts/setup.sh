@@ -13,7 +13,7 @@ packages=(
   python3 python3-meshio          # independent reader used by the cross-read tests
 )
 if [[ "${1:-}" == "--with-tools" ]]; then
-  packages+=(gmsh python3-gmsh tetgen python3-matplotlib python3-numpy)
+  packages+=(gmsh python3-gmsh tetgen python3-matplotlib python3-numpy clang libclang-rt-14-dev llvm-14)
 fi
 
 missing=()
