@@ -153,13 +153,7 @@ TEST(DeviceConnectivity, SharedMeshes) {
   TC_CONTEXT_OR_SKIP(ctx);
   int done = 0;
   for (const std::string& path : test::shared_volume_meshes()) {
-    Mesh m;
-    try {
-      m = read_mesh(path);
-    } catch (const std::exception& e) {
-      std::printf("[ skipped  ] %s: tc::read_mesh cannot read it yet (%s)\n", path.c_str(), e.what());
-      continue;
-    }
+    Mesh m = read_mesh(path);  // every shared mesh must load (tests/io checks the counts)
     if (m.num_tets() > 300000) {  // keeps the test well under a minute; bench_connectivity compares those
       std::printf("[ skipped  ] %s: %lld tets, compared by bench_connectivity instead\n", path.c_str(),
                   (long long)m.num_tets());
@@ -176,5 +170,5 @@ TEST(DeviceConnectivity, SharedMeshes) {
     if (HasFailure()) break;
     ++done;
   }
-  if (done == 0) GTEST_SKIP() << "no shared mesh could be read by tc::read_mesh yet";
+  EXPECT_GT(done, 0) << "no shared mesh compared";
 }

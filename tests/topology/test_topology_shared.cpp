@@ -16,13 +16,7 @@ TEST(Topology, SharedMeshesInvariants) {
   TC_SKIP_IF_NO_SHARED();
   int done = 0;
   for (const std::string& path : test::shared_volume_meshes()) {
-    Mesh m;
-    try {
-      m = read_mesh(path);
-    } catch (const std::exception& e) {
-      std::printf("[ skipped  ] %s: cannot be read yet (%s)\n", path.c_str(), e.what());
-      continue;
-    }
+    Mesh m = read_mesh(path);  // every shared mesh must load (tests/io checks the counts)
     if (m.num_tets() > 120000) continue;  // the large ones are covered by the bench
     SCOPED_TRACE(path);
     Topology t = build_topology(m);
@@ -41,5 +35,5 @@ TEST(Topology, SharedMeshesInvariants) {
     EXPECT_EQ(s.face_vertices + s.ridge_vertices + s.corner_vertices + s.interior_vertices, V);
     ++done;
   }
-  if (done == 0) GTEST_SKIP() << "no shared mesh could be read yet (readers not landed?)";
+  EXPECT_GT(done, 0) << "no shared mesh checked";
 }
