@@ -11,21 +11,13 @@
 #include <vector>
 
 #include "io/io_util.hpp"
+#include "bench_util.hpp"
 #include "tetcollapse/io.hpp"
 
 namespace {
 
-template <class F>
-double median_seconds(F&& f, int runs) {
-  std::vector<double> t;
-  for (int i = 0; i < runs; ++i) {
-    auto a = std::chrono::steady_clock::now();
-    f();
-    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count());
-  }
-  std::sort(t.begin(), t.end());
-  return t[t.size() / 2];
-}
+using tc::bench::median_seconds;
+
 
 }  // namespace
 

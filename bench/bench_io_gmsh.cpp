@@ -7,22 +7,13 @@
 #include <string>
 #include <vector>
 
+#include "bench_util.hpp"
 #include "tetcollapse/io.hpp"
 
 namespace {
 
-template <class F>
-double median_seconds(F&& f, int runs = 5) {
-  std::vector<double> t;
-  for (int i = 0; i < runs; ++i) {
-    auto a = std::chrono::steady_clock::now();
-    f();
-    auto b = std::chrono::steady_clock::now();
-    t.push_back(std::chrono::duration<double>(b - a).count());
-  }
-  std::sort(t.begin(), t.end());
-  return t[t.size() / 2];
-}
+using tc::bench::median_seconds;
+
 
 }  // namespace
 

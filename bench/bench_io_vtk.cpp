@@ -11,20 +11,12 @@
 
 #include <unistd.h>
 
+#include "bench_util.hpp"
 #include "tetcollapse/io.hpp"
 
 namespace {
 
-double median_seconds(const std::function<void()>& f, int runs = 5) {
-  std::vector<double> t;
-  for (int i = 0; i < runs; ++i) {
-    auto a = std::chrono::steady_clock::now();
-    f();
-    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - a).count());
-  }
-  std::sort(t.begin(), t.end());
-  return t[t.size() / 2];
-}
+using tc::bench::median_seconds;
 
 
 }  // namespace
