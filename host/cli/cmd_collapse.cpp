@@ -26,7 +26,7 @@ struct CollapseCli {
   OutputOptions output;
   CollapseOptions opt;
   double target_length = 0, target_factor = 0;
-  std::string boundary = "features";
+  std::string boundary = "features", method = "parallel", conflicts = "two-pass";
   std::string region, sizing_field, labels, cost_cl, device, stats;
   bool check = false, quiet = false, no_labels = false;
 };
@@ -114,6 +114,8 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, double sec
       .field("eps_v", r.eps_v)
       .field("min_quality", c.opt.min_quality)
       .field("boundary", c.boundary)
+      .field("method", c.method)
+      .field("conflicts", c.conflicts)
       .field("seconds_total", seconds_total)
       .field("seconds_collapse", r.seconds_total)
       .field("seconds_upload", r.seconds_upload)
@@ -198,6 +200,14 @@ void register_collapse(CLI::App& app, int& exit_code) {
   app.add_option("--cost-cl", c->cost_cl,
                  "OpenCL C file defining double tc_user_cost(double3 p0, double3 p1, double f0, double f1);\n"
                  "edges with a cost below --target-length are collapsed (see README)");
+  app.add_option("--method", c->method,
+                 "parallel (default): the OpenCL pipeline; sequential: the CPU priority-queue baseline\n"
+                 "with the same checks (no OpenCL device needed)")
+      ->check(CLI::IsMember({"parallel", "sequential"}));
+  app.add_option("--conflicts", c->conflicts,
+                 "Conflict detection of the parallel method: two-pass (default, the paper's) or\n"
+                 "atomic-min (Gautron and Kenzel 2023; needs 64-bit atomics on the device)")
+      ->check(CLI::IsMember({"two-pass", "atomic-min"}));
   app.add_option("--device", c->device, "OpenCL device: index or name substring (see 'tetcollapse devices');\n"
                                         "default: $TETCOLLAPSE_DEVICE, else the first GPU, else the first CPU");
   app.add_option("--stats", c->stats, "Write the run's statistics as JSON to this file ('-' for stdout)");
@@ -221,6 +231,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
                    : c->boundary == "free" ? CollapseOptions::Free
                                            : CollapseOptions::Features;
     opt.use_labels = !c->no_labels;
+    opt.method = c->method == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
+    opt.conflicts = c->conflicts == "atomic-min" ? CollapseOptions::AtomicMin : CollapseOptions::TwoPass;
+    if (opt.method == CollapseOptions::Sequential && !c->device.empty())
+      throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
     if (c->target_length > 0) opt.target_length = c->target_length;
     if (c->target_factor > 0) opt.target_factor = c->target_factor;
     if (!c->region.empty()) combine(opt.vertex_mask, region_mask(mesh, c->region));
@@ -257,9 +271,15 @@ void register_collapse(CLI::App& app, int& exit_code) {
                      (long long)it.after_pass2, (long long)it.collapsed, (long long)it.tets_after, it.seconds_total);
       };
 
-    Context ctx(c->device);
-    if (!c->quiet) std::cerr << "device: " << ctx.info().name << " (" << ctx.info().platform_name << ")\n";
-    CollapseReport r = collapse(mesh, opt, ctx);
+    CollapseReport r;
+    if (opt.method == CollapseOptions::Sequential) {
+      if (!c->quiet) std::cerr << "method: sequential (CPU)\n";
+      r = collapse_sequential(mesh, opt);
+    } else {
+      Context ctx(c->device);
+      if (!c->quiet) std::cerr << "device: " << ctx.info().name << " (" << ctx.info().platform_name << ")\n";
+      r = collapse(mesh, opt, ctx);
+    }
     if (!c->sizing_field.empty()) std::swap(mesh.vertex_fields[0], mesh.vertex_fields[sizing_index]);
 
     std::string verdict;

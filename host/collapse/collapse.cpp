@@ -79,8 +79,11 @@ double median_edge_length(const Mesh& mesh) {
 }
 
 CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
+  if (options.method == CollapseOptions::Sequential) return collapse_sequential(mesh, options);
   if (options.max_iterations < 0) throw std::invalid_argument("max_iterations must be >= 0");
   if (options.selection_rounds < 1) throw std::invalid_argument("selection_rounds must be >= 1");
+  if (options.selection_rounds > 1 && options.conflicts != CollapseOptions::TwoPass)
+    throw std::invalid_argument("selection_rounds > 1 needs the two-pass conflict detection");
   if (!options.cost_cl_source.empty() && !(options.target_length > 0))
     throw std::invalid_argument("a user cost (cost_cl_source) needs an explicit target_length > 0");
   if (!(options.target_length > 0) && !(options.target_factor > 0))
@@ -143,15 +146,25 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     s.marked = cost_and_mark(ctx, dm, conn, st, p);
     double t2 = now();
     s.seconds_cost = t2 - t1;
-    uint32_t passed_q = 0, tested = 0;
-    s.after_pass1 = lazy_admissible_pass1(ctx, dm, conn, st, p, passed_q, tested);
-    s.admissible = s.after_pass1;
-    s.passed_q = passed_q;
-    s.tested = tested;
-    double t4 = now();
-    s.seconds_admissible = t4 - t2;
-    s.seconds_pass1 = 0;
-    s.after_pass2 = conflict_pass2(ctx, dm, conn, st);
+    double t4 = 0;
+    if (options.conflicts == CollapseOptions::AtomicMin) {
+      // every marked edge tested, then one conflict stage
+      s.admissible = admissible(ctx, dm, conn, st, p);
+      s.tested = s.marked;
+      t4 = now();
+      s.seconds_admissible = t4 - t2;
+      s.after_pass2 = s.after_pass1 = conflicts_atomic_min(ctx, dm, conn, st);
+    } else {
+      uint32_t passed_q = 0, tested = 0;
+      s.after_pass1 = lazy_admissible_pass1(ctx, dm, conn, st, p, passed_q, tested);
+      s.admissible = s.after_pass1;
+      s.passed_q = passed_q;
+      s.tested = tested;
+      t4 = now();
+      s.seconds_admissible = t4 - t2;
+      s.seconds_pass1 = 0;
+      s.after_pass2 = conflict_pass2(ctx, dm, conn, st);
+    }
     for (int r = 1; r < options.selection_rounds && s.after_pass2 > 0; ++r) {
       const uint32_t total = next_selection_round(ctx, dm, conn, st, p);
       if (total == s.after_pass2) break;  // nothing more

@@ -118,6 +118,10 @@ uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
 uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                                uint32_t& passed_q, uint32_t& tested);
 uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
+// Atomic-min conflict detection (host/collapse/conflict_atomic.cpp) over the admissible edges
+// of admissible(): replaces both conflict passes, with the same outputs as conflict_pass2.
+// Returns the number of edges to collapse.
+uint32_t conflicts_atomic_min(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
 // Applies the final collapses: dm becomes the new mesh (via `next`, swapped in); origin (input
 // vertex -> current vertex) is updated when non-empty.
 void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connectivity& c, EdgeState& s,

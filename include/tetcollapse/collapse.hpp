@@ -76,6 +76,18 @@ struct CollapseReport {
 };
 
 struct CollapseOptions {
+  // Method. Parallel: the pipeline above on the OpenCL device. Sequential: the CPU baseline of
+  // the paper's evaluation (every admissible edge in a priority queue by cost; pop, re-check,
+  // collapse), the same checks and predicate, no device needed (collapse_sequential).
+  enum Method { Parallel, Sequential };
+  Method method = Parallel;
+  // Conflict detection of the parallel method. TwoPass: the paper's two passes (default).
+  // AtomicMin: Gautron and Kenzel 2023, every admissible edge propagates a 64-bit descriptor
+  // (cost bits high, edge index low) with atomic_min to the tets of both one-rings and
+  // collapses when it holds the minimum in all of them; needs cl_khr_int64_extended_atomics.
+  enum Conflicts { TwoPass, AtomicMin };
+  Conflicts conflicts = TwoPass;
+
   // Edges with a cost below target_length are marked. <= 0: target_factor x the input's median
   // edge length.
   double target_length = 0;
@@ -128,7 +140,11 @@ struct CollapseOptions {
 // Coarsens `mesh` in place. Throws tc::InputError for a mesh the pipeline cannot take (index out
 // of range, repeated vertex in a tet, more than 2^31 entities), std::invalid_argument for bad
 // options, tc::DeviceError for device failures (including a user cost that does not compile).
+// With options.method == Sequential it runs collapse_sequential (ctx is not used).
 CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx);
+
+// The sequential CPU method (options.method is ignored); no OpenCL device needed.
+CollapseReport collapse_sequential(Mesh& mesh, const CollapseOptions& options);
 
 // Median edge length of a mesh (unique edges), on the host. 0 for a mesh without tets.
 double median_edge_length(const Mesh& mesh);
