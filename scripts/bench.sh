@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# Benchmark suite of issue 6: builds tetcollapse (Release) and runs bench/run_suite.py, then
+# bench/plot_suite.py (PNGs in bench/plots/, markdown tables in bench/results/<name>.md).
+#   scripts/bench.sh [run_suite.py options]        e.g. scripts/bench.sh --quick
+# BUILD_DIR (default build/) and JOBS (default nproc) as for scripts/build.sh. Needs Debian's
+# python3-matplotlib for the plots (/usr/bin/python3).
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${BUILD_DIR:-$root/build}
+jobs=${JOBS:-$(nproc)}
+cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$build" --target tetcollapse -j "$jobs"
+# the CGAL peer of bench/peers.py, when the project has it (optional)
+cmake --build "$build" --target bench_peer_cgal -j "$jobs" >/dev/null 2>&1 || true
+
+out=$root/bench/results/suite.json
+for a in "$@"; do [ "$a" = --quick ] && out=$root/bench/results/smoke.json; done
+prev=
+for a in "$@"; do [ "$prev" = --out ] && out=$a; prev=$a; done
+/usr/bin/python3 "$root/bench/run_suite.py" --cli "$build/tetcollapse" --out "$out" "$@"
+/usr/bin/python3 "$root/bench/plot_suite.py" "$out" --markdown "${out%.json}.md"
