@@ -1,0 +1,237 @@
+#!/usr/bin/python3
+"""Every shared mesh coarsened to its median edge length, with --check (issue 5).
+
+    bench/shared_meshes.py [--tetcollapse PATH] [--meshes DIR] [--modes features,strict]
+                           [--only SUBSTRING,...] [--out-json F] [--readme F] [--work-dir DIR]
+
+For every volume mesh in DIR (default ../shared/meshes; every extension the CLI reads:
+.msh .mesh .meshb .vtk .vtu .node; the sub-folders cad/ and surfaces/ hold STEP files and
+surface meshes only and are not read) and every mode, runs
+
+    tetcollapse IN OUT.vtu --target-factor 1 --boundary MODE --check --stats S.json --quiet
+
+and then, on the output when one was written, `tetcollapse check OUT.vtu --reference IN --json`
+for the numbers --check does not put in the statistics (boundary Hausdorff distance, topology,
+output quality). Writes one JSON object per (mesh, mode) to --out-json (default
+bench/results/shared_meshes.json) and replaces the section "Every shared mesh at its median
+edge length (issue 5)" of --readme (default bench/README.md) with a table of the results.
+Expected for every mesh that is valid on input: exit 0, check valid, boundary topology
+unchanged, and in strict mode a Hausdorff distance of 0. Anything else is listed under the table.
+"""
+import argparse
+import datetime
+import json
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+EXTS = (".msh", ".mesh", ".meshb", ".vtk", ".vtu", ".node")
+SECTION = "## Every shared mesh at its median edge length (issue 5)"
+
+
+def default_tetcollapse():
+    for d in ("build", "build-peers", "build-lead"):
+        p = os.path.join(ROOT, d, "tetcollapse")
+        if os.access(p, os.X_OK):
+            return p
+    return None
+
+
+def tail(text, n=400):
+    text = text.strip()
+    return text[-n:] if len(text) > n else text
+
+
+def run_one(tc, path, mode, work, timeout):
+    name = os.path.basename(path)
+    stem = f"{os.path.splitext(name)[0]}_{mode}"
+    out = os.path.join(work, stem + ".vtu")
+    stats = os.path.join(work, stem + ".stats.json")
+    for f in (out, stats):
+        if os.path.exists(f):
+            os.remove(f)
+    cmd = [tc, path, out, "--target-factor", "1", "--boundary", mode, "--check", "--stats", stats, "--quiet"]
+    row = {"mesh": name, "mode": mode,
+           "command": f"tetcollapse {name} OUT.vtu --target-factor 1 --boundary {mode} --check --stats S.json",
+           "load_avg_before": round(os.getloadavg()[0], 2)}
+    t0 = time.perf_counter()
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+        row["exit_code"] = p.returncode
+        stderr = p.stderr
+    except subprocess.TimeoutExpired:
+        row["exit_code"] = None
+        stderr = f"timed out after {timeout} s"
+    row["seconds_wall"] = round(time.perf_counter() - t0, 3)
+    row["check_errors"] = [l[len("error: "):] for l in stderr.splitlines() if l.startswith("error: ")]
+    row["check_warnings"] = [l[len("warning: "):] for l in stderr.splitlines() if l.startswith("warning: ")]
+    if row["exit_code"] not in (0,):
+        row["stderr_tail"] = tail(stderr)
+    if os.path.exists(stats):
+        with open(stats) as f:
+            s = json.load(f)
+        for k in ("vertices_in", "vertices_out", "tets_in", "tets_out", "tet_reduction", "median_edge_length",
+                  "target_length", "seconds_collapse", "seconds_total", "seconds_read", "seconds_write", "device"):
+            row[k] = s.get(k)
+        row["iterations"] = len(s.get("iterations", []))
+        row["check"] = s.get("check")
+    if row["exit_code"] == 0 and os.path.exists(out):
+        js = os.path.join(work, stem + ".check.json")
+        c = subprocess.run([tc, "check", out, "--reference", path, "--json", js, "-q"], capture_output=True, text=True,
+                           timeout=timeout)
+        if os.path.exists(js):
+            with open(js) as f:
+                r = json.load(f)
+            ref = r.get("reference", {})
+            q = r.get("quality", {})
+            row.update({
+                "recheck_valid": r["valid"],
+                "recheck_errors": [f["code"] for f in r["findings"] if f["severity"] == "error"],
+                "topology_changed": ref.get("topology_changed"),
+                "boundary_components": r["boundary"]["components"],
+                "boundary_euler": r["boundary"]["euler_characteristic"],
+                "hausdorff": ref.get("hausdorff"),
+                "hausdorff_rel": ref.get("hausdorff_rel"),
+                "volume_change_rel": ref.get("volume_change_rel"),
+                "min_dihedral_deg": q.get("min_dihedral_deg", {}).get("min"),
+            })
+        else:
+            row["recheck_valid"] = None
+            row["recheck_errors"] = [f"check exit {c.returncode}: {tail(c.stderr, 200)}"]
+        os.remove(out)
+    row["load_avg_after"] = round(os.getloadavg()[0], 2)
+    return row
+
+
+def problems(r):
+    """Why a row is not the expected result (empty when it is)."""
+    why = []
+    if r.get("exit_code") != 0:
+        why.append(f"exit {r.get('exit_code')}")
+    if r.get("check") not in ("valid",):
+        why.append(f"--check {r.get('check')}")
+    if r.get("recheck_valid") is False:
+        why.append("check of the output: " + ", ".join(r.get("recheck_errors", [])))
+    if r.get("topology_changed"):
+        why.append("boundary topology changed")
+    if r["mode"] == "strict" and r.get("hausdorff") not in (None, 0, 0.0):
+        why.append(f"strict Hausdorff {r.get('hausdorff'):.3g} != 0")
+    return why
+
+
+def fmt(x, spec):
+    return "-" if x is None else format(x, spec)
+
+
+def table(rows, meta):
+    lines = [SECTION, ""]
+    lines.append(f"`bench/shared_meshes.py` ({meta['date']}, commit {meta['commit']}, {meta['device']}; load average "
+                 f"{meta['load_min']:.1f}-{meta['load_max']:.1f} during the run). Every volume mesh of "
+                 "`../shared/meshes/`, target = its median edge length (`--target-factor 1`), default options "
+                 "(quality guard 0.1, eps_c 0), one run each: `tetcollapse IN OUT.vtu --target-factor 1 --boundary "
+                 "MODE --check --stats S.json`, then `tetcollapse check OUT.vtu --reference IN` for the boundary "
+                 "Hausdorff distance (relative to the bounding-box diagonal) and the output's smallest dihedral "
+                 "angle. `collapse s` is the pipeline without file I/O (`seconds_collapse`), `total s` the whole "
+                 "command including reading, `--check` and writing (`seconds_total`). Results: "
+                 "`bench/results/shared_meshes.json`.")
+    lines.append("")
+    lines.append("| mesh | tets in | mode | tets out | reduction | iterations | collapse s | total s | --check | "
+                 "Hausdorff rel | min dihedral out |")
+    lines.append("|---|---:|---|---:|---:|---:|---:|---:|---|---:|---:|")
+    for r in rows:
+        check = r.get("check") or (f"exit {r.get('exit_code')}")
+        if r.get("topology_changed"):
+            check += ", topology changed"
+        lines.append("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |".format(
+            r["mesh"], fmt(r.get("tets_in"), ","), r["mode"], fmt(r.get("tets_out"), ","),
+            fmt(None if r.get("tet_reduction") is None else 100 * r["tet_reduction"], ".1f") + "%",
+            fmt(r.get("iterations"), "d"), fmt(r.get("seconds_collapse"), ".2f"), fmt(r.get("seconds_total"), ".2f"),
+            check, fmt(r.get("hausdorff_rel"), ".2g"), fmt(r.get("min_dihedral_deg"), ".2f")))
+    bad = [(r, problems(r)) for r in rows if problems(r)]
+    lines.append("")
+    if bad:
+        lines.append("Not as expected:")
+        lines.append("")
+        for r, why in bad:
+            errs = "; ".join(r.get("check_errors", []))[:300]
+            lines.append(f"- `{r['mesh']}` ({r['mode']}): {', '.join(why)}" + (f". Errors: {errs}" if errs else "") +
+                         f". Command: `{r['command']}`")
+    else:
+        lines.append("Every run: exit 0, output valid, boundary topology unchanged, strict Hausdorff 0.")
+    lines.append("")
+    return "\n".join(lines)
+
+
+def replace_section(readme, text):
+    with open(readme) as f:
+        lines = f.read().split("\n")
+    try:
+        start = lines.index(SECTION)
+    except ValueError:
+        body = "\n".join(lines).rstrip("\n") + "\n\n" + text
+    else:
+        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")), len(lines))
+        body = "\n".join(lines[:start]) + "\n" + text + ("\n" + "\n".join(lines[end:]) if end < len(lines) else "")
+    with open(readme, "w") as f:
+        f.write(body.rstrip("\n") + "\n")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--tetcollapse", default=None)
+    ap.add_argument("--meshes", default=os.path.join(ROOT, "..", "shared", "meshes"))
+    ap.add_argument("--modes", default="features,strict")
+    ap.add_argument("--only", default="", help="comma-separated substrings of the file names to run")
+    ap.add_argument("--out-json", default=os.path.join(HERE, "results", "shared_meshes.json"))
+    ap.add_argument("--readme", default=os.path.join(HERE, "README.md"), help="'' to leave the README alone")
+    ap.add_argument("--work-dir", default=None)
+    ap.add_argument("--timeout", type=float, default=3600)
+    a = ap.parse_args()
+    tc = a.tetcollapse or default_tetcollapse()
+    if not tc or not os.access(tc, os.X_OK):
+        sys.exit("shared_meshes.py: no tetcollapse binary (give --tetcollapse PATH)")
+    tc = os.path.abspath(tc)
+    if not os.path.isdir(a.meshes):
+        sys.exit(f"shared_meshes.py: {a.meshes}: no such folder")
+    only = [s for s in a.only.split(",") if s]
+    meshes = sorted(os.path.join(a.meshes, f) for f in os.listdir(a.meshes)
+                    if f.endswith(EXTS) and os.path.isfile(os.path.join(a.meshes, f))
+                    and (not only or any(s in f for s in only)))
+    modes = [m for m in a.modes.split(",") if m]
+    tmp = None if a.work_dir else tempfile.TemporaryDirectory(prefix="tc_shared_")
+    work = a.work_dir or tmp.name
+    os.makedirs(work, exist_ok=True)
+
+    rows = []
+    for path in meshes:
+        for mode in modes:
+            r = run_one(tc, os.path.abspath(path), mode, work, a.timeout)
+            rows.append(r)
+            why = problems(r)
+            print(f"{r['mesh']:45s} {mode:8s} tets {r.get('tets_in')} -> {r.get('tets_out')}  "
+                  f"collapse {r.get('seconds_collapse')} s  check {r.get('check')}  H {r.get('hausdorff')}"
+                  + (f"  NOT AS EXPECTED: {why}" if why else ""), flush=True)
+
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
+    loads = [r[k] for r in rows for k in ("load_avg_before", "load_avg_after")]
+    device = next((r["device"] for r in rows if r.get("device")), "?")
+    meta = {"date": datetime.date.today().isoformat(), "commit": commit, "device": device,
+            "machine": platform.node(), "load_min": min(loads) if loads else 0, "load_max": max(loads) if loads else 0}
+    os.makedirs(os.path.dirname(os.path.abspath(a.out_json)), exist_ok=True)
+    with open(a.out_json, "w") as f:
+        json.dump({"meta": meta, "runs": rows}, f, indent=1)
+        f.write("\n")
+    if a.readme:
+        replace_section(a.readme, table(rows, meta))
+    if tmp:
+        tmp.cleanup()
+
+
+if __name__ == "__main__":
+    main()
