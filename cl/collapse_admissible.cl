@@ -35,29 +35,8 @@ inline int tcc_ring_has(__global const int* tets, __global const uint* vt_off, _
   return 0;
 }
 
-/* Predicate Q; returns the edge_dir bits, or -1 to refuse. a < b. */
-inline int tcc_predicate_q(int a, int b, uint fa, uint fb, uint fe, int ca, int cb, int mode, int paper_rule) {
-  const int keep_a = TCC_DIR_REMOVE_V1, keep_b = 0;
-  const int sa = fa != 0u, sb = fb != 0u, se = (fe & (TCC_BOUNDARY | TCC_INTERFACE)) != 0u;
-  if (mode == TCC_FREE) return TCC_DIR_MIDPOINT | keep_a;
-  if (mode == TCC_STRICT) {
-    if (sa && sb) return -1;
-    if (sa || sb) return paper_rule ? -1 : (sa ? keep_a : keep_b);
-    return TCC_DIR_MIDPOINT | keep_a;
-  }
-  /* features */
-  if (sa && sb && !se) return -1;               /* would pinch two sheets of S together */
-  if (paper_rule && (sa || sb) && !se) return -1; /* the paper: no interior edge touching S */
-  if (ca == cb) {
-    if (ca == TCC_CORNER) return -1;
-    if (ca == TCC_RIDGEV && !(fe & TCC_RIDGE)) return -1;
-    return TCC_DIR_MIDPOINT | keep_a; /* equal ranks: midpoint, survivor = lower index */
-  }
-  int removed_class = ca < cb ? ca : cb;
-  if (removed_class == TCC_FACE && !se) return -1;
-  if (removed_class == TCC_RIDGEV && !(fe & TCC_RIDGE)) return -1;
-  return ca > cb ? keep_a : keep_b;
-}
+/* Predicate Q (tcc_predicate_q): shared with the sequential CPU method. */
+#include "collapse_predicate.h"
 
 /* The link condition and the volume test of the edge (a, b), a < b, which passed Q with the
  * direction bits dir; returns TCC_OK or the refusal (TCC_REFUSED_LINK / TCC_REFUSED_VOLUME). */
@@ -246,31 +225,24 @@ __kernel void lazy_init(uint ne, __global const int* edges, __global const uint*
   atomic_inc(&counters[5]);
 }
 
-/* One round over the undecided candidates (worklists as in collapse_conflict.cl). */
-__kernel void lazy_pass1_round(uint n, int first, __global const uint* list, __global uint* next,
-                               __global uint* next_n, __global const uint* cand, __global uint* rivals,
-                               __global uint* rcount, __global const int* edges, __global const double* cost,
-                               __global const int* tets, __global const uint* vt_off, __global const int* vt,
-                               __global const uint* nb_off, __global const int* nb, __global const int* nb_edge,
-                               __global const int* labels, int use_labels, __global const double* pts,
-                               __global const uchar* vflags, __global const uchar* vclass,
-                               __global const uchar* eflags, int mode, int paper_rule, double eps_v,
-                               double q_min, __global uchar* state, __global uchar* edge_dir, __global uchar* reason,
-                               __global uint* counters, __global uchar* verdict) {
+/* The decision half of a pass-1 round (pass1_claim in collapse_conflict.cl is the other): an
+ * edge whose turn comes is tested (or takes the verdict carried from an earlier iteration) and
+ * is IN when it passes, OUT otherwise. */
+__kernel void lazy_pass1_decide(uint n, int first, __global const uint* list, __global uint* next,
+                                __global uint* next_n, __global const uint* cand, __global const int* edges,
+                                __global const int* slot, __global int* slot_next, __global uchar* state,
+                                __global int* vaff, __global const int* tets, __global const uint* vt_off,
+                                __global const int* vt, __global const uint* nb_off, __global const int* nb,
+                                __global const int* nb_edge, __global const int* labels, int use_labels,
+                                __global const double* pts, __global const uchar* vflags,
+                                __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
+                                double eps_v, double q_min, __global uchar* edge_dir, __global uchar* reason,
+                                __global uint* counters, __global uchar* verdict) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  uint c = first ? i : list[i];
-  int e = (int)cand[c];
+  int e;
+  if (tcc_pass1_turn(i, first, list, next, next_n, cand, edges, slot, slot_next, state, &e) <= 0) return;
   int a = edges[2 * e], b = edges[2 * e + 1];
-  int w = tcc_pass1_wait(e, a, b, nb_off, nb_edge, cost, state, rivals + c * TCC_RIVALS, rcount + c);
-  if (w < 0) {
-    state[e] = TCC_OUT; /* reason stays TCC_UNTESTED */
-    return;
-  }
-  if (w > 0) {
-    next[atomic_inc(next_n)] = c;
-    return;
-  }
   uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
   int dir = tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule);
   /* a verdict carried from an earlier iteration (the rings of a and b are unchanged since) */
@@ -286,6 +258,8 @@ __kernel void lazy_pass1_round(uint n, int first, __global const uint* list, __g
     edge_dir[e] = (uchar)dir;
     atomic_inc(&counters[1]);
     state[e] = TCC_IN;
+    vaff[a] = e;
+    vaff[b] = e;
   } else {
     state[e] = TCC_OUT;
   }

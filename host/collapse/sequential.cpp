@@ -1,13 +1,245 @@
-// The sequential CPU method (CollapseOptions::Sequential). PLACEHOLDER being written (issue 6):
-// it refuses to run until the implementation lands.
+// The sequential CPU method (CollapseOptions::Sequential): see collapse/sequential_run.hpp for
+// the iteration and collapse/sequential_mesh.hpp for the dynamic mesh and its checks.
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
+#include <string>
 
+#include "collapse/sequential_run.hpp"
+#include "collapse/stages.hpp"  // collapse_detail::Reason
+#include "collapse_predicate.h"
 #include "tetcollapse/collapse.hpp"
 
 namespace tc {
 
-CollapseReport collapse_sequential(Mesh&, const CollapseOptions&) {
-  throw std::invalid_argument("the sequential method is not implemented yet");
+namespace sequential_detail {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Options first (std::invalid_argument), as collapse() checks them before touching the mesh.
+SeqParams checked_params(const Mesh& mesh, const CollapseOptions& o) {
+  if (o.max_iterations < 0) throw std::invalid_argument("max_iterations must be >= 0");
+  if (!o.cost_cl_source.empty())
+    throw std::invalid_argument(
+        "the sequential method cannot evaluate a user cost (cost_cl_source, also behind --sizing-field): it is "
+        "OpenCL C, compiled for a device; use the parallel method");
+  if (!(o.target_length > 0) && !(o.target_factor > 0))
+    throw std::invalid_argument("target_factor must be > 0 when target_length is not given");
+  if (!o.vertex_mask.empty() && o.vertex_mask.size() != size_t(mesh.num_vertices()))
+    throw std::invalid_argument("vertex_mask has " + std::to_string(o.vertex_mask.size()) + " entries for " +
+                                std::to_string(mesh.num_vertices()) + " vertices");
+  SeqParams p = seq_params_from(o);
+  if (o.eps_v_relative) {  // eps_v x (bounding-box diagonal)^3, as collapse() computes it
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i + 2 < mesh.points.size(); i += 3)
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = std::min(lo[c], mesh.points[i + c]);
+        hi[c] = std::max(hi[c], mesh.points[i + c]);
+      }
+    double d2 = 0;
+    for (int c = 0; c < 3; ++c) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
+    p.eps_v = o.eps_v * d2 * std::sqrt(d2);
+  }
+  return p;
+}
+
+// Input triangles / edges through the vertex map; degenerate ones (and bad indices) dropped,
+// tags kept with their element (as collapse() does for the device result).
+void remap_elements(std::vector<int32_t>& elems, std::vector<int32_t>& tags, int arity,
+                    const std::vector<int32_t>& origin) {
+  const size_t n = elems.size() / arity;
+  size_t m = 0, kt = 0;  // elements and tags kept (in place: m <= i)
+  for (size_t i = 0; i < n; ++i) {
+    int32_t v[3];
+    bool ok = true;
+    for (int k = 0; k < arity && ok; ++k) {
+      const int32_t x = elems[i * arity + k];
+      ok = x >= 0 && size_t(x) < origin.size();
+      if (!ok) break;
+      v[k] = origin[x];
+      for (int j = 0; j < k; ++j) ok = ok && v[j] != v[k];
+    }
+    if (!ok) continue;
+    std::copy(v, v + arity, elems.begin() + m * arity);
+    if (i < tags.size()) tags[kt++] = tags[i];
+    ++m;
+  }
+  elems.resize(m * arity);
+  tags.resize(kt);
+}
+
+// Queue order: (cost, a, b) ascending, i.e. (cost, edge index); a heap comparator is "after".
+bool after(double ca, int32_t aa, int32_t ab, double cb, int32_t ba, int32_t bb) {
+  if (ca != cb) return ca > cb;
+  return aa != ba ? aa > ba : ab > bb;
+}
+
+}  // namespace
+
+SeqParams seq_params_from(const CollapseOptions& o) {
+  SeqParams p;
+  p.mode = o.boundary == CollapseOptions::Strict ? TCC_STRICT
+           : o.boundary == CollapseOptions::Features ? TCC_FEATURES
+                                                     : TCC_FREE;
+  p.paper_rule = o.paper_boundary_rule;
+  p.use_labels = o.use_labels;
+  p.eps_f = o.eps_f;
+  p.eps_r = o.eps_r;
+  p.eps_v = o.eps_v;
+  p.min_quality = o.min_quality;
+  return p;
+}
+
+SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options)
+    : mesh_(mesh), o_(options), t_start_(std::chrono::steady_clock::now()), sm_(mesh, checked_params(mesh, options)) {
+  report_.device = "cpu-sequential";
+  report_.vertices_in = mesh.num_vertices();
+  report_.tets_in = mesh.num_tets();
+  report_.eps_v = checked_params(mesh, options).eps_v;
+  mask_ = options.vertex_mask;
+  if (!mesh.tris.empty() || !mesh.edges.empty()) {
+    origin_.resize(size_t(mesh.num_vertices()));
+    for (size_t i = 0; i < origin_.size(); ++i) origin_[i] = int32_t(i);
+  }
+  touched_.assign(size_t(sm_.num_vertices()), 0);
+  target_ = options.target_length;
+}
+
+bool SequentialRun::step() {
+  using namespace collapse_detail;
+  if (done_ || it_ >= o_.max_iterations || sm_.alive_tets() == 0) {
+    done_ = true;
+    return false;
+  }
+  IterationStats s;
+  s.iteration = it_;
+  s.vertices = sm_.alive_vertices();
+  s.tets = sm_.alive_tets();
+  const auto t0 = std::chrono::steady_clock::now();
+
+  // 1. edges and costs
+  edges_.clear();
+  const int32_t nv = sm_.num_vertices();
+  for (int32_t v = 0; v < nv; ++v) {
+    sm_.neighbours(v, nb_, true);
+    for (int32_t u : nb_) edges_.push_back({sm_.length(v, u), v, u, 0});
+  }
+  s.edges = int64_t(edges_.size());
+  const double t1 = seconds_since(t0);
+  if (it_ == 0 && !(target_ > 0)) {
+    // the median edge length of the input (the lower median, as tc::median_edge_length)
+    std::vector<double> len(edges_.size());
+    for (size_t i = 0; i < edges_.size(); ++i) len[i] = edges_[i].cost;
+    if (!len.empty()) {
+      const size_t m = (len.size() - 1) / 2;
+      std::nth_element(len.begin(), len.begin() + m, len.end());
+      report_.median_edge_length = len[m];
+    }
+    target_ = o_.target_factor * report_.median_edge_length;
+  }
+  // marking, Q, link and volume; the admissible edges into the queue
+  const bool reuse = o_.reuse_across_iterations;
+  const uint32_t prev = uint32_t(it_);  // touched_ value of the previous iteration (0: the input)
+  const int mask_mode = mask_.empty() ? 0 : o_.mask_either ? 2 : 1;
+  auto marked = [&](int32_t a, int32_t b, double cost) {
+    const bool allowed = mask_mode == 0 ? true : mask_mode == 1 ? (mask_[a] && mask_[b]) : (mask_[a] || mask_[b]);
+    return allowed && cost < target_;
+  };
+  heap_.clear();
+  for (const QueueEntry& e : edges_) {
+    if (!marked(e.a, e.b, e.cost)) continue;
+    ++s.marked;
+    uint8_t fe = 0;
+    const int dir = sm_.predicate(e.a, e.b, fe);
+    if (dir < 0) continue;
+    ++s.passed_q;
+    if (reuse && touched_[e.a] != prev && touched_[e.b] != prev) continue;  // refused then, refused now
+    ++s.tested;
+    if (sm_.link_and_volume(e.a, e.b, fe, dir) != kOk) continue;
+    heap_.push_back({e.cost, e.a, e.b, uint8_t(dir)});
+  }
+  s.admissible = int64_t(heap_.size());
+  auto later = [](const QueueEntry& x, const QueueEntry& y) { return after(x.cost, x.a, x.b, y.cost, y.a, y.b); };
+  std::make_heap(heap_.begin(), heap_.end(), later);
+  const double t2 = seconds_since(t0);
+
+  // 2. pop, check again where an earlier collapse changed the star, collapse
+  const uint32_t cur = uint32_t(it_) + 1;
+  while (!heap_.empty()) {
+    std::pop_heap(heap_.begin(), heap_.end(), later);
+    const QueueEntry e = heap_.back();
+    heap_.pop_back();
+    if (!sm_.alive(e.a) || !sm_.alive(e.b)) continue;
+    uint8_t dir = e.dir;
+    if (!reuse || touched_[e.a] == cur || touched_[e.b] == cur) {
+      if (!sm_.is_edge(e.a, e.b)) continue;
+      const double cost = sm_.length(e.a, e.b);
+      if (!marked(e.a, e.b, cost)) continue;
+      if (cost != e.cost) {  // an end point moved: back into the queue at its new place
+        heap_.push_back({cost, e.a, e.b, 0});
+        std::push_heap(heap_.begin(), heap_.end(), later);
+        continue;
+      }
+      const Verdict v = sm_.check(e.a, e.b);
+      if (v.reason != kOk) continue;
+      dir = v.dir;
+    }
+    sm_.collapse(e.a, e.b, dir);
+    ++s.collapsed;
+    for (int32_t u : sm_.touched()) touched_[u] = cur;
+  }
+  s.after_pass1 = s.after_pass2 = s.collapsed;  // no conflict passes: every collapse is applied
+
+  // 3. compaction
+  if (s.collapsed > 0) {
+    sm_.compact(vmap_, kept_);
+    // per-vertex data of the survivors; origin composed with the vertex map
+    for (size_t i = 0; i < kept_.size(); ++i) touched_[i] = touched_[kept_[i]];
+    touched_.resize(kept_.size());
+    if (!mask_.empty()) {
+      for (size_t i = 0; i < kept_.size(); ++i) mask_[i] = mask_[kept_[i]];
+      mask_.resize(kept_.size());
+    }
+    for (int32_t& x : origin_) x = vmap_[x];
+  }
+  const double t4 = seconds_since(t0);
+  s.seconds_connectivity = t1;
+  s.seconds_cost = 0;  // the lengths come with the edge list
+  s.seconds_admissible = t2 - t1;
+  s.seconds_collapse = t4 - t2;
+  s.seconds_total = t4;
+  s.vertices_after = sm_.alive_vertices();
+  s.tets_after = sm_.alive_tets();
+  report_.iterations.push_back(s);
+  if (o_.progress) o_.progress(s);
+  ++it_;
+  if (s.collapsed < std::max<int64_t>(o_.eps_c, 1)) done_ = true;
+  return !done_;
+}
+
+CollapseReport SequentialRun::finish() {
+  if (!origin_.empty()) {
+    remap_elements(mesh_.tris, mesh_.tri_tags, 3, origin_);
+    remap_elements(mesh_.edges, mesh_.edge_tags, 2, origin_);
+  }
+  report_.target_length = target_;
+  report_.vertices_out = mesh_.num_vertices();
+  report_.tets_out = mesh_.num_tets();
+  report_.seconds_total = seconds_since(t_start_);
+  return report_;
+}
+
+}  // namespace sequential_detail
+
+CollapseReport collapse_sequential(Mesh& mesh, const CollapseOptions& options) {
+  sequential_detail::SequentialRun run(mesh, options);
+  while (run.step()) {
+  }
+  return run.finish();
 }
 
 }  // namespace tc

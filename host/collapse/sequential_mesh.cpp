@@ -1,0 +1,641 @@
+// The dynamic mesh of the sequential method: see sequential_mesh.hpp.
+#include "collapse/sequential_mesh.hpp"
+
+#include <algorithm>
+#include <limits>
+#include <string>
+
+#include "collapse/stages.hpp"  // collapse_detail::Reason
+#include "collapse_predicate.h"
+#include "tetcollapse/error.hpp"
+
+namespace tc::sequential_detail {
+
+using namespace collapse_detail;
+using geo::tc_d3;
+
+namespace {
+
+// The list limits of the kernels, so that the verdicts agree even where they bite:
+// TCC_MAX_LINK (cl/collapse_admissible.cl) and TCC_MAX_VERTEX_SFACES (collapse_connectivity.cl).
+constexpr size_t kMaxLink = 96;
+constexpr size_t kMaxVertexSFaces = 64;
+constexpr uint8_t kSMask = TCC_BOUNDARY | TCC_INTERFACE;
+
+tc_d3 face_normal(const std::vector<double>& pts, const int32_t* q, int f) {
+  tc_d3 p0 = geo::tc_point(pts.data(), q[geo::TC_TET_FACES[f][0]]);
+  tc_d3 p1 = geo::tc_point(pts.data(), q[geo::TC_TET_FACES[f][1]]);
+  tc_d3 p2 = geo::tc_point(pts.data(), q[geo::TC_TET_FACES[f][2]]);
+  return geo::normalize(geo::cross(p1 - p0, p2 - p0));
+}
+
+// Does the face of q opposite local vertex f run from x to y (x, y consecutive in its order)?
+bool runs(const int32_t* q, int f, int32_t x, int32_t y) {
+  int32_t f0 = q[geo::TC_TET_FACES[f][0]], f1 = q[geo::TC_TET_FACES[f][1]], f2 = q[geo::TC_TET_FACES[f][2]];
+  return (f0 == x && f1 == y) || (f1 == x && f2 == y) || (f2 == x && f0 == y);
+}
+
+}  // namespace
+
+SeqMesh::SeqMesh(Mesh& mesh, const SeqParams& params)
+    : mesh_(mesh), points_(&mesh.points), tets_(&mesh.tets), p_(params) {
+  // the same refusals as the device pipeline's upload (host/collapse/stages.cpp)
+  if (mesh.points.size() % 3 != 0 || mesh.tets.size() % 4 != 0)
+    throw InputError("<mesh>", "point or tet array length is not a multiple of 3 or 4");
+  const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
+  if (nv >= std::numeric_limits<int32_t>::max() || nt >= std::numeric_limits<int32_t>::max() / 12)
+    throw InputError("<mesh>", "mesh too large for 32-bit indices: " + std::to_string(nv) + " vertices, " +
+                                   std::to_string(nt) + " tets");
+  for (int64_t t = 0; t < nt; ++t) {
+    const int32_t* q = &mesh.tets[4 * t];
+    for (int i = 0; i < 4; ++i) {
+      if (q[i] < 0 || q[i] >= nv)
+        throw InputError("<mesh>", "tet " + std::to_string(t) + " has vertex index " + std::to_string(q[i]) +
+                                       " outside [0, " + std::to_string(nv) + ")");
+      for (int j = 0; j < i; ++j)
+        if (q[i] == q[j]) throw InputError("<mesh>", "tet " + std::to_string(t) + " repeats vertex " + std::to_string(q[i]));
+    }
+  }
+  for (const Labels& l : mesh.tet_labels)
+    if (l.values.size() != size_t(nt))
+      throw InputError("<mesh>", "label array '" + l.name + "' has " + std::to_string(l.values.size()) +
+                                     " values for " + std::to_string(nt) + " tets");
+  auto check_fields = [](const std::vector<Field>& fields, int64_t count, const char* kind) {
+    for (const Field& f : fields)
+      if (f.components <= 0 || f.values.size() != size_t(count) * size_t(f.components))
+        throw InputError("<mesh>", std::string(kind) + " field '" + f.name + "' has " + std::to_string(f.values.size()) +
+                                       " values, expected " + std::to_string(count) + " x " + std::to_string(f.components));
+  };
+  check_fields(mesh.vertex_fields, nv, "vertex");
+  check_fields(mesh.tet_fields, nt, "tet");
+
+  labels_ = p_.use_labels && !mesh.tet_labels.empty() ? &mesh.tet_labels[0].values : nullptr;
+  nv_ = alive_v_ = int32_t(nv);
+  nt_ = alive_t_ = int32_t(nt);
+  valive_.assign(nv_, 1);
+  talive_.assign(nt_, 1);
+  fwd_.assign(nv_, -1);
+  mark_.assign(nv_, 0);
+  lmark_.assign(nv_, 0);
+  vflags_.assign(nv_, 0);
+  vclass_.assign(nv_, TCC_INTERIOR);
+  rebuild_rings();
+  for (int32_t v = 0; v < nv_; ++v) classify(v, vflags_[v], vclass_[v]);
+}
+
+// --- vertex -> tets lists ---
+
+void SeqMesh::rebuild_rings() {
+  rlen_.assign(nv_, 0);
+  for (int32_t t = 0; t < nt_; ++t)
+    for (int k = 0; k < 4; ++k) ++rlen_[tet(t)[k]];
+  // every list gets room to grow by half (a survivor takes over the tets of the removed vertex)
+  roff_.resize(nv_);
+  rcap_.resize(nv_);
+  size_t total = 0;
+  for (int32_t v = 0; v < nv_; ++v) {
+    roff_[v] = uint32_t(total);
+    rcap_[v] = rlen_[v] + rlen_[v] / 2 + 2;
+    total += rcap_[v];
+  }
+  if (total + total / 2 >= std::numeric_limits<uint32_t>::max())
+    throw InputError("<mesh>", "mesh too large for the sequential method's 32-bit list offsets");
+  pool_.clear();
+  pool_.reserve(total + total / 4);  // lists that outgrow their slot move to the end
+  pool_.resize(total);
+  std::fill(rlen_.begin(), rlen_.end(), 0u);
+  for (int32_t t = 0; t < nt_; ++t)
+    for (int k = 0; k < 4; ++k) {
+      int32_t v = tet(t)[k];
+      pool_[roff_[v] + rlen_[v]++] = t;
+    }
+}
+
+void SeqMesh::ring_append(int32_t v, int32_t t) {
+  if (rlen_[v] == rcap_[v]) {
+    const uint32_t cap = std::max<uint32_t>(8, 2 * rcap_[v]);
+    const size_t at = pool_.size();
+    if (at + cap >= std::numeric_limits<uint32_t>::max())
+      throw InputError("<mesh>", "mesh too large for the sequential method's 32-bit list offsets");
+    pool_.resize(at + cap);
+    std::copy(pool_.begin() + roff_[v], pool_.begin() + roff_[v] + rlen_[v], pool_.begin() + at);
+    roff_[v] = uint32_t(at);
+    rcap_[v] = cap;
+  }
+  pool_[roff_[v] + rlen_[v]++] = t;
+}
+
+void SeqMesh::ring_remove(int32_t v, int32_t t) {
+  int32_t* r = pool_.data() + roff_[v];
+  for (uint32_t i = 0; i < rlen_[v]; ++i)
+    if (r[i] == t) {
+      r[i] = r[--rlen_[v]];
+      return;
+    }
+}
+
+uint32_t SeqMesh::next_stamp() {
+  if (++stamp_ == 0) {  // wrapped: forget every old stamp
+    std::fill(mark_.begin(), mark_.end(), 0u);
+    std::fill(lmark_.begin(), lmark_.end(), 0u);
+    stamp_ = 1;
+  }
+  return stamp_;
+}
+
+void SeqMesh::neighbours(int32_t v, std::vector<int32_t>& out, bool above_only) {
+  out.clear();
+  const uint32_t s = next_stamp();
+  const int32_t* r = ring(v);
+  for (uint32_t i = 0; i < rlen_[v]; ++i) {
+    const int32_t* q = tet(r[i]);
+    for (int k = 0; k < 4; ++k) {
+      int32_t u = q[k];
+      if (u == v || (above_only && u < v) || mark_[u] == s) continue;
+      mark_[u] = s;
+      out.push_back(u);
+    }
+  }
+}
+
+bool SeqMesh::is_edge(int32_t a, int32_t b) const {
+  const int32_t* r = ring(a);
+  for (uint32_t i = 0; i < rlen_[a]; ++i)
+    if (has(tet(r[i]), b)) return true;
+  return false;
+}
+
+double SeqMesh::length(int32_t a, int32_t b) const {
+  tc_d3 d = point(b) - point(a);
+  return geo::sqrt(geo::dot(d, d));
+}
+
+bool SeqMesh::ring_has(int32_t x, int32_t y, int32_t z, int32_t w) const {
+  const int32_t* r = ring(x);
+  for (uint32_t i = 0; i < rlen_[x]; ++i) {
+    const int32_t* q = tet(r[i]);
+    if (has(q, y) && has(q, z) && (w < 0 || has(q, w))) return true;
+  }
+  return false;
+}
+
+// tcc_triangle_kind: is (x, y, z) an S-face?
+uint8_t SeqMesh::triangle_kind(int32_t x, int32_t y, int32_t z) const {
+  int n = 0;
+  int32_t t0 = -1, t1 = -1;
+  const int32_t* r = ring(x);
+  for (uint32_t i = 0; i < rlen_[x]; ++i) {
+    const int32_t* q = tet(r[i]);
+    if (has(q, y) && has(q, z)) {
+      if (n == 0) t0 = r[i];
+      else if (n == 1) t1 = r[i];
+      ++n;
+    }
+  }
+  if (n == 0) return 0;
+  if (n != 2) return TCC_BOUNDARY;
+  if (labels_ && label(t0) != label(t1)) return TCC_INTERFACE;
+  return 0;
+}
+
+// --- flags and classes (conn_edge_flags, conn_vertex_flags*, conn_vertex_class) ---
+
+uint8_t SeqMesh::edge_flags(int32_t a, int32_t b, bool with_ridge) {
+  if (!vflags_[a] || !vflags_[b]) return 0;  // an S-edge joins two S vertices
+  // the tets around the edge; every face through a and b is a face of two of them (or one)
+  tab_.clear();
+  const int32_t* r = ring(a);
+  for (uint32_t i = 0; i < rlen_[a]; ++i)
+    if (has(tet(r[i]), b)) tab_.push_back(r[i]);
+  uint8_t flags = 0;
+  int ns = 0;
+  int32_t ft[2] = {-1, -1};
+  int ff[2] = {0, 0};
+  for (int32_t t : tab_) {
+    const int32_t* q = tet(t);
+    const int la = local(q, a), lb = local(q, b);
+    for (int f = 0; f < 4; ++f) {
+      if (f == la || f == lb) continue;
+      const int32_t x = q[6 - la - lb - f];  // the face's third vertex
+      int n = 0;
+      int32_t other = -1;
+      for (int32_t u : tab_)
+        if (u != t && has(tet(u), x)) {
+          if (n == 0) other = u;
+          ++n;
+        }
+      uint8_t on_s = 0, own = 0;
+      if (n != 1) {  // no other tet (boundary), or several (invalid input: boundary for each)
+        on_s = own = TCC_BOUNDARY;
+      } else if (labels_ && label(t) != label(other)) {
+        on_s = TCC_INTERFACE;
+        own = label(t) < label(other) ? TCC_INTERFACE : 0;
+      }
+      flags |= on_s;
+      if (own) {
+        if (ns < 2) {
+          ft[ns] = t;
+          ff[ns] = f;
+        }
+        ++ns;
+      }
+    }
+  }
+  if (with_ridge && ns > 0) {
+    bool ridge;
+    if (ns != 2) {
+      ridge = true;
+    } else if (runs(tet(ft[0]), ff[0], a, b) == runs(tet(ft[1]), ff[1], a, b)) {
+      ridge = true;  // the two S-faces are not consistently oriented
+    } else {
+      tc_d3 n0 = face_normal(*points_, tet(ft[0]), ff[0]), n1 = face_normal(*points_, tet(ft[1]), ff[1]);
+      ridge = 1.0 - geo::dot(n0, n1) > p_.eps_r;
+    }
+    if (ridge) flags |= TCC_RIDGE;
+  }
+  return flags;
+}
+
+void SeqMesh::classify(int32_t v, uint8_t& flags_out, uint8_t& cls_out) {
+  // every face through v, keyed by its two other vertices; equal keys are the same face
+  faces_.clear();
+  const int32_t* r = ring(v);
+  for (uint32_t i = 0; i < rlen_[v]; ++i) {
+    const int32_t t = r[i];
+    const int32_t* q = tet(t);
+    const int lv = local(q, v);
+    for (int f = 0; f < 4; ++f) {
+      if (f == lv) continue;
+      int32_t o[2];
+      int no = 0;
+      for (int j = 0; j < 4; ++j)
+        if (j != f && j != lv) o[no++] = q[j];
+      faces_.push_back({std::min(o[0], o[1]), std::max(o[0], o[1]), t, int8_t(f)});
+    }
+  }
+  std::sort(faces_.begin(), faces_.end(),
+            [](const FaceAt& x, const FaceAt& y) { return x.y != y.y ? x.y < y.y : x.z < y.z; });
+  uint8_t flags = 0;
+  bool overflow = false;
+  sfaces_.clear();
+  for (size_t i = 0; i < faces_.size();) {
+    size_t j = i + 1;
+    while (j < faces_.size() && faces_[j].y == faces_[i].y && faces_[j].z == faces_[i].z) ++j;
+    const size_t others = j - i - 1;
+    for (size_t k = i; k < j; ++k) {
+      const int32_t t = faces_[k].t;
+      uint8_t on_s = 0, own = 0;
+      if (others != 1) {
+        on_s = own = TCC_BOUNDARY;
+      } else {
+        const int32_t other = faces_[k == i ? i + 1 : i].t;
+        if (labels_ && label(t) != label(other)) {
+          on_s = TCC_INTERFACE;
+          own = label(t) < label(other) ? TCC_INTERFACE : 0;
+        }
+      }
+      flags |= on_s;
+      if (!own) continue;
+      if (sfaces_.size() == kMaxVertexSFaces) {
+        overflow = true;
+        continue;
+      }
+      const int32_t* q = tet(t);
+      const int f = faces_[k].f;
+      int32_t w[3] = {q[geo::TC_TET_FACES[f][0]], q[geo::TC_TET_FACES[f][1]], q[geo::TC_TET_FACES[f][2]]};
+      int p = w[0] == v ? 0 : w[1] == v ? 1 : 2;
+      sfaces_.push_back({t, int8_t(f), w[(p + 1) % 3], w[(p + 2) % 3], face_normal(*points_, q, f)});
+    }
+    i = j;
+  }
+  flags_out = flags;
+  if (!flags || (sfaces_.empty() && !overflow)) {
+    cls_out = TCC_INTERIOR;
+    return;
+  }
+  if (overflow) {
+    cls_out = TCC_CORNER;
+    return;
+  }
+  // ridge edges at v: the edges (v, u) of its owned S-faces that conn_edge_flags calls ridges
+  us_.clear();
+  for (const SFace& s : sfaces_) {
+    us_.push_back(s.after);
+    us_.push_back(s.before);
+  }
+  std::sort(us_.begin(), us_.end());
+  us_.erase(std::unique(us_.begin(), us_.end()), us_.end());
+  int ridges = 0;
+  for (int32_t u : us_) {
+    int ns = 0;
+    const SFace* two[2] = {nullptr, nullptr};
+    for (const SFace& s : sfaces_)
+      if (s.after == u || s.before == u) {
+        if (ns < 2) two[ns] = &s;
+        ++ns;
+      }
+    bool ridge;
+    if (ns != 2) ridge = true;
+    else if ((two[0]->after == u) == (two[1]->after == u)) ridge = true;  // same direction along (v, u)
+    else ridge = 1.0 - geo::dot(two[0]->n, two[1]->n) > p_.eps_r;
+    ridges += ridge ? 1 : 0;
+  }
+  uint8_t cls;
+  if (ridges == 2) {
+    cls = TCC_RIDGEV;
+  } else if (ridges != 0) {
+    cls = TCC_CORNER;
+  } else {
+    cls = TCC_FACE;
+    const int fn = int(sfaces_.size());
+    for (int i = 0; i < fn && cls == TCC_FACE; ++i)
+      for (int j = i + 1; j < fn; ++j)
+        if (1.0 - geo::dot(sfaces_[i].n, sfaces_[j].n) > p_.eps_f) {
+          cls = TCC_CORNER;
+          break;
+        }
+    if (cls == TCC_FACE) {
+      // one closed fan, walked as conn_vertex_class does (the result does not depend on the start)
+      int cur = 0;
+      for (int step = 1; step <= fn; ++step) {
+        int32_t want = sfaces_[cur].before;
+        int next = -1, found = 0;
+        for (int j = 0; j < fn; ++j)
+          if (sfaces_[j].after == want) {
+            next = j;
+            ++found;
+          }
+        if (found != 1) {
+          cls = TCC_CORNER;
+          break;
+        }
+        cur = next;
+        if (cur == 0 && step != fn) {
+          cls = TCC_CORNER;
+          break;
+        }
+      }
+      if (cls == TCC_FACE && cur != 0) cls = TCC_CORNER;
+    }
+  }
+  cls_out = cls;
+}
+
+int64_t SeqMesh::verify_classes() {
+  int64_t bad = 0;
+  for (int32_t v = 0; v < nv_; ++v) {
+    if (!valive_[v]) continue;
+    uint8_t f = 0, c = 0;
+    classify(v, f, c);
+    if (f != vflags_[v] || c != vclass_[v]) ++bad;
+  }
+  return bad;
+}
+
+// --- the admissible checks ---
+
+int SeqMesh::predicate(int32_t a, int32_t b, uint8_t& fe) {
+  fe = edge_flags(a, b);
+  return rules::tcc_predicate_q(a, b, vflags_[a], vflags_[b], fe, vclass_[a], vclass_[b], p_.mode,
+                                p_.paper_rule ? 1 : 0);
+}
+
+Verdict SeqMesh::check(int32_t a, int32_t b) {
+  if (a > b) std::swap(a, b);
+  Verdict v;
+  uint8_t fe = 0;
+  const int dir = predicate(a, b, fe);
+  if (dir < 0) {
+    v.reason = kRefusedQ;
+    return v;
+  }
+  v.reason = link_and_volume(a, b, fe, dir);
+  if (v.reason == kOk) v.dir = uint8_t(dir);
+  return v;
+}
+
+tc_d3 SeqMesh::placement(int32_t a, int32_t b, unsigned dir) const {
+  tc_d3 p0 = point(a), p1 = point(b);
+  if (dir & TCC_DIR_MIDPOINT) return (p0 + p1) * 0.5;
+  return (dir & TCC_DIR_REMOVE_V1) ? p0 : p1;
+}
+
+// tcc_link_and_volume, over the current rings (a < b).
+uint8_t SeqMesh::link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir) {
+  const uint8_t fa = vflags_[a], fb = vflags_[b];
+  // --- link condition ---
+  // N(a) marked sA; the common neighbours cn = N(a) n N(b) re-marked sC
+  const uint32_t sA = next_stamp(), sC = next_stamp();
+  const int32_t* ra = ring(a);
+  const int32_t* rb = ring(b);
+  for (uint32_t i = 0; i < rlen_[a]; ++i) {
+    const int32_t* q = tet(ra[i]);
+    for (int k = 0; k < 4; ++k)
+      if (q[k] != a) mark_[q[k]] = sA;
+  }
+  cn_.clear();
+  for (uint32_t i = 0; i < rlen_[b]; ++i) {
+    const int32_t* q = tet(rb[i]);
+    for (int k = 0; k < 4; ++k) {
+      int32_t u = q[k];
+      if (u != b && mark_[u] == sA) {
+        mark_[u] = sC;
+        cn_.push_back(u);
+      }
+    }
+  }
+  if (cn_.size() > kMaxLink) return kRefusedLink;
+  // lk(ab): the pairs (c, d) of the tets around the edge, their vertices marked sL
+  const uint32_t sL = next_stamp();
+  pc_.clear();
+  pd_.clear();
+  for (uint32_t i = 0; i < rlen_[a]; ++i) {
+    const int32_t* q = tet(ra[i]);
+    if (!has(q, b)) continue;
+    int32_t o[2];
+    int no = 0;
+    for (int k = 0; k < 4; ++k)
+      if (q[k] != a && q[k] != b) o[no++] = q[k];
+    pc_.push_back(o[0]);
+    pd_.push_back(o[1]);
+    lmark_[o[0]] = lmark_[o[1]] = sL;
+  }
+  if (pc_.size() > kMaxLink) return kRefusedLink;
+  // (i) every common neighbour is a vertex of lk(ab); and w: a, b both on S needs an S-edge
+  for (int32_t c : cn_)
+    if (lmark_[c] != sL) return kRefusedLink;
+  if ((fa & kSMask) && (fb & kSMask) && !(fe & kSMask)) return kRefusedLink;
+  // (ii) with w: S-edges (a,c) and (b,c) need the S-face (a,b,c)
+  for (int32_t c : cn_) {
+    if (!(vflags_[c] & kSMask)) continue;
+    if ((edge_flags(a, c, false) & kSMask) && (edge_flags(b, c, false) & kSMask) && !triangle_kind(a, b, c))
+      return kRefusedLink;
+  }
+  // (ii) triangles and (iii) tets and S-faces, from the tets of ring(a) without b
+  for (uint32_t i = 0; i < rlen_[a]; ++i) {
+    const int32_t* q = tet(ra[i]);
+    if (has(q, b)) continue;
+    int32_t o[3];
+    int no = 0;
+    for (int k = 0; k < 4; ++k)
+      if (q[k] != a) o[no++] = q[k];
+    const bool in[3] = {mark_[o[0]] == sC, mark_[o[1]] == sC, mark_[o[2]] == sC};
+    if (in[0] && in[1] && in[2] && ring_has(b, o[0], o[1], o[2])) return kRefusedLink;  // tets (a,c,d,e), (b,c,d,e)
+    static constexpr int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+    for (const auto& pr : pairs) {
+      if (!in[pr[0]] || !in[pr[1]]) continue;
+      const int32_t c = o[pr[0]], d = o[pr[1]];
+      if (!ring_has(b, c, d, -1)) continue;  // (b,c,d) is no triangle
+      bool in_lk = false;
+      for (size_t m = 0; m < pc_.size() && !in_lk; ++m)
+        in_lk = (pc_[m] == c && pd_[m] == d) || (pc_[m] == d && pd_[m] == c);
+      if (!in_lk) return kRefusedLink;
+      if (triangle_kind(a, c, d) && triangle_kind(b, c, d)) return kRefusedLink;
+    }
+  }
+
+  // --- volumes (and the quality guard) after the tentative collapse ---
+  const tc_d3 p = placement(a, b, unsigned(dir));
+  double q_old = 1.0, q_new = 1.0;
+  const double q_min = p_.min_quality;
+  for (int side = 0; side < 2; ++side) {
+    const int32_t x = side == 0 ? a : b, y = side == 0 ? b : a;
+    const tc_d3 px = point(x);
+    if (px.x == p.x && px.y == p.y && px.z == p.z) continue;  // x does not move: its tets keep their shape
+    const int32_t* rx = ring(x);
+    for (uint32_t i = 0; i < rlen_[x]; ++i) {
+      const int32_t* q = tet(rx[i]);
+      if (has(q, y)) continue;  // removed by the collapse
+      tc_d3 c[4];
+      for (int k = 0; k < 4; ++k) c[k] = q[k] == x ? p : point(q[k]);
+      if (!(geo::tc_tet_volume(c[0], c[1], c[2], c[3]) >= p_.eps_v)) return kRefusedVolume;
+      if (q_min > 0.0) {
+        double qn = geo::tc_tet_quality(c[0], c[1], c[2], c[3]);
+        double qo = geo::tc_tet_quality(point(q[0]), point(q[1]), point(q[2]), point(q[3]));
+        q_new = qn < q_new ? qn : q_new;
+        q_old = qo < q_old ? qo : q_old;
+      }
+    }
+  }
+  if (q_min > 0.0 && q_new < (q_old < q_min ? q_old : q_min)) return kRefusedQuality;
+  return kOk;
+}
+
+// --- collapse and compaction ---
+
+int32_t SeqMesh::collapse(int32_t a, int32_t b, uint8_t dir) {
+  if (a > b) std::swap(a, b);
+  const bool remove_b = (dir & TCC_DIR_REMOVE_V1) != 0;
+  const int32_t r = remove_b ? b : a, s = remove_b ? a : b;
+  const tc_d3 p = placement(a, b, dir);
+  const bool on_s = vflags_[r] || vflags_[s];
+  // the vertices whose star changes: those of the tets of ring(r) U ring(s)
+  const uint32_t st = next_stamp();
+  touched_.clear();
+  for (int32_t x : {r, s}) {
+    const int32_t* rx = ring(x);
+    for (uint32_t i = 0; i < rlen_[x]; ++i) {
+      const int32_t* q = tet(rx[i]);
+      for (int k = 0; k < 4; ++k)
+        if (mark_[q[k]] != st) {
+          mark_[q[k]] = st;
+          touched_.push_back(q[k]);
+        }
+    }
+  }
+  // the tets of the edge disappear, the other tets of ring(r) move to s
+  rr_.assign(ring(r), ring(r) + rlen_[r]);
+  for (int32_t t : rr_) {
+    int32_t* q = tets_->data() + 4 * size_t(t);
+    if (has(q, s)) {
+      talive_[t] = 0;
+      --alive_t_;
+      for (int k = 0; k < 4; ++k)
+        if (q[k] != r) ring_remove(q[k], t);
+    } else {
+      q[local(q, r)] = s;
+      ring_append(s, t);
+    }
+  }
+  rlen_[r] = 0;
+  valive_[r] = 0;
+  --alive_v_;
+  fwd_[r] = s;
+  double* ps = points_->data() + 3 * size_t(s);
+  ps[0] = p.x;
+  ps[1] = p.y;
+  ps[2] = p.z;
+  if (dir & TCC_DIR_MIDPOINT)  // vertex fields follow the placement (collapse_compact.cl)
+    for (Field& f : mesh_.vertex_fields)
+      for (int c = 0; c < f.components; ++c) {
+        double& x = f.values[size_t(s) * f.components + c];
+        x = 0.5 * (x + f.values[size_t(r) * f.components + c]);
+      }
+  // faces of S change only through s, and only when r or s is on S (see the header)
+  if (on_s)
+    for (int32_t u : touched_)
+      if (valive_[u]) classify(u, vflags_[u], vclass_[u]);
+  return s;
+}
+
+void SeqMesh::compact(std::vector<int32_t>& vmap, std::vector<int32_t>& kept) {
+  vmap.assign(nv_, -1);
+  kept.clear();
+  int32_t n = 0;
+  for (int32_t v = 0; v < nv_; ++v)
+    if (valive_[v]) {
+      vmap[v] = n++;
+      kept.push_back(v);
+    }
+  for (int32_t v = 0; v < nv_; ++v) {
+    if (valive_[v]) continue;
+    int32_t x = v;
+    while (!valive_[x]) x = fwd_[x];  // r -> s -> ... ends at a survivor
+    vmap[v] = vmap[x];
+  }
+  // vertices and their data, in order (vmap[v] <= v: in place)
+  std::vector<double>& pts = *points_;
+  for (int32_t v = 0; v < nv_; ++v) {
+    if (!valive_[v]) continue;
+    const int32_t o = vmap[v];
+    for (int c = 0; c < 3; ++c) pts[3 * size_t(o) + c] = pts[3 * size_t(v) + c];
+    vflags_[o] = vflags_[v];
+    vclass_[o] = vclass_[v];
+  }
+  pts.resize(3 * size_t(n));
+  for (Field& f : mesh_.vertex_fields) {
+    const size_t nc = size_t(f.components);
+    for (int32_t v = 0; v < nv_; ++v)
+      if (valive_[v])
+        for (size_t c = 0; c < nc; ++c) f.values[size_t(vmap[v]) * nc + c] = f.values[size_t(v) * nc + c];
+    f.values.resize(size_t(n) * nc);
+  }
+  // tets with their labels and fields
+  std::vector<int32_t>& tets = *tets_;
+  int32_t m = 0;
+  for (int32_t t = 0; t < nt_; ++t) {
+    if (!talive_[t]) continue;
+    for (int k = 0; k < 4; ++k) tets[4 * size_t(m) + k] = vmap[tets[4 * size_t(t) + k]];
+    for (Labels& l : mesh_.tet_labels) l.values[m] = l.values[t];
+    for (Field& f : mesh_.tet_fields)
+      for (int c = 0; c < f.components; ++c)
+        f.values[size_t(m) * f.components + c] = f.values[size_t(t) * f.components + c];
+    ++m;
+  }
+  tets.resize(4 * size_t(m));
+  for (Labels& l : mesh_.tet_labels) l.values.resize(m);
+  for (Field& f : mesh_.tet_fields) f.values.resize(size_t(m) * f.components);
+
+  nv_ = alive_v_ = n;
+  nt_ = alive_t_ = m;
+  valive_.assign(n, 1);
+  talive_.assign(m, 1);
+  fwd_.assign(n, -1);
+  vflags_.resize(n);
+  vclass_.resize(n);
+  mark_.resize(n);  // stale stamps are all older than the next one
+  lmark_.resize(n);
+  rebuild_rings();
+}
+
+}  // namespace tc::sequential_detail

@@ -1,0 +1,152 @@
+// The sequential CPU method (CollapseOptions::Sequential, the paper's "CPU sequential" baseline)
+// over a dynamic mesh: vertex -> tets lists updated in place by every collapse, so nothing is
+// rebuilt between two collapses. Used by tc::collapse_sequential (sequential.cpp) and by the
+// tests, which step it one iteration at a time and compare its checks with the device's.
+//
+// Same semantics as the parallel pipeline (cl/collapse_*.cl):
+//   * the feature surface S (boundary faces and, with labels, interfaces between different
+//     primary labels), vertex flags and classes and edge flags with the rules of
+//     cl/collapse_connectivity.cl (= tc::build_topology), derived here from the tets around a
+//     vertex: every face through v lies in a tet of ring(v), so the star of v alone decides
+//     which of its faces are on S, who owns them, and so the class of v;
+//   * Q is cl/collapse_predicate.h itself (compiled as C++); the link condition with the
+//     virtual vertex, the volume test and the quality guard follow tcc_link_and_volume
+//     (cl/collapse_admissible.cl) step by step, including its list limits (TCC_MAX_LINK);
+//   * geometry from cl/geometry.h (tc::geo).
+//
+// Keeping the classes current. A collapse r -> s changes only faces through s (renamed from r,
+// glued where a tet of the edge disappears, or moved with s), so the flags and classes that can
+// change are those of s and of its neighbours, all vertices of the tets of ring(r) U ring(s)
+// before the collapse (touched()). When neither r nor s is on S no S-face changes at all (a
+// glued face is on S only if one of its two sides was), and nothing needs recomputing;
+// otherwise every touched vertex is reclassified. verify_classes() recomputes everything from
+// scratch for the tests.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "geometry.h"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/mesh.hpp"
+
+namespace tc::sequential_detail {
+
+struct SeqParams {
+  int mode = 1;  // TCC_STRICT / TCC_FEATURES / TCC_FREE
+  bool paper_rule = false;
+  bool use_labels = true;
+  double eps_f = 0.01, eps_r = 0.1, eps_v = 2e-12;
+  double min_quality = 0;
+};
+
+// Result of the admissible checks of one edge: reason as collapse_detail::Reason (kOk, kRefusedQ,
+// kRefusedLink, kRefusedVolume, kRefusedQuality) and, when kOk, the edge_dir bits.
+struct Verdict {
+  uint8_t reason = 0;
+  uint8_t dir = 0;
+};
+
+class SeqMesh {
+ public:
+  // Works on `mesh` in place (points, tets, labels, fields). Throws tc::InputError for a mesh
+  // the method cannot take (as the device pipeline's upload does).
+  SeqMesh(Mesh& mesh, const SeqParams& params);
+
+  int32_t num_vertices() const { return nv_; }  // slots, dead ones included until compact()
+  int32_t num_tets() const { return nt_; }
+  int32_t alive_vertices() const { return alive_v_; }
+  int32_t alive_tets() const { return alive_t_; }
+  bool alive(int32_t v) const { return valive_[v] != 0; }
+
+  // N(v) into out (unordered), or only its vertices above v.
+  void neighbours(int32_t v, std::vector<int32_t>& out, bool above_only = false);
+  bool is_edge(int32_t a, int32_t b) const;
+  double length(int32_t a, int32_t b) const;
+
+  uint8_t vflags(int32_t v) const { return vflags_[v]; }
+  uint8_t vclass(int32_t v) const { return vclass_[v]; }
+  // The eflags of cl/collapse_connectivity.cl (TCC_BOUNDARY | TCC_INTERFACE | TCC_RIDGE).
+  uint8_t edge_flags(int32_t a, int32_t b, bool with_ridge = true);
+
+  // The checks of an edge a < b, as the admissible filter runs them: Q (the edge_dir bits, or
+  // -1; fe receives the edge's flags), then the link condition, the volume test and the
+  // quality guard (a collapse_detail::Reason); check() runs both.
+  int predicate(int32_t a, int32_t b, uint8_t& fe);
+  uint8_t link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir);
+  Verdict check(int32_t a, int32_t b);
+
+  // Collapses the edge (a, b) in the direction `dir` (bits for the ordered pair (min, max), as
+  // check() returns them). Returns the survivor. touched() then lists every vertex whose star
+  // changed (survivor included, the removed vertex too).
+  int32_t collapse(int32_t a, int32_t b, uint8_t dir);
+  const std::vector<int32_t>& touched() const { return touched_; }
+
+  // Drops the dead vertices and tets from the mesh arrays (order kept) and rebuilds the
+  // vertex -> tets lists. vmap receives, for every vertex slot before, its new index (for a
+  // removed vertex: the new index of the vertex it finally went into), and kept, for every new
+  // index, the vertex slot it comes from.
+  void compact(std::vector<int32_t>& vmap, std::vector<int32_t>& kept);
+
+  // Recomputes every flag and class from scratch; returns the number of vertices whose cached
+  // flags or class differ (0 when the incremental updates are right).
+  int64_t verify_classes();
+
+ private:
+  struct FaceAt {  // a face through v: tet t, local face f (opposite vertex f), other vertices y < z
+    int32_t y, z, t;
+    int8_t f;
+  };
+  struct SFace {  // an S-face owned by a tet of ring(v)
+    int32_t t;
+    int8_t f;
+    int32_t after, before;  // the vertices after and before v along the face's orientation
+    geo::tc_d3 n;
+  };
+
+  const int32_t* tet(int32_t t) const { return tets_->data() + 4 * size_t(t); }
+  static bool has(const int32_t* q, int32_t x) { return q[0] == x || q[1] == x || q[2] == x || q[3] == x; }
+  static int local(const int32_t* q, int32_t x) {
+    return q[0] == x ? 0 : q[1] == x ? 1 : q[2] == x ? 2 : q[3] == x ? 3 : -1;
+  }
+  geo::tc_d3 point(int32_t v) const { return geo::tc_point(points_->data(), v); }
+  int32_t label(int32_t t) const { return labels_ ? (*labels_)[t] : 0; }
+
+  const int32_t* ring(int32_t v) const { return pool_.data() + roff_[v]; }
+  uint32_t ring_size(int32_t v) const { return rlen_[v]; }
+  void ring_append(int32_t v, int32_t t);
+  void ring_remove(int32_t v, int32_t t);
+  void rebuild_rings();
+
+  uint32_t next_stamp();
+  void classify(int32_t v, uint8_t& flags, uint8_t& cls);
+  bool ring_has(int32_t x, int32_t y, int32_t z, int32_t w) const;
+  uint8_t triangle_kind(int32_t x, int32_t y, int32_t z) const;
+  geo::tc_d3 placement(int32_t a, int32_t b, unsigned dir) const;
+
+  Mesh& mesh_;
+  std::vector<double>* points_;
+  std::vector<int32_t>* tets_;
+  const std::vector<int32_t>* labels_ = nullptr;  // primary labels when they drive interfaces
+  SeqParams p_;
+  int32_t nv_ = 0, nt_ = 0, alive_v_ = 0, alive_t_ = 0;
+  int vfield_comps_ = 0;
+
+  std::vector<uint8_t> valive_, talive_;
+  // vertex -> tets: ring(v) = pool_[roff_[v] .. roff_[v] + rlen_[v]), capacity rcap_[v]; a list
+  // that outgrows its slot moves to the end of the pool (rebuilt compactly by compact()).
+  std::vector<int32_t> pool_;
+  std::vector<uint32_t> roff_, rlen_, rcap_;
+  std::vector<uint8_t> vflags_, vclass_;
+  std::vector<int32_t> fwd_;  // removed vertex -> the vertex it went into
+
+  // scratch, reused: no allocation per check or collapse once warm
+  std::vector<uint32_t> mark_, lmark_;
+  uint32_t stamp_ = 0;
+  std::vector<int32_t> cn_, pc_, pd_, rr_, touched_, tab_;
+  std::vector<FaceAt> faces_;
+  std::vector<SFace> sfaces_;
+  std::vector<int32_t> us_;
+};
+
+}  // namespace tc::sequential_detail

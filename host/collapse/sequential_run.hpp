@@ -1,0 +1,74 @@
+// The iterations of the sequential CPU method (tc::collapse_sequential), one step at a time so
+// that the tests can look at the mesh between two iterations.
+//
+// One iteration (the paper's "CPU sequential" baseline, Sec. 4):
+//   1. every edge of the current mesh with its cost (the edge length) and marking (cost below
+//      the target, vertex mask); Q and then the link condition, the volume test and the quality
+//      guard on each marked edge; every admissible edge goes into a priority queue ordered by
+//      (cost, edge index) -- the edge index order is that of the lexicographic (a, b), a < b;
+//   2. pop the queue until empty. An edge whose star an earlier collapse of this iteration
+//      changed (an end point in touched()) is checked again on the current mesh: still an edge,
+//      still marked, and every check passes with the current classes; an edge whose cost changed
+//      (an end point moved) goes back into the queue with its new cost. The others collapse
+//      with the verdict of step 1, which still holds since nothing they depend on changed;
+//   3. the dead vertices and tets are dropped from the arrays (order kept).
+// Iterations repeat until one collapses fewer than max(eps_c, 1) edges, or max_iterations.
+//
+// Reuse (CollapseOptions::reuse_across_iterations, default on; the result is the same either
+// way and a test compares both): an edge neither of whose end points was touched in the
+// previous iteration has the star, cost and verdict it had then; it was not admissible then
+// (an admissible edge either collapsed or was overtaken by a collapse that touched it), so step
+// 1 skips its link and volume tests. Off: every marked edge passing Q is tested, and every
+// popped edge checked again.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <vector>
+
+#include "collapse/sequential_mesh.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/mesh.hpp"
+
+namespace tc::sequential_detail {
+
+SeqParams seq_params_from(const CollapseOptions& o);
+
+class SequentialRun {
+ public:
+  // Validates the options (std::invalid_argument) and the mesh (tc::InputError).
+  SequentialRun(Mesh& mesh, const CollapseOptions& options);
+
+  // Runs one iteration; false when there is nothing more to do (the stop rule was met, or
+  // max_iterations reached, or no tets), without running one.
+  bool step();
+  // Remaps mesh.tris and mesh.edges and completes the report. Call once, after the last step.
+  CollapseReport finish();
+
+  SeqMesh& seq() { return sm_; }
+  const CollapseReport& report() const { return report_; }
+  double target() const { return target_; }
+
+ private:
+  struct QueueEntry {
+    double cost;
+    int32_t a, b;  // a < b
+    uint8_t dir;
+  };
+
+  Mesh& mesh_;
+  const CollapseOptions& o_;
+  CollapseReport report_;
+  std::chrono::steady_clock::time_point t_start_;
+  SeqMesh sm_;
+  double target_ = 0;
+  int it_ = 0;
+  bool done_ = false;
+  std::vector<uint8_t> mask_;      // per current vertex (empty: no mask)
+  std::vector<int32_t> origin_;    // input vertex -> current vertex (only with tris or edges)
+  std::vector<uint32_t> touched_;  // per vertex: 1 + the last iteration that touched its star (0: none)
+  std::vector<QueueEntry> edges_, heap_;
+  std::vector<int32_t> nb_, vmap_, kept_;
+};
+
+}  // namespace tc::sequential_detail

@@ -1,0 +1,508 @@
+// The sequential CPU method (tc::collapse_sequential, host/collapse/sequential*.{hpp,cpp}):
+// its checks give the device's verdicts edge for edge (first iteration, and on the incremental
+// state of later ones), its vertex classes stay those of a fresh classification, its results
+// are valid, deterministic and carry the attributes; refusals; the CLI's --method sequential.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <tuple>
+
+#include "collapse/sequential_mesh.hpp"
+#include "collapse/sequential_run.hpp"
+#include "collapse/stages.hpp"
+#include "tetcollapse/check.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/error.hpp"
+#include "tetcollapse/io.hpp"
+#include "tetcollapse/topology.hpp"
+#include "test_support.hpp"
+
+using namespace tc;
+using namespace tc::collapse_detail;
+using namespace tc::sequential_detail;
+
+namespace {
+
+// What the device's stages say about every edge of a mesh in its first iteration.
+struct DeviceVerdicts {
+  std::vector<int32_t> edges;
+  std::vector<uint32_t> marked;
+  std::vector<uint8_t> reason, dir, vflags, vclass, eflags;
+};
+
+DeviceVerdicts device_verdicts(Context& ctx, const Mesh& m, const CollapseOptions& o, double target) {
+  StageParams p = params_from(o);
+  p.target = target;
+  DeviceMesh dm;
+  Connectivity c;
+  EdgeState s;
+  upload_mesh(ctx, m, o, dm);
+  build_connectivity(ctx, dm, c, p);
+  cost_and_mark(ctx, dm, c, s, p);
+  admissible(ctx, dm, c, s, p);
+  DeviceVerdicts d;
+  d.edges = c.edges.download_range(0, 2 * size_t(c.ne));
+  d.marked = s.marked.download_range(0, c.ne);
+  d.reason = s.reason.download_range(0, c.ne);
+  d.dir = s.dir.download_range(0, c.ne);
+  d.vflags = c.vflags.download_range(0, dm.nv);
+  d.vclass = c.vclass.download_range(0, dm.nv);
+  d.eflags = c.eflags.download_range(0, c.ne);
+  return d;
+}
+
+// Compares the sequential checks on `sm` (whose mesh arrays are `m`) with the device's on a
+// fresh upload of m: flags, classes, edges, and the verdict (reason and direction) of every
+// marked edge. Returns the number of marked edges compared.
+int64_t expect_same_verdicts(Context& ctx, SeqMesh& sm, const Mesh& m, const CollapseOptions& o, double target,
+                             const std::string& what) {
+  const DeviceVerdicts d = device_verdicts(ctx, m, o, target);
+  EXPECT_EQ(int64_t(sm.alive_vertices()), m.num_vertices()) << what;
+  int64_t bad_flags = 0, bad_class = 0;
+  for (int32_t v = 0; v < sm.num_vertices(); ++v) {
+    bad_flags += sm.vflags(v) != d.vflags[v];
+    bad_class += sm.vclass(v) != d.vclass[v];
+  }
+  EXPECT_EQ(bad_flags, 0) << what;
+  EXPECT_EQ(bad_class, 0) << what;
+  // the same edges
+  std::vector<int32_t> nb;
+  int64_t ne = 0;
+  for (int32_t v = 0; v < sm.num_vertices(); ++v) {
+    sm.neighbours(v, nb, true);
+    ne += int64_t(nb.size());
+  }
+  EXPECT_EQ(ne, int64_t(d.marked.size())) << what;
+  int64_t compared = 0, bad_eflags = 0, bad_reason = 0, bad_dir = 0;
+  std::map<int, int64_t> reasons;
+  for (size_t e = 0; e < d.marked.size(); ++e) {
+    const int32_t a = d.edges[2 * e], b = d.edges[2 * e + 1];
+    EXPECT_TRUE(sm.is_edge(a, b)) << what << ": edge " << a << " " << b;
+    bad_eflags += sm.edge_flags(a, b) != d.eflags[e];
+    if (!d.marked[e]) {
+      EXPECT_EQ(d.reason[e], kNotMarked);
+      continue;
+    }
+    const Verdict v = sm.check(a, b);
+    ++compared;
+    ++reasons[v.reason];
+    if (v.reason != d.reason[e]) {
+      if (bad_reason < 5)
+        ADD_FAILURE() << what << ": edge (" << a << ", " << b << ") sequential reason " << int(v.reason)
+                      << ", device " << int(d.reason[e]);
+      ++bad_reason;
+    } else if (v.reason == kOk && v.dir != d.dir[e]) {
+      ++bad_dir;
+    }
+  }
+  EXPECT_EQ(bad_eflags, 0) << what;
+  EXPECT_EQ(bad_reason, 0) << what;
+  EXPECT_EQ(bad_dir, 0) << what;
+  return compared;
+}
+
+int64_t expect_same_verdicts_fresh(Context& ctx, const Mesh& in, const CollapseOptions& o, double factor,
+                                   const std::string& what) {
+  Mesh m = in;
+  SeqMesh sm(m, seq_params_from(o));
+  return expect_same_verdicts(ctx, sm, m, o, factor * median_edge_length(in), what);
+}
+
+// cube_tets(n) with two materials (x < 0.5 and x > 0.5): an interface inside.
+Mesh two_material_cube(int n) {
+  Mesh m = test::cube_tets(n);
+  Labels l{"material", {}};
+  for (int64_t t = 0; t < m.num_tets(); ++t) {
+    double x = 0;
+    for (int k = 0; k < 4; ++k) x += m.points[3 * m.tets[4 * t + k]];
+    l.values.push_back(x / 4 < 0.5 ? 1 : 2);
+  }
+  m.tet_labels.push_back(l);
+  return m;
+}
+
+CheckReport check(const Mesh& m, const Mesh& ref, bool hausdorff = false) {
+  CheckOptions o;
+  o.quality = false;
+  o.hausdorff = hausdorff;
+  return check_mesh(m, o, &ref);
+}
+
+std::set<std::tuple<double, double, double>> boundary_points(const Mesh& m) {
+  Topology t = build_topology(m);
+  std::set<std::tuple<double, double, double>> s;
+  for (int32_t v = 0; v < t.num_vertices; ++v)
+    if (t.vertex_boundary[v]) s.insert({m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]});
+  return s;
+}
+
+// Runs the sequential method and checks the result against the input as the CLI's --check does.
+CollapseReport expect_valid_run(const Mesh& in, Mesh& m, const CollapseOptions& o, const std::string& what) {
+  m = in;
+  CollapseReport r = collapse_sequential(m, o);
+  EXPECT_EQ(r.tets_out, m.num_tets()) << what;
+  EXPECT_LT(r.tets_out, r.tets_in) << what << ": nothing collapsed";
+  const bool strict = o.boundary == CollapseOptions::Strict;
+  CheckReport c = check(m, in, strict);
+  EXPECT_TRUE(c.valid) << what << "\n" << check_report_text(c);
+  EXPECT_FALSE(c.reference.topology_changed) << what;
+  if (strict) {
+    EXPECT_TRUE(c.reference.hausdorff_computed) << what;
+    EXPECT_EQ(c.reference.hausdorff, 0.0) << what;
+  }
+  // the report adds up
+  int64_t collapsed = 0;
+  for (const IterationStats& s : r.iterations) {
+    EXPECT_LE(s.passed_q, s.marked);
+    EXPECT_LE(s.tested, s.passed_q);
+    EXPECT_LE(s.admissible, s.tested);
+    EXPECT_LE(s.collapsed, s.admissible);
+    EXPECT_EQ(s.vertices - s.vertices_after, s.collapsed);
+    collapsed += s.collapsed;
+  }
+  EXPECT_EQ(r.vertices_in - r.vertices_out, collapsed) << what;
+  EXPECT_EQ(r.device, "cpu-sequential");
+  if (!r.iterations.empty() && int(r.iterations.size()) < o.max_iterations) {
+    EXPECT_LT(r.iterations.back().collapsed, std::max<int64_t>(o.eps_c, 1)) << what;
+  }
+  return r;
+}
+
+Mesh read_shared(const std::string& name) {
+  const std::string path = test::shared_mesh(name);
+  return path.empty() ? Mesh{} : read_mesh(path);
+}
+
+}  // namespace
+
+// --- the checks: the same verdicts as the device ---
+
+TEST(SequentialVerdicts, SameAsDeviceOnCubesInEveryMode) {
+  Context ctx;
+  for (const Mesh& in : {test::cube_tets(4), two_material_cube(4)}) {
+    for (auto mode : {CollapseOptions::Features, CollapseOptions::Strict, CollapseOptions::Free})
+      for (bool paper : {false, true})
+        for (double qmin : {0.0, 0.1}) {
+          CollapseOptions o;
+          o.boundary = mode;
+          o.paper_boundary_rule = paper;
+          o.min_quality = qmin;
+          const std::string what = "cube labels " + std::to_string(in.tet_labels.size()) + " mode " +
+                                   std::to_string(int(mode)) + " paper " + std::to_string(paper) + " qmin " +
+                                   std::to_string(qmin);
+          EXPECT_GT(expect_same_verdicts_fresh(ctx, in, o, 2.0, what), 100) << what;
+        }
+  }
+}
+
+TEST(SequentialVerdicts, SameAsDeviceOnBracketAndSharedMeshes) {
+  Context ctx;
+  CollapseOptions o;  // features, quality guard 0.1
+  Mesh bracket = read_mesh(test::project_mesh("bracket.msh"));
+  EXPECT_GT(expect_same_verdicts_fresh(ctx, bracket, o, 2.0, "bracket"), 1000);
+  CollapseOptions paper0 = o;
+  paper0.min_quality = 0;
+  paper0.paper_boundary_rule = true;
+  expect_same_verdicts_fresh(ctx, bracket, paper0, 1.0, "bracket paper rule, no guard");
+  TC_SKIP_IF_NO_SHARED();
+  // interfaces (2 and 4 materials), ridges and corners of a CAD part, a sheet one tet thick
+  for (const char* name : {"polyfem_bimetal.msh", "sfepy_multi_material_cylinder_plate.vtk", "gen_gmsh_Angled_43k.msh",
+                           "polyfem_mat100x100t40.msh"}) {
+    Mesh m = read_shared(name);
+    ASSERT_GT(m.num_tets(), 0) << name << " is missing from the shared meshes";
+    EXPECT_GT(expect_same_verdicts_fresh(ctx, m, o, 2.0, name), 1000) << name;
+    CollapseOptions free = o;
+    free.boundary = CollapseOptions::Free;
+    free.min_quality = 0;
+    expect_same_verdicts_fresh(ctx, m, free, 1.0, std::string(name) + " free");
+  }
+}
+
+TEST(SequentialVerdicts, IncrementalStateAgreesWithTheDeviceInLaterIterations) {
+  // After each sequential iteration the classes and rings of the dynamic mesh were updated
+  // collapse by collapse; the device builds them from scratch on the same mesh.
+  Context ctx;
+  std::vector<std::pair<std::string, Mesh>> meshes;
+  meshes.push_back({"two-material cube", two_material_cube(6)});
+  meshes.push_back({"bracket", read_mesh(test::project_mesh("bracket.msh"))});
+  if (!test::shared_meshes_dir().empty()) {
+    meshes.push_back({"bimetal", read_shared("polyfem_bimetal.msh")});
+    meshes.push_back({"Angled", read_shared("gen_gmsh_Angled_43k.msh")});
+  }
+  for (auto& [name, in] : meshes) {
+    ASSERT_GT(in.num_tets(), 0) << name;
+    Mesh m = in;
+    CollapseOptions o;
+    o.target_factor = 2;
+    SequentialRun run(m, o);
+    for (int it = 0; it < 3 && run.step(); ++it) {
+      const std::string what = name + " after iteration " + std::to_string(it + 1);
+      EXPECT_EQ(run.seq().verify_classes(), 0) << what;
+      expect_same_verdicts(ctx, run.seq(), m, o, run.target(), what);
+    }
+  }
+}
+
+TEST(SequentialVerdicts, ClassesStayThoseOfAFreshClassification) {
+  // build_topology (the CPU reference of the classification) on the mesh after every iteration
+  std::vector<std::pair<std::string, Mesh>> meshes;
+  meshes.push_back({"two-material cube", two_material_cube(5)});
+  meshes.push_back({"bracket", read_mesh(test::project_mesh("bracket.msh"))});
+  if (!test::shared_meshes_dir().empty())
+    meshes.push_back({"cylinder plate", read_shared("sfepy_multi_material_cylinder_plate.vtk")});
+  for (auto& [name, in] : meshes) {
+    ASSERT_GT(in.num_tets(), 0) << name;
+    Mesh m = in;
+    CollapseOptions o;
+    o.target_factor = 2;
+    o.min_quality = 0;
+    SequentialRun run(m, o);
+    int steps = 0;
+    while (run.step()) {
+      ++steps;
+      Topology t = build_topology(m);
+      int64_t bad = 0;
+      for (int32_t v = 0; v < t.num_vertices; ++v)
+        bad += run.seq().vclass(v) != t.vertex_class[v] || run.seq().vflags(v) != t.vertex_boundary[v];
+      EXPECT_EQ(bad, 0) << name << " after iteration " << steps;
+      EXPECT_EQ(run.seq().verify_classes(), 0) << name << " after iteration " << steps;
+    }
+    EXPECT_GT(steps, 1) << name;
+  }
+}
+
+// --- results ---
+
+TEST(SequentialCollapse, CubesStayValidInEveryMode) {
+  for (auto mode : {CollapseOptions::Features, CollapseOptions::Strict, CollapseOptions::Free}) {
+    Mesh in = two_material_cube(6), m;
+    CollapseOptions o;
+    o.target_factor = 2;
+    o.boundary = mode;
+    expect_valid_run(in, m, o, "cube mode " + std::to_string(int(mode)));
+    if (mode == CollapseOptions::Free) continue;
+    // the 8 corners never move, and every boundary vertex stays on the cube's surface
+    auto b = boundary_points(m);
+    for (int i = 0; i < 8; ++i)
+      EXPECT_TRUE(b.count({double(i & 1), double((i >> 1) & 1), double((i >> 2) & 1)})) << "corner " << i;
+    for (auto [x, y, z] : b) EXPECT_TRUE(x == 0 || x == 1 || y == 0 || y == 1 || z == 0 || z == 1 || x == 0.5);
+    if (mode == CollapseOptions::Strict) {
+      EXPECT_EQ(b, boundary_points(in));
+    }
+  }
+}
+
+TEST(SequentialCollapse, BracketAndSharedMeshesStayValid) {
+  Mesh m;
+  CollapseOptions o;
+  o.target_factor = 2;
+  expect_valid_run(read_mesh(test::project_mesh("bracket.msh")), m, o, "bracket features");
+  CollapseOptions strict = o;
+  strict.boundary = CollapseOptions::Strict;
+  expect_valid_run(read_mesh(test::project_mesh("bracket.msh")), m, strict, "bracket strict");
+  TC_SKIP_IF_NO_SHARED();
+  for (const char* name : {"polyfem_bimetal.msh", "ipc_hammer.msh", "gen_gmsh_Angled_43k.msh"}) {
+    Mesh in = read_shared(name);
+    ASSERT_GT(in.num_tets(), 0) << name;
+    expect_valid_run(in, m, o, name);
+  }
+  // the paper's setting: no quality guard, paper boundary rule
+  Mesh in = read_shared("polyfem_cubes_v41.msh");
+  ASSERT_GT(in.num_tets(), 0);
+  CollapseOptions paper = o;
+  paper.min_quality = 0;
+  paper.paper_boundary_rule = true;
+  expect_valid_run(in, m, paper, "cubes_v41 paper rule");
+}
+
+TEST(SequentialCollapse, DeterministicAndTheSameWithoutReuse) {
+  Mesh in = read_mesh(test::project_mesh("bracket.msh"));
+  CollapseOptions o;
+  o.target_factor = 2;
+  Mesh a = in, b = in, c = in;
+  CollapseReport ra = collapse_sequential(a, o);
+  CollapseReport rb = collapse_sequential(b, o);
+  o.reuse_across_iterations = false;  // every marked edge tested, every popped edge checked again
+  CollapseReport rc = collapse_sequential(c, o);
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_EQ(a.tets, b.tets);
+  EXPECT_EQ(a.points, c.points);
+  EXPECT_EQ(a.tets, c.tets);
+  ASSERT_EQ(ra.iterations.size(), rc.iterations.size());
+  for (size_t i = 0; i < ra.iterations.size(); ++i) {
+    EXPECT_EQ(ra.iterations[i].collapsed, rc.iterations[i].collapsed);
+    EXPECT_EQ(ra.iterations[i].admissible, rc.iterations[i].admissible);
+    EXPECT_LE(ra.iterations[i].tested, rc.iterations[i].tested);
+  }
+  // tc::collapse dispatches to the same method
+  Context ctx;
+  Mesh d = in;
+  o.reuse_across_iterations = true;
+  o.method = CollapseOptions::Sequential;
+  CollapseReport rd = collapse(d, o, ctx);
+  EXPECT_EQ(rd.device, "cpu-sequential");
+  EXPECT_EQ(a.tets, d.tets);
+}
+
+TEST(SequentialCollapse, AttributesTravel) {
+  Mesh in = two_material_cube(5);
+  Field tf{"tq", 1, {}}, vf{"lin", 1, {}};
+  for (int64_t t = 0; t < in.num_tets(); ++t) tf.values.push_back(double(in.tet_labels[0].values[t]) * 10);
+  for (int64_t v = 0; v < in.num_vertices(); ++v)
+    vf.values.push_back(in.points[3 * v] + 2 * in.points[3 * v + 1] + 4 * in.points[3 * v + 2]);
+  in.tet_fields.push_back(tf);
+  in.vertex_fields.push_back(vf);
+  // the boundary triangles of the input, tagged by their index
+  Topology topo = build_topology(in);
+  for (int32_t f = 0; f < topo.num_sfaces(); ++f) {
+    if (topo.sface_interface[f]) continue;
+    in.tris.insert(in.tris.end(), &topo.sfaces[3 * f], &topo.sfaces[3 * f] + 3);
+    in.tri_tags.push_back(f);
+  }
+  CollapseOptions o;
+  o.target_factor = 2;
+  for (auto mode : {CollapseOptions::Features, CollapseOptions::Free}) {
+    o.boundary = mode;
+    Mesh m;
+    expect_valid_run(in, m, o, "attributes");
+    ASSERT_EQ(m.tet_labels[0].values.size(), size_t(m.num_tets()));
+    ASSERT_EQ(m.tet_fields[0].values.size(), size_t(m.num_tets()));
+    ASSERT_EQ(m.vertex_fields[0].values.size(), size_t(m.num_vertices()));
+    for (int64_t t = 0; t < m.num_tets(); ++t)  // a tet keeps its label and field together
+      EXPECT_EQ(m.tet_fields[0].values[t], 10.0 * m.tet_labels[0].values[t]);
+    // a linear field averaged at midpoints and kept at kept positions stays the same linear field
+    for (int64_t v = 0; v < m.num_vertices(); ++v)
+      EXPECT_NEAR(m.vertex_fields[0].values[v], m.points[3 * v] + 2 * m.points[3 * v + 1] + 4 * m.points[3 * v + 2],
+                  1e-12);
+    // triangles remapped: valid indices, no degenerate ones, tags alongside
+    EXPECT_EQ(m.tris.size(), 3 * m.tri_tags.size());
+    EXPECT_LT(m.tris.size(), in.tris.size());
+    for (size_t i = 0; i < m.tris.size(); i += 3) {
+      for (int k = 0; k < 3; ++k) ASSERT_LT(m.tris[i + k], m.num_vertices());
+      EXPECT_TRUE(m.tris[i] != m.tris[i + 1] && m.tris[i] != m.tris[i + 2] && m.tris[i + 1] != m.tris[i + 2]);
+    }
+    if (mode == CollapseOptions::Features) {
+      // S is kept: every remapped boundary triangle is a boundary face of the result
+      Topology t = build_topology(m);
+      std::set<std::array<int32_t, 3>> faces;
+      for (int32_t f = 0; f < t.num_sfaces(); ++f) {
+        std::array<int32_t, 3> k{t.sfaces[3 * f], t.sfaces[3 * f + 1], t.sfaces[3 * f + 2]};
+        std::sort(k.begin(), k.end());
+        faces.insert(k);
+      }
+      for (size_t i = 0; i < m.tris.size(); i += 3) {
+        std::array<int32_t, 3> k{m.tris[i], m.tris[i + 1], m.tris[i + 2]};
+        std::sort(k.begin(), k.end());
+        EXPECT_TRUE(faces.count(k)) << "triangle " << i / 3;
+      }
+    }
+  }
+}
+
+TEST(SequentialCollapse, MaskKeepsUnselectedVertices) {
+  Mesh in = test::cube_tets(6);
+  CollapseOptions o;
+  o.target_factor = 2;
+  o.vertex_mask.assign(size_t(in.num_vertices()), 0);
+  std::set<std::tuple<double, double, double>> outside;
+  for (int64_t v = 0; v < in.num_vertices(); ++v) {
+    if (in.points[3 * v] < 0.5) o.vertex_mask[v] = 1;
+    else outside.insert({in.points[3 * v], in.points[3 * v + 1], in.points[3 * v + 2]});
+  }
+  Mesh m;
+  expect_valid_run(in, m, o, "mask");
+  std::set<std::tuple<double, double, double>> out;
+  for (int64_t v = 0; v < m.num_vertices(); ++v) out.insert({m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]});
+  for (const auto& p : outside) EXPECT_TRUE(out.count(p)) << "an unselected vertex moved or went away";
+}
+
+TEST(SequentialCollapse, StopRuleAndIterationLimit) {
+  Mesh in = read_mesh(test::project_mesh("bracket.msh"));
+  CollapseOptions o;
+  o.target_factor = 2;
+  o.eps_c = 100;
+  Mesh m;
+  CollapseReport r = expect_valid_run(in, m, o, "eps_c 100");
+  ASSERT_FALSE(r.iterations.empty());
+  for (size_t i = 0; i + 1 < r.iterations.size(); ++i) EXPECT_GE(r.iterations[i].collapsed, 100);
+  EXPECT_LT(r.iterations.back().collapsed, 100);
+  o.eps_c = 0;
+  o.max_iterations = 1;
+  m = in;
+  EXPECT_EQ(collapse_sequential(m, o).iterations.size(), 1u);
+  o.max_iterations = 0;
+  m = in;
+  CollapseReport r0 = collapse_sequential(m, o);
+  EXPECT_TRUE(r0.iterations.empty());
+  EXPECT_EQ(m.tets, in.tets);
+}
+
+// --- refusals ---
+
+TEST(SequentialCollapse, CornersAreNeverRemoved) {
+  Mesh m = test::cube_tets(1);  // 8 corners and nothing else
+  CollapseOptions o;
+  o.target_length = 10;
+  o.min_quality = 0;
+  CollapseReport r = collapse_sequential(m, o);
+  EXPECT_EQ(r.tets_out, 6);
+  EXPECT_EQ(m.num_vertices(), 8);
+  ASSERT_EQ(r.iterations.size(), 1u);
+  EXPECT_EQ(r.iterations[0].marked, 19);
+  EXPECT_EQ(r.iterations[0].passed_q, 0);
+}
+
+TEST(SequentialCollapse, RefusesWhatItCannotDo) {
+  Mesh m = test::cube_tets(2);
+  CollapseOptions o;
+  o.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return 0.0; }";
+  o.target_length = 1;
+  EXPECT_THROW(collapse_sequential(m, o), std::invalid_argument);
+  CollapseOptions mask;
+  mask.vertex_mask.assign(3, 1);
+  EXPECT_THROW(collapse_sequential(m, mask), std::invalid_argument);
+  CollapseOptions neg;
+  neg.max_iterations = -1;
+  EXPECT_THROW(collapse_sequential(m, neg), std::invalid_argument);
+  Mesh bad = m;
+  bad.tets[5] = int32_t(bad.num_vertices());
+  EXPECT_THROW(collapse_sequential(bad, CollapseOptions{}), InputError);
+  bad = m;
+  bad.tets[5] = bad.tets[4];
+  EXPECT_THROW(collapse_sequential(bad, CollapseOptions{}), InputError);
+  bad = m;
+  bad.tet_labels.push_back({"l", {1, 2}});
+  EXPECT_THROW(collapse_sequential(bad, CollapseOptions{}), InputError);
+  EXPECT_EQ(m.tets, test::cube_tets(2).tets);  // refused before touching the mesh
+}
+
+// --- the command line ---
+
+TEST(SequentialCli, MethodSequentialWithCheck) {
+  test::TempDir dir;
+  const std::string cli = std::string("'") + TC_CLI + "'";
+  const std::string in = test::project_mesh("bracket.msh"), out = dir.file("out.msh"), stats = dir.file("s.json");
+  std::string text;
+  EXPECT_EQ(test::run_command(cli + " " + in + " " + out + " --method sequential --check --stats " + stats, &text), 0)
+      << text;
+  EXPECT_NE(text.find("valid"), std::string::npos) << text;
+  Mesh m = read_mesh(out);
+  EXPECT_GT(m.num_tets(), 0);
+  EXPECT_LT(m.num_tets(), read_mesh(in).num_tets());
+  EXPECT_NE(test::read_text(stats).find("cpu-sequential"), std::string::npos);
+  // --device makes no sense without a device: a usage error
+  EXPECT_EQ(test::run_command(cli + " " + in + " " + out + " --method sequential --device 0", &text), 2) << text;
+  // a user cost is OpenCL C: refused with a message naming the method
+  const std::string cost = dir.file("cost.cl");
+  test::write_text(cost, "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return 0.0; }\n");
+  EXPECT_NE(test::run_command(cli + " " + in + " " + out + " --method sequential --cost-cl " + cost +
+                                  " --target-length 1",
+                              &text),
+            0);
+  EXPECT_NE(text.find("sequential"), std::string::npos) << text;
+}
