@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "collapse/guard_surface.hpp"
 #include "collapse/stages.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "geometry.h"
@@ -120,6 +121,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
 
   Connectivity conn;
   EdgeState st;
+  SurfaceGuard guard;
   p.target = options.target_length;
   const double t_loop = now();
   for (int it = 0; it < options.max_iterations && dm.nt > 0; ++it) {
@@ -147,28 +149,34 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     double t2 = now();
     s.seconds_cost = t2 - t1;
     double t4 = 0;
-    if (options.conflicts == CollapseOptions::AtomicMin) {
-      // every marked edge tested, then one conflict stage
-      s.admissible = admissible(ctx, dm, conn, st, p);
-      s.tested = s.marked;
-      t4 = now();
-      s.seconds_admissible = t4 - t2;
-      s.after_pass2 = s.after_pass1 = conflicts_atomic_min(ctx, dm, conn, st);
-    } else {
-      uint32_t passed_q = 0, tested = 0;
-      s.after_pass1 = lazy_admissible_pass1(ctx, dm, conn, st, p, passed_q, tested);
-      s.admissible = s.after_pass1;
-      s.passed_q = passed_q;
-      s.tested = tested;
-      t4 = now();
-      s.seconds_admissible = t4 - t2;
-      s.seconds_pass1 = 0;
-      s.after_pass2 = conflict_pass2(ctx, dm, conn, st);
-    }
-    for (int r = 1; r < options.selection_rounds && s.after_pass2 > 0; ++r) {
-      const uint32_t total = next_selection_round(ctx, dm, conn, st, p);
-      if (total == s.after_pass2) break;  // nothing more
-      s.after_pass2 = total;
+    for (;;) {  // selection; again when the surface guard refuses some of it
+      if (options.conflicts == CollapseOptions::AtomicMin) {
+        // every marked edge tested, then one conflict stage
+        s.admissible = admissible(ctx, dm, conn, st, p);
+        s.tested = s.marked;
+        t4 = now();
+        s.seconds_admissible = t4 - t2;
+        s.after_pass2 = s.after_pass1 = conflicts_atomic_min(ctx, dm, conn, st);
+      } else {
+        uint32_t passed_q = 0, tested = 0;
+        s.after_pass1 = lazy_admissible_pass1(ctx, dm, conn, st, p, passed_q, tested);
+        s.admissible = s.after_pass1;
+        s.passed_q = passed_q;
+        s.tested = tested;
+        t4 = now();
+        s.seconds_admissible = t4 - t2;
+        s.seconds_pass1 = 0;
+        s.after_pass2 = conflict_pass2(ctx, dm, conn, st);
+      }
+      for (int r = 1; r < options.selection_rounds && s.after_pass2 > 0; ++r) {
+        const uint32_t total = next_selection_round(ctx, dm, conn, st, p);
+        if (total == s.after_pass2) break;  // nothing more
+        s.after_pass2 = total;
+      }
+      // Surface guard (guard_surface.hpp): the refused edges are unmarked; this iteration's
+      // verdicts still hold for the next selection.
+      if (guard.run(ctx, dm, conn, st, p, uint32_t(s.after_pass2)) == 0) break;
+      st.verdict_ready = true;
     }
     s.collapsed = s.after_pass2;
     double t5 = now();

@@ -1,0 +1,359 @@
+/* Surface guard: after the conflict passes, refuse the chosen collapses that would make the
+ * feature surface S (boundary and material interfaces) intersect itself.
+ *
+ * Why a global test: the admissible filter only looks at the stars of a and b. A collapse that
+ * moves S within the paper's tolerances (a face vertex removed from a slightly curved face,
+ * a ridge vertex cut off a curved ridge) moves the surface by up to the sagitta of the patch,
+ * and a part of S that is not in the star (the other side of a narrow gap: another body, the
+ * far wall of a thin slot, a boss standing in a hole) may lie within that distance. Nothing
+ * local sees it; the tets stay positive. (Found on corpus mesh cad_052: a ridge vertex on the
+ * rim of a hole, collapsed onto its neighbour, cut the rim's chord through the wall of a boss
+ * standing 0.003 away in the hole.)
+ *
+ * Per iteration, over the collapses chosen by the conflict passes (fin):
+ *   sguard_queries    a collapse that changes S (removed vertex x on S, or a survivor y on S
+ *                     that moves to the midpoint) is a query: the bounding box of its new
+ *                     S triangles (below); the host grids the boxes;
+ *   sguard_surface    every S face of the current mesh that is not replaced by the query is
+ *                     tested against the query's new triangles (over tets, through the grid);
+ *   sguard_pairs      the new triangles of two queries are tested against each other (two
+ *                     collapses of one iteration never share a tet, but their new triangles
+ *                     may still cross);
+ *   sguard_drop       a query with a hit is unmarked; the host then selects again.
+ * The new S triangles of the collapse of x onto y (y at the placement p): the faces containing
+ * x of the tets of ring(x) that survive, and, when y moves, the faces containing y of ring(y),
+ * with x renamed y; a face is taken when it is on S now, or when the tet across it is removed
+ * by the collapse (the two faces of a removed tet are glued: the result may become S). Testing
+ * against faces that another chosen collapse replaces, or against faces that end up interior,
+ * only refuses more (never less).
+ *
+ * The triangle test is floating-point with Shewchuk's static error bound: a sign that is not
+ * certain counts as zero, and zero counts as touching, so every pair that intersects exactly
+ * is reported (pairs sharing an edge are not tested: they can only overlap when coplanar).
+ */
+#include "collapse_common.h"
+
+/* -1 / 0 / 1: the sign of tc_orient3d when certain, else 0. */
+inline int tcc_sg_orient(double3 a, double3 b, double3 c, double3 d) {
+  double det = tc_orient3d(a, b, c, d), eb = tc_orient3d_errbound(a, b, c, d);
+  return det > eb ? 1 : det < -eb ? -1 : 0;
+}
+
+/* 2D orientation of (a, b, c) in the plane of the two kept axes (drop = the dropped axis). */
+inline double2 tcc_sg_proj(double3 p, int drop) {
+  return drop == 0 ? (double2)(p.y, p.z) : drop == 1 ? (double2)(p.z, p.x) : (double2)(p.x, p.y);
+}
+inline int tcc_sg_orient2(double2 a, double2 b, double2 c) {
+  double l = (b.x - a.x) * (c.y - a.y), r = (b.y - a.y) * (c.x - a.x);
+  double det = l - r, eb = 4.0e-16 * (fabs(l) + fabs(r));
+  return det > eb ? 1 : det < -eb ? -1 : 0;
+}
+
+/* Do the closed 2D segments (p, q) and (u, w) meet (zero signs: touching)? */
+inline int tcc_sg_seg_seg2(double2 p, double2 q, double2 u, double2 w) {
+  int s1 = tcc_sg_orient2(p, q, u), s2 = tcc_sg_orient2(p, q, w);
+  int s3 = tcc_sg_orient2(u, w, p), s4 = tcc_sg_orient2(u, w, q);
+  if (s1 * s2 > 0 || s3 * s4 > 0) return 0;
+  if (s1 == 0 && s2 == 0 && s3 == 0 && s4 == 0) { /* collinear: do the intervals overlap? */
+    int ax = fabs(q.x - p.x) + fabs(w.x - u.x) >= fabs(q.y - p.y) + fabs(w.y - u.y);
+    double p0 = ax ? p.x : p.y, p1 = ax ? q.x : q.y, u0 = ax ? u.x : u.y, u1 = ax ? w.x : w.y;
+    return fmax(fmin(p0, p1), fmin(u0, u1)) <= fmin(fmax(p0, p1), fmax(u0, u1));
+  }
+  return 1;
+}
+
+/* Is 2D point p in the closed triangle (a, b, c)? */
+inline int tcc_sg_in_tri2(double2 p, double2 a, double2 b, double2 c) {
+  int s0 = tcc_sg_orient2(a, b, p), s1 = tcc_sg_orient2(b, c, p), s2 = tcc_sg_orient2(c, a, p);
+  return !((s0 > 0 || s1 > 0 || s2 > 0) && (s0 < 0 || s1 < 0 || s2 < 0));
+}
+
+/* Does the closed segment (p, q) meet the closed triangle (a, b, c)? */
+inline int tcc_sg_seg_tri(double3 p, double3 q, double3 a, double3 b, double3 c) {
+  int o1 = tcc_sg_orient(a, b, c, p), o2 = tcc_sg_orient(a, b, c, q);
+  if (o1 * o2 > 0) return 0;
+  if (o1 == 0 && o2 == 0) { /* in the plane (or too close to tell): in 2D */
+    double3 n = tcc_cross(b - a, c - a);
+    double nx = fabs(n.x), ny = fabs(n.y), nz = fabs(n.z);
+    int drop = nx >= ny && nx >= nz ? 0 : ny >= nz ? 1 : 2;
+    double2 p2 = tcc_sg_proj(p, drop), q2 = tcc_sg_proj(q, drop);
+    double2 a2 = tcc_sg_proj(a, drop), b2 = tcc_sg_proj(b, drop), c2 = tcc_sg_proj(c, drop);
+    return tcc_sg_in_tri2(p2, a2, b2, c2) || tcc_sg_in_tri2(q2, a2, b2, c2) || tcc_sg_seg_seg2(p2, q2, a2, b2) ||
+           tcc_sg_seg_seg2(p2, q2, b2, c2) || tcc_sg_seg_seg2(p2, q2, c2, a2);
+  }
+  /* the segment meets the plane: is that point in the triangle? */
+  int s0 = tcc_sg_orient(p, q, a, b), s1 = tcc_sg_orient(p, q, b, c), s2 = tcc_sg_orient(p, q, c, a);
+  return !((s0 > 0 || s1 > 0 || s2 > 0) && (s0 < 0 || s1 < 0 || s2 < 0));
+}
+
+/* Do triangles A and B (vertex ids ia, ib; positions pa, pb) intersect other than in what they
+ * share? Sharing an edge (or all three vertices): not tested. Sharing one vertex s: they meet
+ * elsewhere iff the edge opposite s of one meets the other. Sharing none: iff an edge of one
+ * meets the other. */
+inline int tcc_sg_tri_tri(const int* ia, const double3* pa, const int* ib, const double3* pb) {
+  int sa = -1, sb = -1, shared = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (ia[i] == ib[j]) {
+        ++shared;
+        sa = i;
+        sb = j;
+      }
+  if (shared >= 2) return 0;
+  if (shared == 1)
+    return tcc_sg_seg_tri(pa[(sa + 1) % 3], pa[(sa + 2) % 3], pb[0], pb[1], pb[2]) ||
+           tcc_sg_seg_tri(pb[(sb + 1) % 3], pb[(sb + 2) % 3], pa[0], pa[1], pa[2]);
+  for (int i = 0; i < 3; ++i) {
+    if (tcc_sg_seg_tri(pa[i], pa[(i + 1) % 3], pb[0], pb[1], pb[2])) return 1;
+    if (tcc_sg_seg_tri(pb[i], pb[(i + 1) % 3], pa[0], pa[1], pa[2])) return 1;
+  }
+  return 0;
+}
+
+/* The collapse of edge e as chosen: x removed, y survives at *p; returns whether y moves. */
+inline int tcc_sg_collapse(int e, __global const int* edges, __global const uchar* dir, __global const double* pts,
+                           int* x, int* y, double3* p) {
+  int v0 = edges[2 * e], v1 = edges[2 * e + 1];
+  uint d = dir[e];
+  *x = (d & TCC_DIR_REMOVE_V1) ? v1 : v0;
+  *y = (d & TCC_DIR_REMOVE_V1) ? v0 : v1;
+  *p = tcc_placement(pts, v0, v1, d);
+  double3 py = tc_point(pts, *y);
+  return !(py.x == p->x && py.y == p->y && py.z == p->z);
+}
+
+/* Is face f of tet t (found in ring(x) when side == 0, ring(y) when side == 1) a new S
+ * triangle of the collapse of x onto y (see the top)? Fills its vertex ids (x renamed y) and
+ * positions (y at p). A face glued to another one through a removed tet o is S after the
+ * collapse when the face of o it is glued to is on the boundary or the two tets' labels
+ * differ. */
+inline int tcc_sg_new_tri(int t, int f, int side, int x, int y, int moves_y, double3 p, __global const int* tets,
+                          __global const int* tet_nbr, __global const int* labels, int use_labels,
+                          __global const double* pts, int* id, double3* pos) {
+  __global const int* q = tets + 4 * t;
+  int z = side == 0 ? x : y;
+  if (q[f] == z) return 0; /* the face opposite z does not contain it */
+  int other = tet_nbr[4 * t + f];
+  if (other >= 0 && tcc_has(tets, other, x) && tcc_has(tets, other, y)) { /* glued through o = other */
+    int across = tet_nbr[4 * other + tcc_local(tets, other, z)];
+    if (!(across < 0 || (use_labels && labels[t] != labels[across]))) return 0; /* interior after */
+  } else {
+    if (side == 1 && !moves_y) return 0; /* unchanged */
+    if (!(other < 0 || (use_labels && labels[t] != labels[other]))) return 0; /* interior */
+  }
+  for (int k = 0; k < 3; ++k) {
+    int v = q[TC_TET_FACES[f][k]];
+    if (v == x) v = y;
+    id[k] = v;
+    pos[k] = v == y ? p : tc_point(pts, v);
+  }
+  return 1;
+}
+
+/* Loop over the new S triangles of a collapse: BODY sees id[3], pos[3]. */
+#define TCC_SG_FOR_NEW_TRIS(x, y, moves_y, p, id, pos, BODY)                                               \
+  for (int side_ = 0; side_ < 2; ++side_) {                                                               \
+    int z_ = side_ == 0 ? (x) : (y);                                                                        \
+    for (uint i_ = vt_off[z_]; i_ < vt_off[z_ + 1]; ++i_) {                                                 \
+      int t_ = vt[i_];                                                                                      \
+      if (tcc_has(tets, t_, side_ == 0 ? (y) : (x))) continue; /* removed, or seen from ring(x) */         \
+      for (int f_ = 0; f_ < 4; ++f_) {                                                                      \
+        if (!tcc_sg_new_tri(t_, f_, side_, (x), (y), (moves_y), (p), tets, tet_nbr, labels, use_labels, pts, \
+                            id, pos))                                                                       \
+          continue;                                                                                         \
+        BODY                                                                                                \
+      }                                                                                                     \
+    }                                                                                                       \
+  }
+
+/* Queries: the chosen collapses that change S, with the box and the number of their new S
+ * triangles. */
+__kernel void sguard_queries(uint ne, __global const int* edges, __global const uint* fin, __global const uchar* dir,
+                             __global const double* pts, __global const int* tets, __global const uint* vt_off,
+                             __global const int* vt, __global const int* tet_nbr, __global const int* labels,
+                             int use_labels, __global const uchar* vflags, __global int* qedge,
+                             __global double* qbox, __global uint* qntri, __global uint* qcount) {
+  uint e = get_global_id(0);
+  if (e >= ne || !fin[e]) return;
+  int x, y;
+  double3 p;
+  int moves_y = tcc_sg_collapse((int)e, edges, dir, pts, &x, &y, &p);
+  if (!vflags[x] && !(moves_y && vflags[y])) return; /* S is not touched */
+  double3 lo = (double3)(INFINITY, INFINITY, INFINITY), hi = -lo;
+  int id[3];
+  uint n = 0;
+  double3 pos[3];
+  TCC_SG_FOR_NEW_TRIS(x, y, moves_y, p, id, pos, {
+    ++n;
+    for (int k = 0; k < 3; ++k) {
+      lo = fmin(lo, pos[k]);
+      hi = fmax(hi, pos[k]);
+    }
+  })
+  if (n == 0) return;
+  uint slot = atomic_inc(qcount);
+  qedge[slot] = (int)e;
+  qntri[slot] = n;
+  __global double* b = qbox + 6 * slot;
+  b[0] = lo.x, b[1] = lo.y, b[2] = lo.z, b[3] = hi.x, b[4] = hi.y, b[5] = hi.z;
+}
+
+/* The new S triangles of each query, at qoff[q] .. qoff[q + 1] (ids, positions). */
+__kernel void sguard_tris(uint nq, __global const int* qedge, __global const uint* qoff, __global const int* edges,
+                          __global const uchar* dir, __global const double* pts, __global const int* tets,
+                          __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
+                          __global const int* labels, int use_labels, __global int* tid, __global double* tpos) {
+  uint qi = get_global_id(0);
+  if (qi >= nq) return;
+  int x, y;
+  double3 p;
+  int moves_y = tcc_sg_collapse(qedge[qi], edges, dir, pts, &x, &y, &p);
+  uint n = qoff[qi];
+  int id[3];
+  double3 pos[3];
+  TCC_SG_FOR_NEW_TRIS(x, y, moves_y, p, id, pos, {
+    for (int k = 0; k < 3; ++k) {
+      tid[3 * n + k] = id[k];
+      tpos[9 * n + 3 * k] = pos[k].x;
+      tpos[9 * n + 3 * k + 1] = pos[k].y;
+      tpos[9 * n + 3 * k + 2] = pos[k].z;
+    }
+    ++n;
+  })
+}
+
+inline void tcc_sg_load_tri(__global const int* tid, __global const double* tpos, uint n, int* id, double3* pos) {
+  for (int k = 0; k < 3; ++k) {
+    id[k] = tid[3 * n + k];
+    pos[k] = (double3)(tpos[9 * n + 3 * k], tpos[9 * n + 3 * k + 1], tpos[9 * n + 3 * k + 2]);
+  }
+}
+
+inline int tcc_sg_boxes_apart(const double3* a, const double3* b) {
+  double3 alo = fmin(fmin(a[0], a[1]), a[2]), ahi = fmax(fmax(a[0], a[1]), a[2]);
+  double3 blo = fmin(fmin(b[0], b[1]), b[2]), bhi = fmax(fmax(b[0], b[1]), b[2]);
+  return alo.x > bhi.x || alo.y > bhi.y || alo.z > bhi.z || blo.x > ahi.x || blo.y > ahi.y || blo.z > ahi.z;
+}
+
+/* The uniform grid of the query boxes (built by the host): cell (i, j, k) of size h from org,
+ * dims gd; the queries of cell c are cell_items[cell_off[c] .. cell_off[c + 1]). */
+inline int tcc_sg_cell(double v, double org, double h, int n) {
+  double c = floor((v - org) / h);
+  return c < 0.0 ? 0 : c >= (double)n ? n - 1 : (int)c;
+}
+
+/* Is (i, j, k) the cell holding the low corner of the overlap of boxes A and B (so each pair
+ * is tested once)? Also tests the overlap. */
+inline int tcc_sg_owner_cell(double3 alo, double3 ahi, __global const double* b, int i, int j, int k, double3 org,
+                             double h, int4 gd) {
+  double3 blo = (double3)(b[0], b[1], b[2]), bhi = (double3)(b[3], b[4], b[5]);
+  if (alo.x > bhi.x || alo.y > bhi.y || alo.z > bhi.z || blo.x > ahi.x || blo.y > ahi.y || blo.z > ahi.z) return 0;
+  double3 c = fmax(alo, blo);
+  return tcc_sg_cell(c.x, org.x, h, gd.x) == i && tcc_sg_cell(c.y, org.y, h, gd.y) == j &&
+         tcc_sg_cell(c.z, org.z, h, gd.z) == k;
+}
+
+/* Every current S face against the queries whose box it overlaps. */
+__kernel void sguard_surface(uint nt, __global const int* edges, __global const uchar* dir, __global const double* pts,
+                             __global const int* tets, __global const int* tet_nbr, __global const int* labels,
+                             int use_labels, __global const int* qedge, __global const double* qbox,
+                             __global const uint* qoff, __global const int* tid, __global const double* tpos,
+                             double ox, double oy, double oz, double h, int gx, int gy, int gz,
+                             __global const uint* cell_off, __global const uint* cell_items, __global uint* qbad) {
+  uint t = get_global_id(0);
+  if (t >= nt) return;
+  const double3 org = (double3)(ox, oy, oz);
+  const int4 gd = (int4)(gx, gy, gz, 0);
+  __global const int* tq = tets + 4 * t;
+  for (int f = 0; f < 4; ++f) {
+    uint on_s;
+    if (!tcc_owned_sface(tet_nbr, labels, use_labels, (int)t, f, &on_s)) continue;
+    int fid[3];
+    double3 fpos[3];
+    for (int k = 0; k < 3; ++k) {
+      fid[k] = tq[TC_TET_FACES[f][k]];
+      fpos[k] = tc_point(pts, fid[k]);
+    }
+    double3 lo = fmin(fmin(fpos[0], fpos[1]), fpos[2]), hi = fmax(fmax(fpos[0], fpos[1]), fpos[2]);
+    int i0 = tcc_sg_cell(lo.x, ox, h, gx), i1 = tcc_sg_cell(hi.x, ox, h, gx);
+    int j0 = tcc_sg_cell(lo.y, oy, h, gy), j1 = tcc_sg_cell(hi.y, oy, h, gy);
+    int k0 = tcc_sg_cell(lo.z, oz, h, gz), k1 = tcc_sg_cell(hi.z, oz, h, gz);
+    for (int k = k0; k <= k1; ++k)
+      for (int j = j0; j <= j1; ++j)
+        for (int i = i0; i <= i1; ++i) {
+          uint c = ((uint)k * (uint)gy + (uint)j) * (uint)gx + (uint)i;
+          for (uint m = cell_off[c]; m < cell_off[c + 1]; ++m) {
+            uint qi = cell_items[m];
+            if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qi, i, j, k, org, h, gd)) continue;
+            int x, y;
+            double3 p;
+            int moves_y = tcc_sg_collapse(qedge[qi], edges, dir, pts, &x, &y, &p);
+            int replaced = 0;
+            for (int a = 0; a < 3; ++a) replaced |= fid[a] == x || (moves_y && fid[a] == y);
+            if (replaced) continue; /* the face is one the collapse moves or removes */
+            for (uint n = qoff[qi]; n < qoff[qi + 1]; ++n) {
+              int id[3];
+              double3 pos[3];
+              tcc_sg_load_tri(tid, tpos, n, id, pos);
+              if (tcc_sg_boxes_apart(pos, fpos) || !tcc_sg_tri_tri(id, pos, fid, fpos)) continue;
+              uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
+              qbad[qi] = code < 0xfffffffeu ? code + 2u : 1u;
+              break;
+            }
+          }
+        }
+  }
+}
+
+/* The new triangles of two queries against each other. */
+__kernel void sguard_pairs(uint nq, __global const double* qbox, __global const uint* qoff, __global const int* tid,
+                           __global const double* tpos, double ox, double oy, double oz, double h, int gx, int gy,
+                           int gz, __global const uint* cell_off, __global const uint* cell_items,
+                           __global uint* qbad) {
+  uint qa = get_global_id(0);
+  if (qa >= nq) return;
+  const double3 org = (double3)(ox, oy, oz);
+  const int4 gd = (int4)(gx, gy, gz, 0);
+  __global const double* ba = qbox + 6 * qa;
+  double3 lo = (double3)(ba[0], ba[1], ba[2]), hi = (double3)(ba[3], ba[4], ba[5]);
+  int i0 = tcc_sg_cell(lo.x, ox, h, gx), i1 = tcc_sg_cell(hi.x, ox, h, gx);
+  int j0 = tcc_sg_cell(lo.y, oy, h, gy), j1 = tcc_sg_cell(hi.y, oy, h, gy);
+  int k0 = tcc_sg_cell(lo.z, oz, h, gz), k1 = tcc_sg_cell(hi.z, oz, h, gz);
+  for (int k = k0; k <= k1; ++k)
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        uint c = ((uint)k * (uint)gy + (uint)j) * (uint)gx + (uint)i;
+        for (uint m = cell_off[c]; m < cell_off[c + 1]; ++m) {
+          uint qb = cell_items[m];
+          if (qb == qa || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qb, i, j, k, org, h, gd)) continue;
+          for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
+            int ida[3];
+            double3 posa[3];
+            tcc_sg_load_tri(tid, tpos, na, ida, posa);
+            for (uint nb = qoff[qb]; nb < qoff[qb + 1]; ++nb) {
+              int idb[3];
+              double3 posb[3];
+              tcc_sg_load_tri(tid, tpos, nb, idb, posb);
+              if (tcc_sg_boxes_apart(posa, posb) || !tcc_sg_tri_tri(ida, posa, idb, posb)) continue;
+              qbad[qa] = 1u;
+              return;
+            }
+          }
+        }
+      }
+}
+
+/* Refusal reason of the guard, kept as the edge's verdict (collapse_verdicts.cl) so that the
+ * edge is not chosen again while its rings do not change. */
+#define TCC_REFUSED_SURFACE 7
+
+/* A query with a hit is unmarked (selected again without it) and its verdict set (when the
+ * verdict buffer is there); counts them. */
+__kernel void sguard_drop(uint nq, __global const int* qedge, __global const uint* qbad, __global uint* marked,
+                          int has_verdict, __global uchar* verdict, __global uint* count) {
+  uint q = get_global_id(0);
+  if (q >= nq || !qbad[q]) return;
+  marked[qedge[q]] = 0u;
+  if (has_verdict) verdict[qedge[q]] = TCC_REFUSED_SURFACE;
+  atomic_inc(count);
+}

@@ -1,0 +1,178 @@
+// Host side of the surface guard (cl/collapse_guard.cl): the queries are found on the device,
+// their boxes gridded here (a dense uniform grid; the boxes are few and of similar size, the
+// collapses of one iteration), then every S face and every pair of queries is tested on the
+// device through the grid.
+#include "collapse/guard_surface.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "tetcollapse/error.hpp"
+
+namespace tc::collapse_detail {
+
+namespace {
+
+template <class T>
+void ensure(DeviceBuffer<T>& b, Context& ctx, size_t n) {
+  n = std::max<size_t>(n, 1);  // no zero-sized OpenCL buffers
+  if (!b.buffer()()) b = DeviceBuffer<T>(ctx, n);
+  else b.resize(n);
+}
+
+// TETCOLLAPSE_PROFILE=1 prints the wall time of every launch on stderr (as stages.cpp does).
+const bool kProfile = std::getenv("TETCOLLAPSE_PROFILE") != nullptr;
+
+template <class... A>
+void launch(Context& ctx, const char* name, size_t n, const A&... args) {
+  cl::Kernel k = ctx.kernel("collapse_guard.cl", name);
+  detail::cl_call(name, [&] {
+    cl_uint i = 0;
+    (k.setArg(i++, args), ...);
+  });
+  auto t0 = std::chrono::steady_clock::now();
+  ctx.launch(k, n, name);
+  if (kProfile) {
+    ctx.finish();
+    std::fprintf(stderr, "  %-28s n=%-9zu %8.4f s\n", name, n,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+}
+
+// The cell of coordinate v on one axis; the same arithmetic as tcc_sg_cell in the kernels.
+int cell_of(double v, double org, double h, int n) {
+  double c = std::floor((v - org) / h);
+  return c < 0.0 ? 0 : c >= double(n) ? n - 1 : int(c);
+}
+
+// At most this many cells per axis: the grid is over the union of the query boxes, which
+// may be spread over the whole mesh.
+constexpr int kMaxCellsPerAxis = 64;
+
+}  // namespace
+
+uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                           uint32_t chosen) {
+  last_queries = 0;
+  if (chosen == 0) return 0;
+  ensure(qedge, ctx, chosen);
+  ensure(qbox, ctx, size_t(chosen) * 6);
+  ensure(qntri, ctx, chosen);
+  ensure(qcount, ctx, 1);
+  qcount.fill(0u);
+  const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
+  const cl::Buffer& labels = dm.labels[0].buffer();
+  launch(ctx, "sguard_queries", c.ne, cl_uint(c.ne), c.edges.buffer(), s.fin.buffer(), s.dir.buffer(),
+         dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
+         c.vflags.buffer(), qedge.buffer(), qbox.buffer(), qntri.buffer(), qcount.buffer());
+  uint32_t nq = 0;
+  qcount.download(&nq, 1);
+  last_queries = nq;
+  if (nq == 0) return 0;
+
+  // the new triangles of each query, stored once (offsets by a scan of their counts)
+  const std::vector<uint32_t> counts = qntri.download_range(0, nq);
+  std::vector<uint32_t> off_tri(nq + 1, 0);
+  for (uint32_t q = 0; q < nq; ++q) off_tri[q + 1] = off_tri[q] + counts[q];
+  const uint32_t ntri = off_tri[nq];
+  ensure(qoff, ctx, nq + 1);
+  qoff.upload(off_tri);
+  ensure(tid, ctx, size_t(ntri) * 3);
+  ensure(tpos, ctx, size_t(ntri) * 9);
+  launch(ctx, "sguard_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(), s.dir.buffer(),
+         dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
+         tid.buffer(), tpos.buffer());
+
+  // The grid: cells at least as large as the largest query box (a box spans <= 2 cells per
+  // axis), at most kMaxCellsPerAxis per axis.
+  const std::vector<double> box = qbox.download_range(0, size_t(nq) * 6);
+  double lo[3], hi[3], h = 0;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::numeric_limits<double>::infinity();
+    hi[a] = -lo[a];
+  }
+  for (uint32_t q = 0; q < nq; ++q)
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], box[6 * q + a]);
+      hi[a] = std::max(hi[a], box[6 * q + 3 + a]);
+      h = std::max(h, box[6 * q + 3 + a] - box[6 * q + a]);
+    }
+  double ext = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+  h = std::max(h, ext / kMaxCellsPerAxis);
+  if (!(h > 0) || !std::isfinite(h)) h = 1;  // all boxes one point
+  int g[3];
+  for (int a = 0; a < 3; ++a) g[a] = std::min(kMaxCellsPerAxis + 1, int(std::floor((hi[a] - lo[a]) / h)) + 1);
+  const size_t ncells = size_t(g[0]) * g[1] * g[2];
+  // counting sort of the (cell, query) pairs by cell
+  std::vector<uint32_t> off(ncells + 1, 0);
+  auto for_cells = [&](uint32_t q, auto&& fn) {
+    int r0[3], r1[3];
+    for (int a = 0; a < 3; ++a) {
+      r0[a] = cell_of(box[6 * q + a], lo[a], h, g[a]);
+      r1[a] = cell_of(box[6 * q + 3 + a], lo[a], h, g[a]);
+    }
+    for (int k = r0[2]; k <= r1[2]; ++k)
+      for (int j = r0[1]; j <= r1[1]; ++j)
+        for (int i = r0[0]; i <= r1[0]; ++i) fn((size_t(k) * g[1] + j) * g[0] + i);
+  };
+  for (uint32_t q = 0; q < nq; ++q) for_cells(q, [&](size_t cell) { ++off[cell + 1]; });
+  for (size_t i = 0; i < ncells; ++i) off[i + 1] += off[i];
+  std::vector<uint32_t> items(std::max<uint32_t>(off[ncells], 1)), cursor(off.begin(), off.end() - 1);
+  for (uint32_t q = 0; q < nq; ++q) for_cells(q, [&](size_t cell) { items[cursor[cell]++] = q; });
+  ensure(cell_off, ctx, off.size());
+  cell_off.upload(off);
+  ensure(cell_items, ctx, items.size());
+  cell_items.upload(items);
+
+  ensure(qbad, ctx, nq);
+  qbad.fill(0u);
+  launch(ctx, "sguard_surface", dm.nt, cl_uint(dm.nt), c.edges.buffer(), s.dir.buffer(), dm.points.buffer(),
+         dm.tets.buffer(), c.tet_nbr.buffer(), labels, use_labels, qedge.buffer(), qbox.buffer(), qoff.buffer(),
+         tid.buffer(), tpos.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(h),
+         cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());
+  launch(ctx, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
+         cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(h), cl_int(g[0]), cl_int(g[1]),
+         cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());
+  qcount.fill(0u);
+  const bool has_verdict = s.verdict.size() >= c.ne && s.verdict.buffer()();
+  launch(ctx, "sguard_drop", nq, cl_uint(nq), qedge.buffer(), qbad.buffer(), s.marked.buffer(),
+         cl_int(has_verdict ? 1 : 0), has_verdict ? s.verdict.buffer() : qbad.buffer(), qcount.buffer());
+  uint32_t refused = 0;
+  qcount.download(&refused, 1);
+  if (kProfile) std::fprintf(stderr, "  surface guard: %u collapses chosen, %u change S, %u refused\n", chosen, nq, refused);
+  if (std::getenv("TETCOLLAPSE_GUARD_DEBUG") && refused > 0) {
+    std::vector<uint32_t> bad = qbad.download_range(0, nq);
+    std::vector<int32_t> qe = qedge.download_range(0, nq);
+    std::vector<int32_t> ed = c.edges.download_range(0, size_t(c.ne) * 2);
+    std::vector<uint8_t> dr = s.dir.download_range(0, c.ne);
+    std::vector<int32_t> tt = dm.tets.download_range(0, size_t(dm.nt) * 4);
+    for (uint32_t q = 0; q < nq; ++q)
+      if (bad[q]) {
+        int e = qe[q];
+        std::fprintf(stderr, "  refused edge %d (%d, %d) dir %d:", e, ed[2 * e], ed[2 * e + 1], dr[e]);
+        if (bad[q] >= 2) {
+          uint32_t t = (bad[q] - 2) / 4, f = (bad[q] - 2) % 4;
+          std::fprintf(stderr, " face %u/%u = tet (%d %d %d %d)", t, f, tt[4 * t], tt[4 * t + 1], tt[4 * t + 2], tt[4 * t + 3]);
+        } else {
+          std::fprintf(stderr, " another collapse");
+        }
+        std::fprintf(stderr, "\n");
+      }
+  }
+  if (refused > 0) {
+    // the selection runs again: its counters start from zero (counters[0], marked, stays)
+    uint32_t marked = 0;
+    s.counters.download(&marked, 1, 0);
+    s.counters.fill(0u);
+    s.counters.upload(&marked, 1, 0);
+  }
+  return refused;
+}
+
+}  // namespace tc::collapse_detail

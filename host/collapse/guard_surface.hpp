@@ -1,0 +1,25 @@
+// Surface guard (cl/collapse_guard.cl): after the conflict passes, refuses the chosen collapses
+// whose new boundary / interface triangles would intersect the feature surface S (another part
+// of S across a narrow gap, or another chosen collapse's new triangles). Refused edges are
+// unmarked; the caller then selects again (same connectivity) and guards again, until nothing
+// is refused. Only collapses that change S are tested, against the S faces near them.
+#pragma once
+
+#include <cstdint>
+
+#include "collapse/stages.hpp"
+
+namespace tc::collapse_detail {
+
+struct SurfaceGuard {
+  DeviceBuffer<int32_t> qedge, tid;          // per query: its edge; per new triangle: ids
+  DeviceBuffer<double> qbox, tpos;           // per query: box; per new triangle: positions
+  DeviceBuffer<uint32_t> qntri, qoff, qcount, qbad, cell_off, cell_items;
+  uint32_t last_queries = 0;  // collapses tested by the last run (that change S)
+
+  // Tests the `chosen` collapses of s.fin / s.dir; returns how many were refused (their edges
+  // are unmarked in s.marked).
+  uint32_t run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p, uint32_t chosen);
+};
+
+}  // namespace tc::collapse_detail
