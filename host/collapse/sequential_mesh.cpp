@@ -270,17 +270,17 @@ void SeqMesh::classify(int32_t v, uint8_t& flags_out, uint8_t& cls_out) {
       int no = 0;
       for (int j = 0; j < 4; ++j)
         if (j != f && j != lv) o[no++] = q[j];
-      faces_.push_back({std::min(o[0], o[1]), std::max(o[0], o[1]), t, int8_t(f)});
+      const uint32_t y = uint32_t(std::min(o[0], o[1])), z = uint32_t(std::max(o[0], o[1]));
+      faces_.push_back({uint64_t(y) << 32 | z, t, int8_t(f)});
     }
   }
-  std::sort(faces_.begin(), faces_.end(),
-            [](const FaceAt& x, const FaceAt& y) { return x.y != y.y ? x.y < y.y : x.z < y.z; });
+  std::sort(faces_.begin(), faces_.end(), [](const FaceAt& x, const FaceAt& y) { return x.key < y.key; });
   uint8_t flags = 0;
   bool overflow = false;
   sfaces_.clear();
   for (size_t i = 0; i < faces_.size();) {
     size_t j = i + 1;
-    while (j < faces_.size() && faces_[j].y == faces_[i].y && faces_[j].z == faces_[i].z) ++j;
+    while (j < faces_.size() && faces_[j].key == faces_[i].key) ++j;
     const size_t others = j - i - 1;
     for (size_t k = i; k < j; ++k) {
       const int32_t t = faces_[k].t;
@@ -485,12 +485,17 @@ uint8_t SeqMesh::link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir) {
     for (const auto& pr : pairs) {
       if (!in[pr[0]] || !in[pr[1]]) continue;
       const int32_t c = o[pr[0]], d = o[pr[1]];
-      if (!ring_has(b, c, d, -1)) continue;  // (b,c,d) is no triangle
+      // triangles (a,c,d) and (b,c,d) need the tet (a,b,c,d), i.e. (c, d) in lk(ab); when it is,
+      // (b,c,d) is a triangle (of that tet), so the kernel's order of tests gives the same answer
       bool in_lk = false;
       for (size_t m = 0; m < pc_.size() && !in_lk; ++m)
         in_lk = (pc_[m] == c && pd_[m] == d) || (pc_[m] == d && pd_[m] == c);
-      if (!in_lk) return kRefusedLink;
-      if (triangle_kind(a, c, d) && triangle_kind(b, c, d)) return kRefusedLink;
+      if (!in_lk) {
+        if (ring_has(b, c, d, -1)) return kRefusedLink;
+        continue;  // (b,c,d) is no triangle
+      }
+      // S-faces (a,c,d) and (b,c,d); an S-face through a needs a on S (and b likewise)
+      if ((fa & kSMask) && (fb & kSMask) && triangle_kind(a, c, d) && triangle_kind(b, c, d)) return kRefusedLink;
     }
   }
 
@@ -571,10 +576,11 @@ int32_t SeqMesh::collapse(int32_t a, int32_t b, uint8_t dir) {
         double& x = f.values[size_t(s) * f.components + c];
         x = 0.5 * (x + f.values[size_t(r) * f.components + c]);
       }
-  // faces of S change only through s, and only when r or s is on S (see the header)
+  // faces of S change only through s, and only when r or s is on S; a vertex off S stays off
+  // S (see the header), so only s and the touched vertices on S are classified again
   if (on_s)
     for (int32_t u : touched_)
-      if (valive_[u]) classify(u, vflags_[u], vclass_[u]);
+      if (valive_[u] && (vflags_[u] || u == s)) classify(u, vflags_[u], vclass_[u]);
   return s;
 }
 

@@ -19,8 +19,9 @@
 // change are those of s and of its neighbours, all vertices of the tets of ring(r) U ring(s)
 // before the collapse (touched()). When neither r nor s is on S no S-face changes at all (a
 // glued face is on S only if one of its two sides was), and nothing needs recomputing;
-// otherwise every touched vertex is reclassified. verify_classes() recomputes everything from
-// scratch for the tests.
+// otherwise s and every touched vertex on S are reclassified (a vertex off S stays off S: its
+// faces keep their two tets, or are glued from two faces off S). verify_classes() recomputes
+// everything from scratch for the tests.
 #pragma once
 
 #include <cstdint>
@@ -93,8 +94,9 @@ class SeqMesh {
   int64_t verify_classes();
 
  private:
-  struct FaceAt {  // a face through v: tet t, local face f (opposite vertex f), other vertices y < z
-    int32_t y, z, t;
+  struct FaceAt {  // a face through v: tet t, local face f (opposite vertex f), key y << 32 | z of
+    uint64_t key;   // its other vertices y < z
+    int32_t t;
     int8_t f;
   };
   struct SFace {  // an S-face owned by a tet of ring(v)
