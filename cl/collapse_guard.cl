@@ -18,7 +18,8 @@
  *                     tested against the query's new triangles (over tets, through the grid);
  *   sguard_pairs      the new triangles of two queries are tested against each other (two
  *                     collapses of one iteration never share a tet, but their new triangles
- *                     may still cross);
+ *                     may still cross), and those of one query among themselves (a fold of
+ *                     S around the survivor that positive tets do not exclude);
  *   sguard_drop       a query with a hit is unmarked; the host then selects again.
  * The new S triangles of the collapse of x onto y (y at the placement p): the faces containing
  * x of the tets of ring(x) that survive, and, when y moves, the faces containing y of ring(y),
@@ -316,6 +317,20 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
   const int4 gd = (int4)(gx, gy, gz, 0);
   __global const double* ba = qbox + 6 * qa;
   double3 lo = (double3)(ba[0], ba[1], ba[2]), hi = (double3)(ba[3], ba[4], ba[5]);
+  /* the new triangles of the collapse among themselves (S folded over itself around y) */
+  for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
+    int ida[3];
+    double3 posa[3];
+    tcc_sg_load_tri(tid, tpos, na, ida, posa);
+    for (uint nb = na + 1; nb < qoff[qa + 1]; ++nb) {
+      int idb[3];
+      double3 posb[3];
+      tcc_sg_load_tri(tid, tpos, nb, idb, posb);
+      if (tcc_sg_boxes_apart(posa, posb) || !tcc_sg_tri_tri(ida, posa, idb, posb)) continue;
+      qbad[qa] = 1u;
+      return;
+    }
+  }
   int i0 = tcc_sg_cell(lo.x, ox, h, gx), i1 = tcc_sg_cell(hi.x, ox, h, gx);
   int j0 = tcc_sg_cell(lo.y, oy, h, gy), j1 = tcc_sg_cell(hi.y, oy, h, gy);
   int k0 = tcc_sg_cell(lo.z, oz, h, gz), k1 = tcc_sg_cell(hi.z, oz, h, gz);

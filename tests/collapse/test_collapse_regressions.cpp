@@ -1,0 +1,122 @@
+// Regressions of the collapse pipeline found by the robustness campaign.
+//
+// Surface across a gap (corpus mesh cad_052, features mode, 1x median): a collapse that moves
+// the feature surface S within the paper's tolerances (there: a ridge vertex on the rim of a
+// hole, removed onto its neighbour, so the rim became the chord; here: a face vertex at the
+// bottom of a shallow dimple, normals within eps_F, removed onto a corner, so the dimple
+// becomes flat) moves S by up to the sagitta of the patch. A part of S that is not in the
+// collapse's star but lies within that distance (another body, the far wall of a narrow slot)
+// is then crossed: every tet stays positive, the link condition holds, and the output's
+// boundary intersects itself. The surface guard (cl/collapse_guard.cl) refuses such collapses.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "geometry.h"
+#include "test_support.hpp"
+#include "tetcollapse/check.hpp"
+#include "tetcollapse/collapse.hpp"
+
+namespace {
+
+// Adds tet (a, b, c, d) to m, positively oriented (b and c swapped when needed).
+void add_tet(tc::Mesh& m, int a, int b, int c, int d) {
+  auto p = [&](int i) { return tc::geo::tc_point(m.points.data(), i); };
+  if (tc::geo::tc_orient3d(p(a), p(b), p(c), p(d)) < 0) std::swap(b, c);
+  m.tets.insert(m.tets.end(), {a, b, c, d});
+}
+
+// Body A: four tets around the axis (v4 top, v5 bottom) under the square c0..c3 (z = 0,
+// half-width 1), whose top face is a dimple: v4 at depth `depth` below the square's centre.
+// With depth 0.05 the four top triangles' normals differ by at most 5.7 degrees
+// (1 - cos < eps_F = 0.01), so v4 is a face vertex and every other vertex of A is a corner:
+// the only collapses are v4 onto a corner, which flattens the top to z = 0.
+// Body B (when `with_b`): one tet standing on its tip (0.2, 0.1, -0.02), in the dimple's void
+// (the dimple's surface is at z = -0.04 below it): it does not touch A, but is below z = 0.
+tc::Mesh dimple_and_tip(bool with_b, double depth = 0.05) {
+  tc::Mesh m;
+  m.points = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0, 0, 0, -depth, 0, 0, -1};
+  for (int i = 0; i < 4; ++i) add_tet(m, 4, i, (i + 1) % 4, 5);
+  if (with_b) {
+    m.points.insert(m.points.end(), {0.2, 0.1, -0.02, 0.7, 0.1, 0.5, -0.1, 0.6, 0.5, -0.1, -0.4, 0.5});
+    add_tet(m, 6, 7, 8, 9);
+  }
+  return m;
+}
+
+tc::CheckReport check(const tc::Mesh& out, const tc::Mesh& in) {
+  tc::CheckOptions co;
+  co.hausdorff = false;
+  co.quality = false;
+  return tc::check_mesh(out, co, &in);
+}
+
+bool has_finding(const tc::CheckReport& r, const std::string& code) {
+  for (const tc::CheckFinding& f : r.findings)
+    if (f.code == code) return true;
+  return false;
+}
+
+tc::CollapseOptions every_edge() {
+  tc::CollapseOptions opt;
+  opt.target_length = 10;  // every edge is marked
+  return opt;
+}
+
+TEST(CollapseRegressions, DimpleAloneIsFlattened) {
+  // The control: without body B the dimple vertex goes (so the guard below is what keeps it).
+  const tc::Mesh in = dimple_and_tip(false);
+  ASSERT_TRUE(check(in, in).valid);
+  tc::Mesh out = in;
+  tc::Context ctx;
+  tc::collapse(out, every_edge(), ctx);
+  EXPECT_EQ(out.num_vertices(), in.num_vertices() - 1);
+  EXPECT_EQ(out.num_tets(), 2);
+  EXPECT_TRUE(check(out, in).valid);
+}
+
+TEST(CollapseRegressions, FlatteningDoesNotPushTheSurfaceIntoAnotherBody) {
+  const tc::Mesh in = dimple_and_tip(true);
+  const tc::CheckReport rin = check(in, in);
+  ASSERT_TRUE(rin.valid) << rin.errors.size();
+  // The collapse that flattens the dimple would put B's tip inside A: check that it would,
+  // by applying it by hand (v4 onto c0: its two tets with c0 go, the others take c0).
+  {
+    tc::Mesh flat = in;
+    flat.tets.clear();
+    add_tet(flat, 0, 1, 2, 5);
+    add_tet(flat, 0, 2, 3, 5);
+    add_tet(flat, 6, 7, 8, 9);
+    flat.points[3 * 4 + 2] = 0;  // v4 is unused now; keep it off the surface
+    tc::CheckReport rf = check(flat, in);
+    EXPECT_TRUE(has_finding(rf, "boundary_self_intersection"));
+  }
+  // (Free mode is not used here: it collapses the lone tet of B away, a separate matter.)
+  for (double q : {0.1, 0.0}) {  // with and without the quality guard
+    SCOPED_TRACE("min_quality " + std::to_string(q));
+    tc::CollapseOptions opt = every_edge();
+    opt.min_quality = q;
+    tc::Mesh out = in;
+    tc::Context ctx;
+    tc::collapse(out, opt, ctx);
+    tc::CheckReport r = check(out, in);
+    EXPECT_FALSE(has_finding(r, "boundary_self_intersection"));
+    EXPECT_TRUE(r.valid) << (r.errors.empty() ? "" : r.errors[0]);
+    EXPECT_EQ(out.num_vertices(), in.num_vertices());  // the flattening was the only collapse
+  }
+}
+
+TEST(CollapseRegressions, GuardRefusesOnlyWhatIntersects) {
+  // The same B raised by 0.03, its tip above z = 0: the flattened top stays clear of it, and
+  // the collapse goes.
+  tc::Mesh in = dimple_and_tip(true);
+  for (int v = 6; v < 10; ++v) in.points[3 * v + 2] += 0.03;
+  ASSERT_TRUE(check(in, in).valid);
+  tc::Mesh out = in;
+  tc::Context ctx;
+  tc::collapse(out, every_edge(), ctx);
+  EXPECT_EQ(out.num_vertices(), in.num_vertices() - 1);
+  EXPECT_TRUE(check(out, in).valid);
+}
+
+}  // namespace
