@@ -24,23 +24,46 @@ __kernel void conflict_init(uint ne, __global const uint* adm, __global uchar* s
  * the undecided ones (the first round, first != 0, takes slot i for work item i); those
  * still waiting for a cheaper rival are appended to next (via the counter next_n). The order
  * of a worklist does not matter, since a decision depends only on final decisions of cheaper
- * edges. rivals / rcount: see collapse_common.h.
+ * edges.
  *
- * One round of pass 1. */
-__kernel void conflict_pass1_round(uint n, int first, __global const uint* list, __global uint* next,
-                                   __global uint* next_n, __global const uint* cand, __global uint* rivals,
-                                   __global uint* rcount, __global const int* edges, __global const double* cost,
-                                   __global const uint* nb_off, __global const int* nb_edge,
-                                   __global uchar* state) {
+ * Pass 1 (edges sharing a vertex conflict) runs two kernels per round, with per-vertex slots
+ * instead of scans of the neighbour edges:
+ *   pass1_claim   an undecided edge with an end point taken by an IN edge is OUT (that edge
+ *                 was the first undecided edge there when it won, so it comes before); the
+ *                 others claim both end points (tcc_claim: the slot keeps the first claimant);
+ *   *_decide      an edge holding both of its slots is first among the undecided edges at both
+ *                 end points, i.e. every rival before it is OUT: it is decided (IN; in the lazy
+ *                 filter IN when it passes the link and volume tests, else OUT); the others
+ *                 wait for the next round, whose slots they clear (two slot arrays alternate,
+ *                 so clearing never races with reading).
+ * vaff[x] is the IN edge at x (-1 when none). */
+__kernel void pass1_claim(uint n, int first, __global const uint* list, __global const uint* cand,
+                          __global const int* edges, __global const double* cost, __global const int* vaff,
+                          volatile __global int* slot, __global uchar* state) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  uint c = first ? i : list[i];
-  int e = (int)cand[c];
-  int w = tcc_pass1_wait(e, edges[2 * e], edges[2 * e + 1], nb_off, nb_edge, cost, state, rivals + c * TCC_RIVALS,
-                         rcount + c);
-  if (w < 0) state[e] = TCC_OUT;
-  else if (w > 0) next[atomic_inc(next_n)] = c;
-  else state[e] = TCC_IN;
+  int e = (int)cand[first ? i : list[i]];
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  if (vaff[a] >= 0 || vaff[b] >= 0) {
+    state[e] = TCC_OUT;
+    return;
+  }
+  tcc_claim(slot + a, e, cost);
+  tcc_claim(slot + b, e, cost);
+}
+
+/* Pass 1 over admissible edges (every edge tested beforehand): a turn means IN. */
+__kernel void conflict_pass1_decide(uint n, int first, __global const uint* list, __global uint* next,
+                                    __global uint* next_n, __global const uint* cand, __global const int* edges,
+                                    __global const int* slot, __global int* slot_next, __global uchar* state,
+                                    __global int* vaff) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  int e;
+  if (tcc_pass1_turn(i, first, list, next, next_n, cand, edges, slot, slot_next, state, &e) <= 0) return;
+  state[e] = TCC_IN;
+  vaff[edges[2 * e]] = e;
+  vaff[edges[2 * e + 1]] = e;
 }
 
 /* After pass 1: p1 flags, vaff (vertAffectedByEdge) of both end points of IN edges, counters[2]. */
@@ -65,17 +88,17 @@ __kernel void conflict_pass2_init(uint ne, __global const uint* p1, __global uch
 }
 
 /* One round of pass 2 over the pass-1 edges: the rivals of e = (a, b) are the pass-1 edges
- * recorded (vaff) at the vertices of the tets of ring(a) and ring(b). */
+ * recorded (vaff) at the vertices of the tets of ring(a) and ring(b), i.e. at N(a) and N(b). */
 __kernel void conflict_pass2_round(uint n, int first, __global const uint* list, __global uint* next,
                                    __global uint* next_n, __global const uint* cand, __global uint* rivals,
                                    __global uint* rcount, __global const int* edges, __global const double* cost,
-                                   __global const int* tets, __global const uint* vt_off, __global const int* vt,
-                                   __global const int* vaff, __global uchar* state) {
+                                   __global const uint* nb_off, __global const int* nb, __global const int* vaff,
+                                   __global uchar* state) {
   uint i = get_global_id(0);
   if (i >= n) return;
   uint c = first ? i : list[i];
   int e = (int)cand[c];
-  int w = tcc_pass2_wait(e, edges[2 * e], edges[2 * e + 1], tets, vt_off, vt, vaff, cost, state,
+  int w = tcc_pass2_wait(e, edges[2 * e], edges[2 * e + 1], nb_off, nb, vaff, cost, state,
                          rivals + c * TCC_RIVALS, rcount + c);
   if (w < 0) state[e] = TCC_OUT;
   else if (w > 0) next[atomic_inc(next_n)] = c;

@@ -45,17 +45,17 @@ inline void tcc_sort_segment(__global int* a, uint n) {
 #define TCC_MAX_NB 64
 #endif
 
-/* Sorts ring(v); then gathers N(v) into scratch[3 vt_off[v] ..], sorted and unique, and counts
+/* Sorts ring(v) (unless sort == 0: carried rings are sorted); then gathers N(v) into scratch[3 vt_off[v] ..], sorted and unique, and counts
  * it (nb_count) and its part above v (up_count). */
 __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __global const uint* vt_off,
                                         __global int* vt, __global int* scratch, __global uint* nb_count,
-                                        __global uint* up_count, int carry, __global const uchar* ndirty,
+                                        __global uint* up_count, int sort, int carry, __global const uchar* ndirty,
                                         __global const int* vold, __global const int* vmap,
                                         __global const uint* prev_nb_off, __global const int* prev_nb) {
   uint v = get_global_id(0);
   if (v >= nv) return;
   uint b = vt_off[v], n = vt_off[v + 1] - b;
-  tcc_sort_segment(vt + b, n);
+  if (sort) tcc_sort_segment(vt + b, n); /* else already sorted (collapse_update.cl) */
   __global int* s = scratch + 3 * b;
   if (carry && !ndirty[v]) {
     /* ring(v) unchanged (collapse_verdicts.cl): N(v) is the previous one renumbered; none of

@@ -154,6 +154,7 @@ uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, Edg
 }
 
 void remember_for_carry(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
+  s.update_next = true;
   ensure(s.vdirty, ctx, dm.nv);
   run(ctx, "collapse_verdicts.cl", "verdict_dirty", dm.nv, "", U(dm.nv), B(s.vaff), B(c.nb_off), B(c.nb),
       B(s.vdirty));
@@ -207,17 +208,26 @@ void download_mesh(const DeviceMesh& dm, Mesh& mesh) {
   unpack(mesh.tet_fields, dm.tfields, dm.tfield_comps, dm.nt);
 }
 
-void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const StageParams& p, const EdgeState* carry) {
+void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const StageParams& p, EdgeState* carry) {
   const std::string F = "collapse_connectivity.cl";
   const uint32_t nv = dm.nv, nt = dm.nt;
   ensure(c.count, ctx, nv);
   ensure(c.cursor, ctx, nv);
-  c.count.fill(0);
-  c.cursor.fill(0);
-  ensure(c.vt, ctx, size_t(nt) * 4);
-  run(ctx, F, "conn_count", nt, "", B(dm.tets), U(nt), B(c.count));
-  scan_offsets(ctx, c.count, c.vt_off, nv);
-  run(ctx, F, "conn_scatter", nt, "", B(dm.tets), U(nt), B(c.vt_off), B(c.cursor), B(c.vt));
+  // rings and tet_nbr carried through the compaction (collapse_update.cl)
+  const bool updated = carry && carry->has_prev && carry->has_update;
+  if (updated) {
+    std::swap(c.vt_off, carry->upd_vt_off);
+    std::swap(c.vt, carry->upd_vt);
+    std::swap(c.tet_nbr, carry->upd_tet_nbr);
+    carry->has_update = false;
+  } else {
+    c.count.fill(0);
+    c.cursor.fill(0);
+    ensure(c.vt, ctx, size_t(nt) * 4);
+    run(ctx, F, "conn_count", nt, "", B(dm.tets), U(nt), B(c.count));
+    scan_offsets(ctx, c.count, c.vt_off, nv);
+    run(ctx, F, "conn_scatter", nt, "", B(dm.tets), U(nt), B(c.vt_off), B(c.cursor), B(c.vt));
+  }
   ensure(c.scratch, ctx, size_t(nt) * 12);
   ensure(c.up_count, ctx, nv);
   // c.count is reused for |N(v)|
@@ -230,7 +240,7 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   const cl::Buffer& pno = cy ? B(carry->prev_nb_off) : B(c.count);
   const cl::Buffer& pnb = cy ? B(carry->prev_nb) : B(c.count);
   run(ctx, F, "conn_ring_sort_and_gather", nv, "", B(dm.tets), U(nv), B(c.vt_off), B(c.vt), B(c.scratch),
-      B(c.count), B(c.up_count), ci, nd, vo, vm, pno, pnb);
+      B(c.count), B(c.up_count), cl_int(updated ? 0 : 1), ci, nd, vo, vm, pno, pnb);
   uint32_t nnb = scan_offsets(ctx, c.count, c.nb_off, nv);
   c.ne = scan_offsets(ctx, c.up_count, c.edge_off, nv);
   ensure(c.nb, ctx, nnb);
@@ -251,7 +261,9 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   const cl::Buffer& pvc = cy ? B(carry->prev_vclass) : B(c.vflags);
   const cl::Buffer& pef = cy ? B(carry->prev_eflags) : B(c.vflags);
   const cl::Buffer& pne = cy ? B(carry->prev_nb_edge) : B(c.nb_edge);
-  if (cy) {
+  if (updated) {
+    // c.tet_nbr taken over above
+  } else if (cy) {
     run(ctx, F, "conn_tet_neighbours_carry", nt, "", U(nt), B(dm.tets), B(c.tet_nbr), nd, to, tn, pt);
     // the full matching only for the dirty vertices
     ensure(c.dirty_list, ctx, nv);
@@ -355,13 +367,54 @@ void worklist_rounds(Context& ctx, cl::Kernel& round, EdgeState& s, uint32_t n, 
   }
 }
 
-// Sets the round kernel's arguments from kRoundArgs on.
+// Sets the round kernel's arguments from `first_arg` on.
 template <class... A>
-void set_round_args(cl::Kernel& k, const char* what, const A&... a) {
+void set_args_from(cl::Kernel& k, cl_uint first_arg, const char* what, const A&... a) {
   detail::cl_call(what, [&] {
-    cl_uint i = kRoundArgs;
+    cl_uint i = first_arg;
     (k.setArg(i++, a), ...);
   });
+}
+template <class... A>
+void set_round_args(cl::Kernel& k, const char* what, const A&... a) {
+  set_args_from(k, kRoundArgs, what, a...);
+}
+
+// The first arguments of a pass-1 decide kernel: n, first, list, next, next_n, cand, edges,
+// slot, slot_next, state, vaff.
+constexpr cl_uint kDecideArgs = 11;
+
+// Pass-1 rounds (collapse_conflict.cl: pass1_claim, then `decide`, whose arguments from
+// kDecideArgs on are already set) over the n candidates of s.cand_edges until none is left
+// undecided. s.vaff must be -1 everywhere; it ends with the IN edge at each vertex.
+void pass1_rounds(Context& ctx, cl::Kernel& decide, EdgeState& s, const Connectivity& c, uint32_t nv, uint32_t n,
+                  const char* what) {
+  ensure(s.work_n, ctx, 1);
+  ensure(s.work[0], ctx, n);
+  ensure(s.work[1], ctx, n);
+  ensure(s.slot[0], ctx, nv);
+  ensure(s.slot[1], ctx, nv);
+  s.slot[0].fill(-1);
+  s.slot[1].fill(-1);
+  cl::Kernel claim = ctx.kernel("collapse_conflict.cl", "pass1_claim");
+  int cur = 0;
+  for (cl_int first = 1; n > 0; first = 0) {
+    s.work_n.fill(0);
+    auto t0 = std::chrono::steady_clock::now();
+    set_args(claim, "pass1_claim", U(n), first, B(s.work[cur]), B(s.cand_edges), B(c.edges), B(s.cost), B(s.vaff),
+             B(s.slot[cur]), B(s.state));
+    ctx.launch(claim, n, "pass1_claim");
+    set_args(decide, what, U(n), first, B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n), B(s.cand_edges), B(c.edges),
+             B(s.slot[cur]), B(s.slot[1 - cur]), B(s.state), B(s.vaff));
+    ctx.launch(decide, n, what);
+    uint32_t next = 0;
+    s.work_n.download(&next, 1);
+    if (kProfile)
+      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s\n", what, n,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    n = next;
+    cur = 1 - cur;
+  }
 }
 }  // namespace
 
@@ -372,10 +425,10 @@ uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
   ensure(s.vaff, ctx, dm.nv);
   s.vaff.fill(-1);
   run(ctx, F, "conflict_init", c.ne, "", U(c.ne), B(s.adm), B(s.state));
-  const uint32_t n = prepare_candidates(ctx, s, s.adm, c.ne);
-  cl::Kernel round = ctx.kernel(F, "conflict_pass1_round");
-  set_round_args(round, "conflict_pass1_round", B(c.edges), B(s.cost), B(c.nb_off), B(c.nb_edge), B(s.state));
-  worklist_rounds(ctx, round, s, n, "conflict_pass1_round");
+  ensure(s.cand_edges, ctx, c.ne);
+  const uint32_t n = dev::compact_indices(ctx, s.adm, s.cand_edges, c.ne);
+  cl::Kernel decide = ctx.kernel(F, "conflict_pass1_decide");
+  pass1_rounds(ctx, decide, s, c, dm.nv, n, "conflict_pass1_decide");
   run(ctx, F, "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1), B(s.vaff), B(s.counters));
   return counter(s, 2);
 }
@@ -400,13 +453,13 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   run(ctx, A, "lazy_init", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(c.vflags), B(c.vclass), B(c.eflags), mode,
       paper_rule, B(s.state), B(s.dir), B(s.reason), B(s.cand), B(s.counters), cl_int(restrict_clean ? 1 : 0),
       restrict_clean ? B(s.vdirty) : B(c.vflags));
-  const uint32_t n = prepare_candidates(ctx, s, s.cand, c.ne);
-  cl::Kernel round = ctx.kernel(A, "lazy_pass1_round");
-  set_round_args(round, "lazy_pass1_round", B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt), B(c.nb_off),
-                 B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass),
-                 B(c.eflags), mode, paper_rule, p.eps_v, p.min_quality, B(s.state), B(s.dir), B(s.reason), B(s.counters),
-                 B(s.verdict));
-  worklist_rounds(ctx, round, s, n, "lazy_pass1_round");
+  ensure(s.cand_edges, ctx, c.ne);
+  const uint32_t n = dev::compact_indices(ctx, s.cand, s.cand_edges, c.ne);
+  cl::Kernel decide = ctx.kernel(A, "lazy_pass1_decide");
+  set_args_from(decide, kDecideArgs, "lazy_pass1_decide", B(dm.tets), B(c.vt_off), B(c.vt), B(c.nb_off), B(c.nb),
+                B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass), B(c.eflags), mode,
+                paper_rule, p.eps_v, p.min_quality, B(s.dir), B(s.reason), B(s.counters), B(s.verdict));
+  pass1_rounds(ctx, decide, s, c, dm.nv, n, "lazy_pass1_decide");
   run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1),
       B(s.vaff), B(s.counters));
   uint32_t cnt[6];
@@ -416,14 +469,13 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   return cnt[2];
 }
 
-uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
+uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s) {
   const std::string F = "collapse_conflict.cl";
   ensure(s.fin, ctx, c.ne);
   run(ctx, F, "conflict_pass2_init", c.ne, "", U(c.ne), B(s.p1), B(s.state));
   const uint32_t n = prepare_candidates(ctx, s, s.p1, c.ne);
   cl::Kernel round = ctx.kernel(F, "conflict_pass2_round");
-  set_round_args(round, "conflict_pass2_round", B(c.edges), B(s.cost), B(dm.tets), B(c.vt_off), B(c.vt), B(s.vaff),
-                 B(s.state));
+  set_round_args(round, "conflict_pass2_round", B(c.edges), B(s.cost), B(c.nb_off), B(c.nb), B(s.vaff), B(s.state));
   worklist_rounds(ctx, round, s, n, "conflict_pass2_round");
   run(ctx, F, "conflict_finalize", c.ne, "", U(c.ne), B(c.edges), B(s.p1), B(s.state), B(s.fin), B(s.vaff),
       B(s.counters));
@@ -473,6 +525,22 @@ void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connec
   if (dm.tfield_comps > 0)
     run(ctx, F, "compact_doubles", nt, "", U(nt), B(tkeep), B(tnew), U(dm.tfield_comps), B(dm.tfields), B(next.tfields));
   if (n_origin > 0) run(ctx, F, "origin_update", n_origin, "", U(n_origin), B(vmap), B(origin));
+  if (s.update_next) {
+    // the next iteration's rings and tet_nbr from this one's (collapse_update.cl)
+    const std::string U8 = "collapse_update.cl";
+    ensure(s.upd_count, ctx, nv2);
+    run(ctx, U8, "ring_update_count", nv, "", U(nv), B(vkeep), B(vnew), B(s.vaff), B(c.edges), B(c.vt_off), B(c.vt),
+        B(tkeep), B(s.upd_count));
+    const uint32_t nring = scan_offsets(ctx, s.upd_count, s.upd_vt_off, nv2);
+    ensure(s.upd_vt, ctx, nring);
+    run(ctx, U8, "ring_update_write", nv, "", U(nv), B(vkeep), B(vnew), B(s.vaff), B(c.edges), B(c.vt_off), B(c.vt),
+        B(tkeep), B(tnew), B(s.upd_vt_off), B(s.upd_vt));
+    ensure(s.upd_tet_nbr, ctx, size_t(nt2) * 4);
+    run(ctx, U8, "tet_nbr_update", nt, "", U(nt), B(dm.tets), B(tkeep), B(tnew), B(s.vaff), B(c.edges), B(c.tet_nbr),
+        B(s.upd_tet_nbr));
+    s.update_next = false;
+    s.has_update = true;
+  }
   std::swap(dm, next);
 }
 

@@ -50,8 +50,9 @@ struct EdgeState {
   DeviceBuffer<uint8_t> state;      // conflict passes: 0 undecided, 1 in, 2 out
   DeviceBuffer<uint32_t> cand;      // lazy filter: marked and passing Q
   // Conflict rounds (collapse_conflict.cl): candidate edges, worklists of their slots, the
-  // length of the next worklist, stored rivals per slot and their count.
+  // length of the next worklist, stored rivals per slot (pass 2) and their count.
   DeviceBuffer<uint32_t> cand_edges, work[2], work_n, rivals, rcount;
+  DeviceBuffer<int32_t> slot[2];    // pass 1: per-vertex claims (collapse_conflict.cl)
   DeviceBuffer<uint8_t> dir, reason;
   DeviceBuffer<int32_t> vaff;       // per vertex
   // marked, admissible, pass1, pass2, tested (lazy), passed Q (lazy)
@@ -80,6 +81,11 @@ struct EdgeState {
   DeviceBuffer<uint32_t> prev_nb_off;
   DeviceBuffer<int32_t> prev_nb, prev_nb_edge, prev_tet_nbr;
   DeviceBuffer<uint8_t> prev_vclass, prev_eflags;
+  // Connectivity carried through the compaction (collapse_update.cl): requested by
+  // remember_for_carry, computed by collapse_and_compact, taken over by build_connectivity.
+  bool update_next = false, has_update = false;
+  DeviceBuffer<uint32_t> upd_count, upd_vt_off;
+  DeviceBuffer<int32_t> upd_vt, upd_tet_nbr;
 };
 
 enum Reason : uint8_t {
@@ -103,9 +109,10 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
 
 // With carry (an EdgeState after note_compaction), the data (N(v), tet_nbr, vclass,
 // eflags) of the vertices whose rings did not change is copied from the previous iteration
-// instead of recomputed.
+// instead of recomputed, and the rings and tet_nbr computed by collapse_and_compact are taken
+// over (carry->upd_*, swapped into c).
 void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const StageParams& p,
-                        const EdgeState* carry = nullptr);
+                        EdgeState* carry = nullptr);
 // Returns the number of marked edges.
 uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p);
 // Tests every marked edge (adm, dir, reason); returns the number of admissible edges.

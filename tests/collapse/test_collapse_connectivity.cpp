@@ -165,9 +165,15 @@ TEST(CollapseConnectivity, CarriedAfterCollapsesEqualsFreshBuild) {
       note_compaction(ctx, dm, c, s);
       Connectivity fresh;
       build_connectivity(ctx, dm, fresh, p);
+      EXPECT_TRUE(s.has_update);  // the rings and tet_nbr of collapse_update.cl are taken over
       build_connectivity(ctx, dm, c, p, &s);
+      EXPECT_FALSE(s.has_update);
       carry_verdicts(ctx, dm, c, s);
       ASSERT_EQ(c.ne, fresh.ne);
+      // rings and tet_nbr carried through the compaction (collapse_update.cl) = rebuilt ones
+      EXPECT_EQ(c.vt_off.download_range(0, size_t(dm.nv) + 1), fresh.vt_off.download_range(0, size_t(dm.nv) + 1));
+      EXPECT_EQ(c.vt.download_range(0, 4 * size_t(dm.nt)), fresh.vt.download_range(0, 4 * size_t(dm.nt)));
+      EXPECT_EQ(c.nb.download_range(0, 2 * size_t(c.ne)), fresh.nb.download_range(0, 2 * size_t(c.ne)));
       EXPECT_EQ(c.edges.download_range(0, 2 * size_t(c.ne)), fresh.edges.download_range(0, 2 * size_t(c.ne)));
       EXPECT_EQ(c.tet_nbr.download_range(0, 4 * size_t(dm.nt)), fresh.tet_nbr.download_range(0, 4 * size_t(dm.nt)));
       EXPECT_EQ(c.vflags.download_range(0, dm.nv), fresh.vflags.download_range(0, dm.nv));
