@@ -95,11 +95,15 @@ SeqParams seq_params_from(const CollapseOptions& o) {
 }
 
 SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options)
-    : mesh_(mesh), o_(options), t_start_(std::chrono::steady_clock::now()), sm_(mesh, checked_params(mesh, options)) {
+    : mesh_(mesh),
+      o_(options),
+      t_start_(std::chrono::steady_clock::now()),
+      params_(checked_params(mesh, options)),
+      sm_(mesh, params_) {
   report_.device = "cpu-sequential";
   report_.vertices_in = mesh.num_vertices();
   report_.tets_in = mesh.num_tets();
-  report_.eps_v = checked_params(mesh, options).eps_v;
+  report_.eps_v = params_.eps_v;
   mask_ = options.vertex_mask;
   if (!mesh.tris.empty() || !mesh.edges.empty()) {
     origin_.resize(size_t(mesh.num_vertices()));

@@ -13,6 +13,15 @@
 //      with the verdict of step 1, which still holds since nothing they depend on changed;
 //   3. the dead vertices and tets are dropped from the arrays (order kept).
 // Iterations repeat until one collapses fewer than max(eps_c, 1) edges, or max_iterations.
+// Edges created by a collapse (the removed vertex's edges, now at the survivor) wait for the
+// next iteration, as in the paper. The options of the parallel method's conflict detection
+// (conflicts, selection_rounds) do not apply; a user cost (cost_cl_source) is refused.
+//
+// IterationStats of an iteration: marked (all marked edges), passed_q (of those, passing Q at
+// the start), tested (link and volume tests at the start), admissible (pushed into the queue),
+// after_pass1 = after_pass2 = collapsed (no conflict passes); seconds_connectivity: the edge
+// list, seconds_admissible: marking, checks and queue, seconds_collapse: popping, checking
+// again, collapsing and the compaction (seconds_cost, _pass1, _pass2 are 0).
 //
 // Reuse (CollapseOptions::reuse_across_iterations, default on; the result is the same either
 // way and a test compares both): an edge neither of whose end points was touched in the
@@ -57,9 +66,10 @@ class SequentialRun {
   };
 
   Mesh& mesh_;
-  const CollapseOptions& o_;
+  const CollapseOptions o_;  // a copy: the run may outlive the caller's options
   CollapseReport report_;
   std::chrono::steady_clock::time_point t_start_;
+  SeqParams params_;  // before sm_, which is built from it
   SeqMesh sm_;
   double target_ = 0;
   int it_ = 0;
