@@ -34,6 +34,11 @@ def stem(mesh):
     return os.path.splitext(os.path.basename(mesh))[0]
 
 
+def short(msg, n=110):
+    msg = str(msg)
+    return msg if len(msg) <= n else msg[:n] + "..."
+
+
 def fmt(x, digits=3):
     return "-" if x is None else f"{x:.{digits}f}"
 
@@ -83,8 +88,8 @@ def plot_fig7(plt, r, out_dir, tag):
         ax.set_yscale("log")
         ax.set_xlabel("iteration")
         ax.set_ylabel("collapses in the iteration")
-        ax.set_title(f"{tag}Fig. 7: {m['mesh']} ({m['info']['tets']:,} tets), below the median edge length, eps_c 0",
-                     fontsize=9)
+        ax.set_title(f"{tag}Fig. 7: {m['mesh']} ({m['info']['tets']:,} tets)\n"
+                     "edges below the median length, eps_c 0", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
         f = os.path.join(out_dir, f"fig7_{stem(m['mesh'])}.png")
@@ -101,7 +106,7 @@ def plot_fig8(plt, r, out_dir, tag):
     for m in r["parts"].get("fig8", {}).get("data", []):
         if m.get("status") != "ok":
             continue
-        fig, ax = plt.subplots(figsize=(7, 4.2))
+        fig, ax = plt.subplots(figsize=(9.5, 4.2))
         series = {}
         for p in m["points"]:
             for e in p["results"]:
@@ -121,17 +126,21 @@ def plot_fig8(plt, r, out_dir, tag):
             ax.plot(xs, [q[1] for q in s["pts"]], "-o", markersize=3, color=col, label=lab + " overall")
             ax.plot(xs, [max(q[2], 1e-6) for q in s["pts"]], "--", marker="x", markersize=3, color=col,
                     label=lab + " collapsing")
+        peers_shown = False
         for p in m["points"]:
             for row in (p.get("peers") or {}).get("rows", []):
                 if row.get("seconds") is not None and not str(row.get("peer", "")).startswith("tetcollapse"):
-                    ax.plot([p["threshold"]], [row["seconds"]], "k+", markersize=6)
+                    ax.plot([p["threshold"]], [row["seconds"]], "k+", markersize=6,
+                            label=None if peers_shown else "peers (wall clock, bench/peers.py)")
+                    peers_shown = True
         el = m["info"]["edge_length"]
         ax.set_yscale("log")
         ax.set_xlabel(f"edge length threshold (min {el['min']:.4g} .. median {el['median']:.4g})")
         ax.set_ylabel("seconds (median)")
-        ax.set_title(f"{tag}Fig. 8: {m['mesh']} ({m['info']['tets']:,} tets), eps_c 0", fontsize=9)
+        ax.set_title(f"{tag}Fig. 8: {m['mesh']} ({m['info']['tets']:,} tets), eps_c 0\n"
+                     "overall (solid, with connectivity) and collapsing only (dashed)", fontsize=9)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
         f = os.path.join(out_dir, f"fig8_{stem(m['mesh'])}.png")
         fig.tight_layout()
         fig.savefig(f, dpi=120)
@@ -158,7 +167,7 @@ def plot_fig9(plt, r, out_dir, tag):
         if not ok:
             continue
         lab = label_of(ok[0][1], md)
-        ax.plot([i for i, _ in ok], [e["median"]["seconds_collapse"] for _, e in ok], "-o",
+        ax.plot([i for i, _ in ok], [e["median"]["seconds_collapse"] for _, e in ok], "-",
                 color=METHOD_COLORS["ours"], marker=DEVICE_STYLES[k % len(DEVICE_STYLES)], label=lab + ": run time")
         ax2.plot([i for i, _ in ok], [e["tets_out"] for _, e in ok], ":", marker=DEVICE_STYLES[k % len(DEVICE_STYLES)],
                  color="tab:red", label=lab + ": tets left")
@@ -170,13 +179,14 @@ def plot_fig9(plt, r, out_dir, tag):
     ax.set_xlabel("eps_c (stop when an iteration collapses fewer edges)")
     ax.set_ylabel("seconds (median, collapse incl. connectivity)")
     ax2.set_ylabel("tets left")
-    ax.set_ylim(bottom=0)
-    ax2.set_ylim(bottom=0)
-    ax.set_title(f"{tag}Fig. 9: {m['mesh']} ({m['info']['tets']:,} tets) to 2 x median edge length", fontsize=9)
+    ax.set_ylim(0, ax.get_ylim()[1] * 1.25)
+    ax2.set_ylim(0, ax2.get_ylim()[1] * 1.25)
+    ax.set_title(f"{tag}Fig. 9: {m['mesh']} ({m['info']['tets']:,} tets)\nto 2 x median edge length, ours",
+                 fontsize=9)
     ax.grid(True, alpha=0.3)
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
-    ax.legend(h1 + h2, l1 + l2, fontsize=8, loc="upper right")
+    ax.legend(h1 + h2, l1 + l2, fontsize=8, loc="lower center")
     f = os.path.join(out_dir, "fig9.png")
     fig.tight_layout()
     fig.savefig(f, dpi=120)
@@ -203,7 +213,7 @@ def markdown(r):
                 continue
             for e in m["results"]:
                 if e.get("status") != "ok":
-                    out.append(f"| {m['mesh']} | {m['info']['tets']:,} | {label_of(e, md)} | failed: {e.get('message')} | | |")
+                    out.append(f"| {m['mesh']} | {m['info']['tets']:,} | {label_of(e, md)} | failed: {short(e.get('message'))} | | |")
                 else:
                     first = ", ".join(str(x) for x in e["collapsed"][:8])
                     out.append(f"| {m['mesh']} | {m['info']['tets']:,} | {label_of(e, md)} | "
@@ -255,12 +265,15 @@ def markdown(r):
             out += ["| method | run time (s) | speedup of ours | collapsing only (s) | whole CLI (s) | reps | iterations | tets out |",
                     "|---|---:|---:|---:|---:|---:|---:|---:|"]
             for row in t["rows"]:
+                name = row["name"] + (" (peer)" if row["method"] == "peer" else "")
                 if row["status"] != "ok":
-                    out.append(f"| {row['name']} | failed: {row.get('message')} | | | | | | |")
+                    out.append(f"| {name} | failed: {short(row.get('message'))} | | | | | | |")
                 elif row["method"] == "peer":
-                    out.append(f"| {row['name']} (peer) | {fmt(row.get('seconds'))} | {fmt(row.get('speedup'), 2)}x | | "
-                               f"{fmt(row.get('seconds_wall'))} (speedup {fmt(row.get('speedup_wall'), 2)}x) | | | "
-                               f"{row.get('tets_out') or '-'} |")
+                    tets = f"{row['tets_out']:,}" if isinstance(row.get("tets_out"), int) else "-"
+                    alg = (f"{fmt(row.get('seconds'))} | {fmt(row.get('speedup'), 2)}x" if row.get("seconds") is not None
+                           else "- | -")
+                    out.append(f"| {name} | {alg} | | {fmt(row.get('seconds_wall'))} (ours {fmt(row.get('speedup_wall'), 2)}x "
+                               f"faster) | | | {tets} |")
                 else:
                     out.append(f"| {row['name']} | {fmt(row['seconds'])} | {fmt(row['speedup'], 2)}x | "
                                f"{fmt(row['seconds_collapse_only'])} | {fmt(row['seconds_total'])} | {row['reps']} | "
@@ -286,7 +299,7 @@ def markdown(r):
                 for e in p["results"]:
                     dev = e["device"]["name"] if e.get("device") else "-"
                     if e.get("status") != "ok":
-                        out.append(f"| {p['eps_c']} | {dev} | failed: {e.get('message')} | | | |")
+                        out.append(f"| {p['eps_c']} | {dev} | failed: {short(e.get('message'))} | | | |")
                     else:
                         out.append(f"| {p['eps_c']} | {dev} | {fmt(e['median']['seconds_collapse'])} | "
                                    f"{e['iterations_collapsing']} | {e['tets_out']:,} | {e['vertices_out']:,} |")

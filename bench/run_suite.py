@@ -383,7 +383,13 @@ class Suite:
             res["peers"] = self.peers(mesh, 2 * info["edge_length"]["median"])
         res["rows"] = table2_rows(entries, res.get("peers"))
         for r in res["rows"]:
-            log(f"  {r['name']}: {r['status']} {fmt(r.get('seconds'))} s, speedup of ours {fmt(r.get('speedup'), 2)}x")
+            if r["status"] != "ok":
+                log(f"  {r['name']}: failed: {r.get('message')}")
+            elif r["method"] == "peer":
+                log(f"  {r['name']} (peer): wall {fmt(r.get('seconds_wall'))} s (ours' whole CLI {fmt(r.get('speedup_wall'), 2)}x "
+                    f"faster), own algorithm time {fmt(r.get('seconds'))} s")
+            else:
+                log(f"  {r['name']}: {fmt(r.get('seconds'))} s, speedup of ours {fmt(r.get('speedup'), 2)}x")
         return res
 
     def part_fig9(self):
@@ -413,8 +419,9 @@ def summarize(e):
     e["max"] = {k: max(r[k] for r in runs) for k in ("seconds_collapse", "seconds_collapse_only")}
     first = runs[0]
     for k in ("tets_in", "tets_out", "vertices_in", "vertices_out", "iterations", "iterations_collapsing",
-              "collapsed", "target_length", "median_edge_length", "device"):
+              "collapsed", "target_length", "median_edge_length"):
         e[k] = first.get(k)
+    e["device_reported"] = first.get("device")  # the device name the CLI wrote in --stats
     e["deterministic"] = all(r["collapsed"] == first["collapsed"] and r["tets_out"] == first["tets_out"] for r in runs)
     e["reps"] = len(runs)
     e["load1"] = [r.get("load1_before") for r in runs]
@@ -518,7 +525,7 @@ def main():
     ap.add_argument("--peer-list", default="mmg3d_hsiz,mmg3d_hsiz_nosurf,cgal_remesh,tetgen_rR",
                     help="--peers passed to bench/peers.py ('' = its default)")
     ap.add_argument("--peer-args", default="",
-                    help="more options for bench/peers.py, e.g. '--no-hausdorff --cgal-peer build-peers/bench/bench_peer_cgal'")
+                    help="more options for bench/peers.py, written with '=', e.g. --peer-args='--no-hausdorff --cgal-peer PATH'")
     ap.add_argument("--peer-reps", type=int, default=None, help="--reps of bench/peers.py (default 3, --quick 1)")
     ap.add_argument("--timeout", type=float, default=3600, help="seconds per process")
     ap.add_argument("--label", default=None, help="label of the result (default 'full', 'smoke' with --quick)")
