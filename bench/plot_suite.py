@@ -223,6 +223,8 @@ def markdown(r):
                 "| mesh | goal | verdict | detail |", "|---|---|---|---|"]
         for mesh, g in goals:
             out.append(f"| {mesh} | {g['goal']}{g.get('device_tag', '')} | **{g['verdict']}** | {g['detail']} |")
+        if not goals:
+            out.append("| - | - | not evaluated | no Fig. 7 mesh ran |")
         out.append("")
 
     if "fig8" in parts:
