@@ -178,6 +178,14 @@ Mesh read_shared(const std::string& name) {
   return path.empty() ? Mesh{} : read_mesh(path);
 }
 
+// Skips the test (with the names) unless every one of the shared meshes is present.
+#define SKIP_UNLESS_SHARED(...)                                                                        \
+  do {                                                                                               \
+    TC_SKIP_IF_NO_SHARED();                                                                          \
+    for (const char* n : {__VA_ARGS__})                                                              \
+      if (test::shared_mesh(n).empty()) GTEST_SKIP() << "shared mesh " << n << " is absent; skipped"; \
+  } while (0)
+
 }  // namespace
 
 // --- the checks: the same verdicts as the device ---
@@ -209,7 +217,8 @@ TEST(SequentialVerdicts, SameAsDeviceOnBracketAndSharedMeshes) {
   paper0.min_quality = 0;
   paper0.paper_boundary_rule = true;
   expect_same_verdicts_fresh(ctx, bracket, paper0, 1.0, "bracket paper rule, no guard");
-  TC_SKIP_IF_NO_SHARED();
+  SKIP_UNLESS_SHARED("polyfem_bimetal.msh", "sfepy_multi_material_cylinder_plate.vtk", "gen_gmsh_Angled_43k.msh",
+                     "polyfem_mat100x100t40.msh");
   // interfaces (2 and 4 materials), ridges and corners of a CAD part, a sheet one tet thick
   for (const char* name : {"polyfem_bimetal.msh", "sfepy_multi_material_cylinder_plate.vtk", "gen_gmsh_Angled_43k.msh",
                            "polyfem_mat100x100t40.msh"}) {
@@ -230,10 +239,8 @@ TEST(SequentialVerdicts, IncrementalStateAgreesWithTheDeviceInLaterIterations) {
   std::vector<std::pair<std::string, Mesh>> meshes;
   meshes.push_back({"two-material cube", two_material_cube(6)});
   meshes.push_back({"bracket", read_mesh(test::project_mesh("bracket.msh"))});
-  if (!test::shared_meshes_dir().empty()) {
-    meshes.push_back({"bimetal", read_shared("polyfem_bimetal.msh")});
-    meshes.push_back({"Angled", read_shared("gen_gmsh_Angled_43k.msh")});
-  }
+  for (const char* name : {"polyfem_bimetal.msh", "gen_gmsh_Angled_43k.msh"})  // when present
+    if (!test::shared_mesh(name).empty()) meshes.push_back({name, read_shared(name)});
   for (auto& [name, in] : meshes) {
     ASSERT_GT(in.num_tets(), 0) << name;
     Mesh m = in;
@@ -253,7 +260,7 @@ TEST(SequentialVerdicts, ClassesStayThoseOfAFreshClassification) {
   std::vector<std::pair<std::string, Mesh>> meshes;
   meshes.push_back({"two-material cube", two_material_cube(5)});
   meshes.push_back({"bracket", read_mesh(test::project_mesh("bracket.msh"))});
-  if (!test::shared_meshes_dir().empty())
+  if (!test::shared_mesh("sfepy_multi_material_cylinder_plate.vtk").empty())  // when present
     meshes.push_back({"cylinder plate", read_shared("sfepy_multi_material_cylinder_plate.vtk")});
   for (auto& [name, in] : meshes) {
     ASSERT_GT(in.num_tets(), 0) << name;
@@ -305,7 +312,7 @@ TEST(SequentialCollapse, BracketAndSharedMeshesStayValid) {
   CollapseOptions strict = o;
   strict.boundary = CollapseOptions::Strict;
   expect_valid_run(read_mesh(test::project_mesh("bracket.msh")), m, strict, "bracket strict");
-  TC_SKIP_IF_NO_SHARED();
+  SKIP_UNLESS_SHARED("polyfem_bimetal.msh", "ipc_hammer.msh", "gen_gmsh_Angled_43k.msh", "polyfem_cubes_v41.msh");
   for (const char* name : {"polyfem_bimetal.msh", "ipc_hammer.msh", "gen_gmsh_Angled_43k.msh"}) {
     Mesh in = read_shared(name);
     ASSERT_GT(in.num_tets(), 0) << name;
