@@ -30,6 +30,8 @@ A peer's binary is looked up with --<peer> PATH, else on PATH (mmg3d_O3, mmg3d, 
 next to tetcollapse (bench_peer_cgal in <build>/bench/). The input is converted once with
 `tetcollapse convert` to Medit .mesh (MMG3D) and TetGen .node/.ele (TetGen); the peers' outputs
 (.mesh, .node/.ele) are read by `tetcollapse check` directly.
+
+    bench/peers.py --table F.json    prints the rows of a results file as a markdown table
 """
 import argparse
 import json
@@ -138,7 +140,32 @@ def check_output(tc, out, mesh, work, timeout, hausdorff):
     }
 
 
+def fmt(x, spec):
+    return "-" if x is None else format(x, spec)
+
+
+def markdown(rows):
+    """The rows of a results file as a markdown table (bench/peers.py --table F.json)."""
+    out = ["| peer | command | wall s | own s | tets out | min dihedral | max dihedral | tets < 10 deg | "
+           "valid | Hausdorff rel |", "|---|---|---:|---:|---:|---:|---:|---:|---|---:|"]
+    for r in rows:
+        if "skipped_reason" in r:
+            out.append(f"| {r['peer']} | `{r.get('command') or '-'}` | skipped: {r['skipped_reason'][:160]} "
+                       "| | | | | | | |")
+            continue
+        valid = {True: "yes", False: "no: " + ", ".join(r.get("check_errors") or []), None: "?"}[r.get("valid")]
+        out.append(f"| {r['peer']} | `{r['command']}` | {fmt(r.get('seconds'), '.2f')} | "
+                   f"{fmt(r.get('seconds_algorithm'), '.2f')} | {fmt(r.get('tets_out'), ',')} | "
+                   f"{fmt(r.get('min_dihedral_deg'), '.3g')} | {fmt(r.get('max_dihedral_deg'), '.4g')} | "
+                   f"{fmt(r.get('tets_below_10_deg'), ',')} | {valid} | {fmt(r.get('hausdorff_rel'), '.2g')} |")
+    return "\n".join(out)
+
+
 def main():
+    if len(sys.argv) == 3 and sys.argv[1] == "--table":
+        with open(sys.argv[2]) as f:
+            print(markdown(json.load(f)))
+        return
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--mesh", required=True)
     ap.add_argument("--target-length", type=float, required=True)

@@ -111,6 +111,8 @@ def run_one(tc, path, mode, work, timeout):
 def problems(r):
     """Why a row is not the expected result (empty when it is)."""
     why = []
+    if any(w.startswith("reference_invalid") for w in r.get("check_warnings", [])):
+        why.append("the input is itself invalid (reference_invalid)")
     if r.get("exit_code") != 0:
         why.append(f"exit {r.get('exit_code')}")
     if r.get("check") not in ("valid",):
@@ -130,7 +132,8 @@ def fmt(x, spec):
 
 def table(rows, meta):
     lines = [SECTION, ""]
-    lines.append(f"`bench/shared_meshes.py` ({meta['date']}, commit {meta['commit']}, {meta['device']}; load average "
+    lines.append(f"`bench/shared_meshes.py` ({meta['date']}, commit {meta['commit']}, binary built "
+                 f"{meta.get('binary_built', '?')}, {meta['device']}; load average "
                  f"{meta['load_min']:.1f}-{meta['load_max']:.1f} during the run). Every volume mesh of "
                  "`../shared/meshes/`, target = its median edge length (`--target-factor 1`), default options "
                  "(quality guard 0.1, eps_c 0), one run each: `tetcollapse IN OUT.vtu --target-factor 1 --boundary "
@@ -207,6 +210,11 @@ def main():
     work = a.work_dir or tmp.name
     os.makedirs(work, exist_ok=True)
 
+    # The binary's build time and the commit at the start of the run (the tree is shared by
+    # several people: the binary may hold uncommitted work of its build time).
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
+    built = datetime.datetime.fromtimestamp(os.path.getmtime(tc), datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     rows = []
     for path in meshes:
         for mode in modes:
@@ -217,11 +225,9 @@ def main():
                   f"collapse {r.get('seconds_collapse')} s  check {r.get('check')}  H {r.get('hausdorff')}"
                   + (f"  NOT AS EXPECTED: {why}" if why else ""), flush=True)
 
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
     loads = [r[k] for r in rows for k in ("load_avg_before", "load_avg_after")]
     device = next((r["device"] for r in rows if r.get("device")), "?")
-    meta = {"date": datetime.date.today().isoformat(), "commit": commit, "device": device,
+    meta = {"date": datetime.date.today().isoformat(), "commit": commit, "binary_built": built, "device": device,
             "machine": platform.node(), "load_min": min(loads) if loads else 0, "load_max": max(loads) if loads else 0}
     os.makedirs(os.path.dirname(os.path.abspath(a.out_json)), exist_ok=True)
     with open(a.out_json, "w") as f:
