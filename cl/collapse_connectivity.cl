@@ -51,7 +51,8 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
                                         __global int* vt, __global int* scratch, __global uint* nb_count,
                                         __global uint* up_count, int sort, int carry, __global const uchar* ndirty,
                                         __global const int* vold, __global const int* vmap,
-                                        __global const uint* prev_nb_off, __global const int* prev_nb) {
+                                        __global const uint* prev_nb_off, __global const int* prev_nb,
+                                        int rename, __global const int* prev_vaff) {
   uint v = get_global_id(0);
   if (v >= nv) return;
   uint b = vt_off[v], n = vt_off[v + 1] - b;
@@ -70,6 +71,43 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
     nb_count[v] = m;
     up_count[v] = up;
     return;
+  }
+  if (carry && rename && prev_vaff[vold[v]] < 0) {
+    /* v is a neighbour of collapses, not an end point (rename: the rings were carried through
+     * the compaction, collapse_update.cl). A collapse of x onto y renames x to y in the tets
+     * of ring(v) and removes tets holding both; the link condition leaves every edge (v, w)
+     * in some surviving tet, so N(v) is the previous one with each removed x renamed to its
+     * survivor. The end points of the collapses (renamed, or kept but possibly equal to a
+     * renamed one) are merged into the renumbered others, which stay in order. */
+    int o = vold[v];
+    uint pb = prev_nb_off[o], pm = prev_nb_off[o + 1] - pb, m = 0;
+    int ren[16];
+    int nr = 0;
+    for (uint i = 0; i < pm && nr <= 16; ++i) {
+      int w = prev_nb[pb + i];
+      if (prev_vaff[w] >= 0) {
+        if (nr < 16) ren[nr] = vmap[w];
+        ++nr;
+      } else {
+        s[m++] = vmap[w];
+      }
+    }
+    if (nr <= 16) {
+      for (int r = 0; r < nr; ++r) {
+        int u = ren[r];
+        uint j = m;
+        while (j > 0 && s[j - 1] > u) --j;
+        if (j > 0 && s[j - 1] == u) continue;
+        for (uint k2 = m; k2 > j; --k2) s[k2] = s[k2 - 1];
+        s[j] = u;
+        ++m;
+      }
+      uint up = 0;
+      for (uint i = 0; i < m; ++i) up += s[i] > (int)v ? 1u : 0u;
+      nb_count[v] = m;
+      up_count[v] = up;
+      return;
+    }
   }
   /* N(v) is built by insertion into a sorted private list (short: ~15 entries), spilling to the
    * global scratch area only when it outgrows TCC_MAX_NB */

@@ -240,7 +240,8 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   const cl::Buffer& pno = cy ? B(carry->prev_nb_off) : B(c.count);
   const cl::Buffer& pnb = cy ? B(carry->prev_nb) : B(c.count);
   run(ctx, F, "conn_ring_sort_and_gather", nv, "", B(dm.tets), U(nv), B(c.vt_off), B(c.vt), B(c.scratch),
-      B(c.count), B(c.up_count), cl_int(updated ? 0 : 1), ci, nd, vo, vm, pno, pnb);
+      B(c.count), B(c.up_count), cl_int(updated ? 0 : 1), ci, nd, vo, vm, pno, pnb, cl_int(updated ? 1 : 0),
+      updated ? B(carry->vaff) : B(c.count));
   uint32_t nnb = scan_offsets(ctx, c.count, c.nb_off, nv);
   c.ne = scan_offsets(ctx, c.up_count, c.edge_off, nv);
   ensure(c.nb, ctx, nnb);
