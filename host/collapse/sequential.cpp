@@ -163,7 +163,7 @@ bool SequentialRun::step() {
     ++s.passed_q;
     if (reuse && touched_[e.a] != prev && touched_[e.b] != prev) continue;  // refused then, refused now
     ++s.tested;
-    if (sm_.link_and_volume(e.a, e.b, fe, dir) != kOk) continue;
+    if (!sm_.admissible(e.a, e.b, fe, dir)) continue;
     heap_.push_back({e.cost, e.a, e.b, uint8_t(dir)});
   }
   s.admissible = int64_t(heap_.size());
@@ -188,9 +188,10 @@ bool SequentialRun::step() {
         std::push_heap(heap_.begin(), heap_.end(), later);
         continue;
       }
-      const Verdict v = sm_.check(e.a, e.b);
-      if (v.reason != kOk) continue;
-      dir = v.dir;
+      uint8_t fe = 0;
+      const int d = sm_.predicate(e.a, e.b, fe);
+      if (d < 0 || !sm_.admissible(e.a, e.b, fe, d)) continue;
+      dir = uint8_t(d);
     }
     sm_.collapse(e.a, e.b, dir);
     ++s.collapsed;

@@ -422,8 +422,18 @@ tc_d3 SeqMesh::placement(int32_t a, int32_t b, unsigned dir) const {
 
 // tcc_link_and_volume, over the current rings (a < b).
 uint8_t SeqMesh::link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir) {
+  if (!link_ok(a, b, fe)) return kRefusedLink;
+  return volume_and_quality(a, b, dir);
+}
+
+bool SeqMesh::admissible(int32_t a, int32_t b, uint8_t fe, int dir) {
+  // the volume test first: it is cheaper and refuses more edges than the link condition
+  return volume_and_quality(a, b, dir) == kOk && link_ok(a, b, fe);
+}
+
+// The link condition of tcc_link_and_volume (a < b): true when it holds.
+bool SeqMesh::link_ok(int32_t a, int32_t b, uint8_t fe) {
   const uint8_t fa = vflags_[a], fb = vflags_[b];
-  // --- link condition ---
   // N(a) marked sA; the common neighbours cn = N(a) n N(b) re-marked sC
   const uint32_t sA = next_stamp(), sC = next_stamp();
   const int32_t* ra = ring(a);
@@ -444,7 +454,7 @@ uint8_t SeqMesh::link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir) {
       }
     }
   }
-  if (cn_.size() > kMaxLink) return kRefusedLink;
+  if (cn_.size() > kMaxLink) return false;
   // lk(ab): the pairs (c, d) of the tets around the edge, their vertices marked sL
   const uint32_t sL = next_stamp();
   pc_.clear();
@@ -460,16 +470,16 @@ uint8_t SeqMesh::link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir) {
     pd_.push_back(o[1]);
     lmark_[o[0]] = lmark_[o[1]] = sL;
   }
-  if (pc_.size() > kMaxLink) return kRefusedLink;
+  if (pc_.size() > kMaxLink) return false;
   // (i) every common neighbour is a vertex of lk(ab); and w: a, b both on S needs an S-edge
   for (int32_t c : cn_)
-    if (lmark_[c] != sL) return kRefusedLink;
-  if ((fa & kSMask) && (fb & kSMask) && !(fe & kSMask)) return kRefusedLink;
+    if (lmark_[c] != sL) return false;
+  if ((fa & kSMask) && (fb & kSMask) && !(fe & kSMask)) return false;
   // (ii) with w: S-edges (a,c) and (b,c) need the S-face (a,b,c)
   for (int32_t c : cn_) {
     if (!(vflags_[c] & kSMask)) continue;
     if ((edge_flags(a, c, false) & kSMask) && (edge_flags(b, c, false) & kSMask) && !triangle_kind(a, b, c))
-      return kRefusedLink;
+      return false;
   }
   // (ii) triangles and (iii) tets and S-faces, from the tets of ring(a) without b
   for (uint32_t i = 0; i < rlen_[a]; ++i) {
@@ -480,7 +490,7 @@ uint8_t SeqMesh::link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir) {
     for (int k = 0; k < 4; ++k)
       if (q[k] != a) o[no++] = q[k];
     const bool in[3] = {mark_[o[0]] == sC, mark_[o[1]] == sC, mark_[o[2]] == sC};
-    if (in[0] && in[1] && in[2] && ring_has(b, o[0], o[1], o[2])) return kRefusedLink;  // tets (a,c,d,e), (b,c,d,e)
+    if (in[0] && in[1] && in[2] && ring_has(b, o[0], o[1], o[2])) return false;  // tets (a,c,d,e), (b,c,d,e)
     static constexpr int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
     for (const auto& pr : pairs) {
       if (!in[pr[0]] || !in[pr[1]]) continue;
@@ -491,15 +501,18 @@ uint8_t SeqMesh::link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir) {
       for (size_t m = 0; m < pc_.size() && !in_lk; ++m)
         in_lk = (pc_[m] == c && pd_[m] == d) || (pc_[m] == d && pd_[m] == c);
       if (!in_lk) {
-        if (ring_has(b, c, d, -1)) return kRefusedLink;
+        if (ring_has(b, c, d, -1)) return false;
         continue;  // (b,c,d) is no triangle
       }
       // S-faces (a,c,d) and (b,c,d); an S-face through a needs a on S (and b likewise)
-      if ((fa & kSMask) && (fb & kSMask) && triangle_kind(a, c, d) && triangle_kind(b, c, d)) return kRefusedLink;
+      if ((fa & kSMask) && (fb & kSMask) && triangle_kind(a, c, d) && triangle_kind(b, c, d)) return false;
     }
   }
+  return true;
+}
 
-  // --- volumes (and the quality guard) after the tentative collapse ---
+// The volumes (and the quality guard) after the tentative collapse.
+uint8_t SeqMesh::volume_and_quality(int32_t a, int32_t b, int dir) const {
   const tc_d3 p = placement(a, b, unsigned(dir));
   double q_old = 1.0, q_new = 1.0;
   const double q_min = p_.min_quality;

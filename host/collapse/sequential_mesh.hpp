@@ -76,6 +76,8 @@ class SeqMesh {
   int predicate(int32_t a, int32_t b, uint8_t& fe);
   uint8_t link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir);
   Verdict check(int32_t a, int32_t b);
+  // link_and_volume(...) == kOk, the cheaper test first (for when the reason does not matter).
+  bool admissible(int32_t a, int32_t b, uint8_t fe, int dir);
 
   // Collapses the edge (a, b) in the direction `dir` (bits for the ordered pair (min, max), as
   // check() returns them). Returns the survivor. touched() then lists every vertex whose star
@@ -124,6 +126,8 @@ class SeqMesh {
   void classify(int32_t v, uint8_t& flags, uint8_t& cls);
   bool ring_has(int32_t x, int32_t y, int32_t z, int32_t w) const;
   uint8_t triangle_kind(int32_t x, int32_t y, int32_t z) const;
+  bool link_ok(int32_t a, int32_t b, uint8_t fe);
+  uint8_t volume_and_quality(int32_t a, int32_t b, int dir) const;
   geo::tc_d3 placement(int32_t a, int32_t b, unsigned dir) const;
 
   Mesh& mesh_;
