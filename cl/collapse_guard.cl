@@ -7,8 +7,8 @@
  * and a part of S that is not in the star (the other side of a narrow gap: another body, the
  * far wall of a thin slot, a boss standing in a hole) may lie within that distance. Nothing
  * local sees it; the tets stay positive. (Found on corpus mesh cad_052: a ridge vertex on the
- * rim of a hole, collapsed onto its neighbour, cut the rim's chord through the wall of a boss
- * standing 0.003 away in the hole.)
+ * rim of a hole (radius 0.09), collapsed onto its neighbour, made the rim its chord, and the
+ * chord cut through the wall of a boss standing in the hole, a thin crescent of void away.)
  *
  * Per iteration, over the collapses chosen by the conflict passes (fin):
  *   sguard_queries    a collapse that changes S (removed vertex x on S, or a survivor y on S
@@ -24,21 +24,15 @@
  * The new S triangles of the collapse of x onto y (y at the placement p): the faces containing
  * x of the tets of ring(x) that survive, and, when y moves, the faces containing y of ring(y),
  * with x renamed y; a face is taken when it is on S now, or when the tet across it is removed
- * by the collapse (the two faces of a removed tet are glued: the result may become S). Testing
- * against faces that another chosen collapse replaces, or against faces that end up interior,
- * only refuses more (never less).
+ * by the collapse and the face it is glued to through that tet is on the boundary or the two
+ * tets' labels differ. The current S faces are tested in their current places, also those that
+ * another chosen collapse moves (whose new triangles are tested too): that only refuses more.
  *
- * The triangle test is floating-point with Shewchuk's static error bound: a sign that is not
- * certain counts as zero, and zero counts as touching, so every pair that intersects exactly
- * is reported (pairs sharing an edge are not tested: they can only overlap when coplanar).
+ * The triangle test is floating-point with a tolerance of 1e-9 times the triangles' size: a
+ * contact within it counts, so rounding never hides a pair that intersects exactly (pairs
+ * sharing an edge are not tested: they can only overlap when coplanar).
  */
 #include "collapse_common.h"
-
-/* -1 / 0 / 1: the sign of tc_orient3d when certain, else 0. */
-inline int tcc_sg_orient(double3 a, double3 b, double3 c, double3 d) {
-  double det = tc_orient3d(a, b, c, d), eb = tc_orient3d_errbound(a, b, c, d);
-  return det > eb ? 1 : det < -eb ? -1 : 0;
-}
 
 /* 2D orientation of (a, b, c) in the plane of the two kept axes (drop = the dropped axis). */
 inline double2 tcc_sg_proj(double3 p, int drop) {
@@ -63,28 +57,43 @@ inline int tcc_sg_seg_seg2(double2 p, double2 q, double2 u, double2 w) {
   return 1;
 }
 
-/* Is 2D point p in the closed triangle (a, b, c)? */
-inline int tcc_sg_in_tri2(double2 p, double2 a, double2 b, double2 c) {
-  int s0 = tcc_sg_orient2(a, b, p), s1 = tcc_sg_orient2(b, c, p), s2 = tcc_sg_orient2(c, a, p);
-  return !((s0 > 0 || s1 > 0 || s2 > 0) && (s0 < 0 || s1 < 0 || s2 < 0));
+/* Is 2D point p in triangle (a, b, c) grown by tol? */
+inline int tcc_sg_in_tri2_tol(double2 p, double2 a, double2 b, double2 c, double tol) {
+  double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+  double sgn = area >= 0.0 ? 1.0 : -1.0;
+  double2 v[3] = {a, b, c};
+  for (int k = 0; k < 3; ++k) {
+    double2 u = v[k], w = v[(k + 1) % 3];
+    double ex = w.x - u.x, ey = w.y - u.y, len = sqrt(ex * ex + ey * ey);
+    if (sgn * (ex * (p.y - u.y) - ey * (p.x - u.x)) < -tol * len) return 0;
+  }
+  return 1;
 }
 
-/* Does the closed segment (p, q) meet the closed triangle (a, b, c)? */
+/* Does the closed segment (p, q) meet the closed triangle (a, b, c), up to a distance of
+ * 1e-9 times their size (so that rounding never hides a contact)? A segment within that
+ * distance of the triangle's plane is tested in the plane; otherwise the point where it
+ * crosses the plane is. */
 inline int tcc_sg_seg_tri(double3 p, double3 q, double3 a, double3 b, double3 c) {
-  int o1 = tcc_sg_orient(a, b, c, p), o2 = tcc_sg_orient(a, b, c, q);
-  if (o1 * o2 > 0) return 0;
-  if (o1 == 0 && o2 == 0) { /* in the plane (or too close to tell): in 2D */
-    double3 n = tcc_cross(b - a, c - a);
-    double nx = fabs(n.x), ny = fabs(n.y), nz = fabs(n.z);
-    int drop = nx >= ny && nx >= nz ? 0 : ny >= nz ? 1 : 2;
+  double3 n = tcc_cross(b - a, c - a);
+  double ln = sqrt(tcc_dot(n, n));
+  if (!(ln > 0.0)) return 1; /* a degenerate triangle: cannot tell */
+  double3 ab = b - a, ac = c - a, bc = c - b, pq = q - p;
+  double size = sqrt(fmax(fmax(tcc_dot(ab, ab), tcc_dot(ac, ac)), fmax(tcc_dot(bc, bc), tcc_dot(pq, pq))));
+  double tol = 1e-9 * size;
+  double dp = tcc_dot(n, p - a) / ln, dq = tcc_dot(n, q - a) / ln; /* signed distances */
+  if ((dp > tol && dq > tol) || (dp < -tol && dq < -tol)) return 0;
+  double nx = fabs(n.x), ny = fabs(n.y), nz = fabs(n.z);
+  int drop = nx >= ny && nx >= nz ? 0 : ny >= nz ? 1 : 2;
+  double2 a2 = tcc_sg_proj(a, drop), b2 = tcc_sg_proj(b, drop), c2 = tcc_sg_proj(c, drop);
+  if (fabs(dp) <= tol && fabs(dq) <= tol) { /* in the plane: in 2D */
     double2 p2 = tcc_sg_proj(p, drop), q2 = tcc_sg_proj(q, drop);
-    double2 a2 = tcc_sg_proj(a, drop), b2 = tcc_sg_proj(b, drop), c2 = tcc_sg_proj(c, drop);
-    return tcc_sg_in_tri2(p2, a2, b2, c2) || tcc_sg_in_tri2(q2, a2, b2, c2) || tcc_sg_seg_seg2(p2, q2, a2, b2) ||
-           tcc_sg_seg_seg2(p2, q2, b2, c2) || tcc_sg_seg_seg2(p2, q2, c2, a2);
+    return tcc_sg_in_tri2_tol(p2, a2, b2, c2, tol) || tcc_sg_in_tri2_tol(q2, a2, b2, c2, tol) ||
+           tcc_sg_seg_seg2(p2, q2, a2, b2) || tcc_sg_seg_seg2(p2, q2, b2, c2) || tcc_sg_seg_seg2(p2, q2, c2, a2);
   }
-  /* the segment meets the plane: is that point in the triangle? */
-  int s0 = tcc_sg_orient(p, q, a, b), s1 = tcc_sg_orient(p, q, b, c), s2 = tcc_sg_orient(p, q, c, a);
-  return !((s0 > 0 || s1 > 0 || s2 > 0) && (s0 < 0 || s1 < 0 || s2 < 0));
+  double t = dp / (dp - dq); /* dp != dq here */
+  t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+  return tcc_sg_in_tri2_tol(tcc_sg_proj(p + pq * t, drop), a2, b2, c2, tol);
 }
 
 /* Do triangles A and B (vertex ids ia, ib; positions pa, pb) intersect other than in what they
@@ -298,7 +307,7 @@ __kernel void sguard_surface(uint nt, __global const int* edges, __global const 
               tcc_sg_load_tri(tid, tpos, n, id, pos);
               if (tcc_sg_boxes_apart(pos, fpos) || !tcc_sg_tri_tri(id, pos, fid, fpos)) continue;
               uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
-              qbad[qi] = code < 0xfffffffeu ? code + 2u : 1u;
+              qbad[qi] = code < 0x7ffffffeu ? code + 2u : 1u;
               break;
             }
           }
@@ -327,7 +336,7 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
       double3 posb[3];
       tcc_sg_load_tri(tid, tpos, nb, idb, posb);
       if (tcc_sg_boxes_apart(posa, posb) || !tcc_sg_tri_tri(ida, posa, idb, posb)) continue;
-      qbad[qa] = 1u;
+      qbad[qa] = 0x80000000u | qa;
       return;
     }
   }
@@ -350,7 +359,7 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
               double3 posb[3];
               tcc_sg_load_tri(tid, tpos, nb, idb, posb);
               if (tcc_sg_boxes_apart(posa, posb) || !tcc_sg_tri_tri(ida, posa, idb, posb)) continue;
-              qbad[qa] = 1u;
+              qbad[qa] = 0x80000000u | qb; /* names the other query for debugging */
               return;
             }
           }

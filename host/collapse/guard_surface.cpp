@@ -1,7 +1,8 @@
 // Host side of the surface guard (cl/collapse_guard.cl): the queries are found on the device,
 // their boxes gridded here (a dense uniform grid; the boxes are few and of similar size, the
 // collapses of one iteration), then every S face and every pair of queries is tested on the
-// device through the grid.
+// device through the grid. TETCOLLAPSE_PROFILE=1 prints the launches and a count per run;
+// TETCOLLAPSE_GUARD_DEBUG=1 also names each refused edge and what its new triangles hit.
 #include "collapse/guard_surface.hpp"
 
 #include <algorithm>
@@ -156,11 +157,13 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
       if (bad[q]) {
         int e = qe[q];
         std::fprintf(stderr, "  refused edge %d (%d, %d) dir %d:", e, ed[2 * e], ed[2 * e + 1], dr[e]);
-        if (bad[q] >= 2) {
+        if (bad[q] & 0x80000000u) {
+          int other = qe[bad[q] & 0x7fffffffu];
+          std::fprintf(stderr, " new triangles of edge %d (%d, %d) dir %d", other, ed[2 * other], ed[2 * other + 1],
+                       dr[other]);
+        } else if (bad[q] >= 2) {
           uint32_t t = (bad[q] - 2) / 4, f = (bad[q] - 2) % 4;
           std::fprintf(stderr, " face %u/%u = tet (%d %d %d %d)", t, f, tt[4 * t], tt[4 * t + 1], tt[4 * t + 2], tt[4 * t + 3]);
-        } else {
-          std::fprintf(stderr, " another collapse");
         }
         std::fprintf(stderr, "\n");
       }
