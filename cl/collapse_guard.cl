@@ -27,98 +27,11 @@
  * by the collapse and the face it is glued to through that tet is on the boundary or the two
  * tets' labels differ. The current S faces are tested in their current places, also those that
  * another chosen collapse moves (whose new triangles are tested too): that only refuses more.
- *
- * The triangle test is floating-point with a tolerance of 1e-9 times the triangles' size: a
- * contact within it counts, so rounding never hides a pair that intersects exactly (pairs
- * sharing an edge are not tested: they can only overlap when coplanar).
+ * The triangle test: cl/collapse_guard_geometry.h (floating point with a tolerance: rounding
+ * never hides a contact).
  */
 #include "collapse_common.h"
-
-/* 2D orientation of (a, b, c) in the plane of the two kept axes (drop = the dropped axis). */
-inline double2 tcc_sg_proj(double3 p, int drop) {
-  return drop == 0 ? (double2)(p.y, p.z) : drop == 1 ? (double2)(p.z, p.x) : (double2)(p.x, p.y);
-}
-inline int tcc_sg_orient2(double2 a, double2 b, double2 c) {
-  double l = (b.x - a.x) * (c.y - a.y), r = (b.y - a.y) * (c.x - a.x);
-  double det = l - r, eb = 4.0e-16 * (fabs(l) + fabs(r));
-  return det > eb ? 1 : det < -eb ? -1 : 0;
-}
-
-/* Do the closed 2D segments (p, q) and (u, w) meet (zero signs: touching)? */
-inline int tcc_sg_seg_seg2(double2 p, double2 q, double2 u, double2 w) {
-  int s1 = tcc_sg_orient2(p, q, u), s2 = tcc_sg_orient2(p, q, w);
-  int s3 = tcc_sg_orient2(u, w, p), s4 = tcc_sg_orient2(u, w, q);
-  if (s1 * s2 > 0 || s3 * s4 > 0) return 0;
-  if (s1 == 0 && s2 == 0 && s3 == 0 && s4 == 0) { /* collinear: do the intervals overlap? */
-    int ax = fabs(q.x - p.x) + fabs(w.x - u.x) >= fabs(q.y - p.y) + fabs(w.y - u.y);
-    double p0 = ax ? p.x : p.y, p1 = ax ? q.x : q.y, u0 = ax ? u.x : u.y, u1 = ax ? w.x : w.y;
-    return fmax(fmin(p0, p1), fmin(u0, u1)) <= fmin(fmax(p0, p1), fmax(u0, u1));
-  }
-  return 1;
-}
-
-/* Is 2D point p in triangle (a, b, c) grown by tol? */
-inline int tcc_sg_in_tri2_tol(double2 p, double2 a, double2 b, double2 c, double tol) {
-  double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
-  double sgn = area >= 0.0 ? 1.0 : -1.0;
-  double2 v[3] = {a, b, c};
-  for (int k = 0; k < 3; ++k) {
-    double2 u = v[k], w = v[(k + 1) % 3];
-    double ex = w.x - u.x, ey = w.y - u.y, len = sqrt(ex * ex + ey * ey);
-    if (sgn * (ex * (p.y - u.y) - ey * (p.x - u.x)) < -tol * len) return 0;
-  }
-  return 1;
-}
-
-/* Does the closed segment (p, q) meet the closed triangle (a, b, c), up to a distance of
- * 1e-9 times their size (so that rounding never hides a contact)? A segment within that
- * distance of the triangle's plane is tested in the plane; otherwise the point where it
- * crosses the plane is. */
-inline int tcc_sg_seg_tri(double3 p, double3 q, double3 a, double3 b, double3 c) {
-  double3 n = tcc_cross(b - a, c - a);
-  double ln = sqrt(tcc_dot(n, n));
-  if (!(ln > 0.0)) return 1; /* a degenerate triangle: cannot tell */
-  double3 ab = b - a, ac = c - a, bc = c - b, pq = q - p;
-  double size = sqrt(fmax(fmax(tcc_dot(ab, ab), tcc_dot(ac, ac)), fmax(tcc_dot(bc, bc), tcc_dot(pq, pq))));
-  double tol = 1e-9 * size;
-  double dp = tcc_dot(n, p - a) / ln, dq = tcc_dot(n, q - a) / ln; /* signed distances */
-  if ((dp > tol && dq > tol) || (dp < -tol && dq < -tol)) return 0;
-  double nx = fabs(n.x), ny = fabs(n.y), nz = fabs(n.z);
-  int drop = nx >= ny && nx >= nz ? 0 : ny >= nz ? 1 : 2;
-  double2 a2 = tcc_sg_proj(a, drop), b2 = tcc_sg_proj(b, drop), c2 = tcc_sg_proj(c, drop);
-  if (fabs(dp) <= tol && fabs(dq) <= tol) { /* in the plane: in 2D */
-    double2 p2 = tcc_sg_proj(p, drop), q2 = tcc_sg_proj(q, drop);
-    return tcc_sg_in_tri2_tol(p2, a2, b2, c2, tol) || tcc_sg_in_tri2_tol(q2, a2, b2, c2, tol) ||
-           tcc_sg_seg_seg2(p2, q2, a2, b2) || tcc_sg_seg_seg2(p2, q2, b2, c2) || tcc_sg_seg_seg2(p2, q2, c2, a2);
-  }
-  double t = dp / (dp - dq); /* dp != dq here */
-  t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-  return tcc_sg_in_tri2_tol(tcc_sg_proj(p + pq * t, drop), a2, b2, c2, tol);
-}
-
-/* Do triangles A and B (vertex ids ia, ib; positions pa, pb) intersect other than in what they
- * share? Sharing an edge (or all three vertices): not tested. Sharing one vertex s: they meet
- * elsewhere iff the edge opposite s of one meets the other. Sharing none: iff an edge of one
- * meets the other. */
-inline int tcc_sg_tri_tri(const int* ia, const double3* pa, const int* ib, const double3* pb) {
-  int sa = -1, sb = -1, shared = 0;
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (ia[i] == ib[j]) {
-        ++shared;
-        sa = i;
-        sb = j;
-      }
-  if (shared >= 2) return 0;
-  if (shared == 1)
-    return tcc_sg_seg_tri(pa[(sa + 1) % 3], pa[(sa + 2) % 3], pb[0], pb[1], pb[2]) ||
-           tcc_sg_seg_tri(pb[(sb + 1) % 3], pb[(sb + 2) % 3], pa[0], pa[1], pa[2]);
-  for (int i = 0; i < 3; ++i) {
-    if (tcc_sg_seg_tri(pa[i], pa[(i + 1) % 3], pb[0], pb[1], pb[2])) return 1;
-    if (tcc_sg_seg_tri(pb[i], pb[(i + 1) % 3], pa[0], pa[1], pa[2])) return 1;
-  }
-  return 0;
-}
+#include "collapse_guard_geometry.h"
 
 /* The collapse of edge e as chosen: x removed, y survives at *p; returns whether y moves. */
 inline int tcc_sg_collapse(int e, __global const int* edges, __global const uchar* dir, __global const double* pts,
@@ -305,7 +218,7 @@ __kernel void sguard_surface(uint nt, __global const int* edges, __global const 
               int id[3];
               double3 pos[3];
               tcc_sg_load_tri(tid, tpos, n, id, pos);
-              if (tcc_sg_boxes_apart(pos, fpos) || !tcc_sg_tri_tri(id, pos, fid, fpos)) continue;
+              if (tcc_sg_boxes_apart(pos, fpos) || !tc_sg_tri_tri(id, pos, fid, fpos)) continue;
               uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
               qbad[qi] = code < 0x7ffffffeu ? code + 2u : 1u;
               break;
@@ -335,7 +248,7 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
       int idb[3];
       double3 posb[3];
       tcc_sg_load_tri(tid, tpos, nb, idb, posb);
-      if (tcc_sg_boxes_apart(posa, posb) || !tcc_sg_tri_tri(ida, posa, idb, posb)) continue;
+      if (tcc_sg_boxes_apart(posa, posb) || !tc_sg_tri_tri(ida, posa, idb, posb)) continue;
       qbad[qa] = 0x80000000u | qa;
       return;
     }
@@ -358,7 +271,7 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
               int idb[3];
               double3 posb[3];
               tcc_sg_load_tri(tid, tpos, nb, idb, posb);
-              if (tcc_sg_boxes_apart(posa, posb) || !tcc_sg_tri_tri(ida, posa, idb, posb)) continue;
+              if (tcc_sg_boxes_apart(posa, posb) || !tc_sg_tri_tri(ida, posa, idb, posb)) continue;
               qbad[qa] = 0x80000000u | qb; /* names the other query for debugging */
               return;
             }

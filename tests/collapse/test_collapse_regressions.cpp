@@ -10,14 +10,56 @@
 // boundary intersects itself. The surface guard (cl/collapse_guard.cl) refuses such collapses.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <string>
 
+#include "collapse_guard_geometry.h"
 #include "geometry.h"
 #include "test_support.hpp"
 #include "tetcollapse/check.hpp"
 #include "tetcollapse/collapse.hpp"
 
 namespace {
+
+using tc::geo::tc_d3;
+
+// The guard's triangle test (cl/collapse_guard_geometry.h) on triangles with vertex ids.
+bool tri_tri(std::array<int, 3> ia, std::array<tc_d3, 3> pa, std::array<int, 3> ib, std::array<tc_d3, 3> pb) {
+  return tc::geo::tc_sg_tri_tri(ia.data(), pa.data(), ib.data(), pb.data()) != 0;
+}
+
+TEST(CollapseRegressions, TriangleTestOfTheGuard) {
+  const tc_d3 o{0, 0, 0}, x{1, 0, 0}, y{0, 1, 0};
+  // crossing, no shared vertex (both ways round)
+  EXPECT_TRUE(tri_tri({0, 1, 2}, {o, x, y}, {3, 4, 5}, {tc_d3{0.2, 0.2, -1}, tc_d3{0.2, 0.2, 1}, tc_d3{2, 2, 0.5}}));
+  EXPECT_TRUE(tri_tri({3, 4, 5}, {tc_d3{0.2, 0.2, -1}, tc_d3{0.2, 0.2, 1}, tc_d3{2, 2, 0.5}}, {0, 1, 2}, {o, x, y}));
+  // parallel planes 1e-3 apart: apart
+  EXPECT_FALSE(tri_tri({0, 1, 2}, {o, x, y}, {3, 4, 5}, {tc_d3{0, 0, 1e-3}, tc_d3{1, 0, 1e-3}, tc_d3{0, 1, 1e-3}}));
+  // a vertex of one exactly inside the other: touching counts
+  EXPECT_TRUE(tri_tri({0, 1, 2}, {o, x, y}, {3, 4, 5}, {tc_d3{0.2, 0.2, 0}, tc_d3{0.2, 0.2, 1}, tc_d3{1, 1, 1}}));
+  // coplanar in a tilted plane (rounding puts each a little off the other's plane; pairs like
+  // this were reported as crossing by a first, sign-filtered version): apart, and overlapping
+  const tc_d3 u{0.7277838, 0.6858065, 0}, w{0, 0, 1}, v{-0.6858065, 0.7277838, 0};
+  auto at = [&](double s, double t) { return tc_d3{3 * u.x + s * v.x + t * w.x, 3 * u.y + s * v.y + t * w.y, t}; };
+  EXPECT_FALSE(tri_tri({0, 1, 2}, {at(0, 0), at(0.05, 0.07), at(0.04, 0)}, {3, 4, 5},
+                       {at(0.1, 0), at(0.14, 0.07), at(0.15, 0.01)}));
+  EXPECT_TRUE(tri_tri({0, 1, 2}, {at(0, 0), at(0.05, 0.07), at(0.04, 0)}, {3, 4, 5},
+                      {at(0.03, 0.01), at(0.14, 0.07), at(0.15, 0.01)}));
+  // one shared vertex: a flat fan's two non-adjacent triangles are apart; folded over, not
+  EXPECT_FALSE(tri_tri({0, 1, 2}, {o, x, tc_d3{1, 1, 0}}, {0, 3, 4}, {o, tc_d3{-1, 1, 0}, tc_d3{-1, 0, 0}}));
+  EXPECT_TRUE(tri_tri({0, 1, 2}, {o, x, tc_d3{1, 1, 0}}, {0, 3, 4}, {o, tc_d3{1, 0.2, 0}, tc_d3{1, 0.6, 0}}));
+  EXPECT_FALSE(tri_tri({0, 1, 2}, {o, x, y}, {0, 3, 4}, {o, tc_d3{1, 0, 1}, tc_d3{0, 1, 1}}));  // a ridge
+  EXPECT_TRUE(tri_tri({0, 1, 2}, {o, x, y}, {0, 3, 4}, {o, tc_d3{0.5, 0.5, 1}, tc_d3{0.5, 0.5, -1}}));
+  // a shared edge is not tested
+  EXPECT_FALSE(tri_tri({0, 1, 2}, {o, x, y}, {0, 1, 3}, {o, x, tc_d3{0.2, 0.2, 0}}));
+  // cad_052: the hole-rim triangle (24, 1299, 23) after the ridge vertex between 24 and 23 was
+  // collapsed onto 23, against the boss-wall triangle (1333, 1329, 23) it crosses
+  const tc_d3 p24{0.89360733, 0.96118565, 0.41246214}, p23{0.92401485, 1.04185464, 0.41246214},
+      p1299{0.88995325, 0.98924029, 0.37904372}, p1333{0.90303744, 1.00326568, 0.3786471},
+      p1329{0.9023039, 1.00126319, 0.45252134};
+  EXPECT_TRUE(tri_tri({24, 1299, 23}, {p24, p1299, p23}, {1333, 1329, 23}, {p1333, p1329, p23}));
+  EXPECT_TRUE(tri_tri({24, 1299, 23}, {p24, p1299, p23}, {1333, 24, 1329}, {p1333, p24, p1329}));
+}
 
 // Adds tet (a, b, c, d) to m, positively oriented (b and c swapped when needed).
 void add_tet(tc::Mesh& m, int a, int b, int c, int d) {

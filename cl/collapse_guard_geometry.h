@@ -1,0 +1,121 @@
+/* Triangle-triangle test of the surface guard (cl/collapse_guard.cl), written once and compiled
+ * as OpenCL C and as C++ (namespace tc::geo, as geometry.h), so that the host (the sequential
+ * method, the tests) can run the very test the device runs.
+ *
+ * Floating point with a tolerance: a contact within 1e-9 times the triangles' size counts, so
+ * rounding never hides a pair that intersects exactly; the price is that triangles closer than
+ * that are reported too. Pairs sharing an edge are not tested (they can only overlap when
+ * coplanar, which the tets between them exclude in a valid mesh).
+ */
+#ifndef TETCOLLAPSE_COLLAPSE_GUARD_GEOMETRY_H
+#define TETCOLLAPSE_COLLAPSE_GUARD_GEOMETRY_H
+
+#include "geometry.h"
+
+#ifndef __OPENCL_C_VERSION__
+namespace tc::geo {
+#endif
+
+/* A point of a coordinate plane. */
+typedef struct {
+  double x, y;
+} tc_sg_d2;
+
+/* p in the plane of the two axes kept when axis `drop` is dropped. */
+TC_FN tc_sg_d2 tc_sg_proj(tc_d3 p, int drop) {
+  tc_sg_d2 r;
+  r.x = drop == 0 ? p.y : drop == 1 ? p.z : p.x;
+  r.y = drop == 0 ? p.z : drop == 1 ? p.x : p.y;
+  return r;
+}
+
+/* Sign of the 2D orientation of (a, b, c); 0 when rounding could change it. */
+TC_FN int tc_sg_orient2(tc_sg_d2 a, tc_sg_d2 b, tc_sg_d2 c) {
+  double l = (b.x - a.x) * (c.y - a.y), r = (b.y - a.y) * (c.x - a.x);
+  double det = l - r, eb = 4.0e-16 * (fabs(l) + fabs(r));
+  return det > eb ? 1 : det < -eb ? -1 : 0;
+}
+
+/* Do the closed 2D segments (p, q) and (u, w) meet (an uncertain sign counts as touching)? */
+TC_FN int tc_sg_seg_seg2(tc_sg_d2 p, tc_sg_d2 q, tc_sg_d2 u, tc_sg_d2 w) {
+  int s1 = tc_sg_orient2(p, q, u), s2 = tc_sg_orient2(p, q, w);
+  int s3 = tc_sg_orient2(u, w, p), s4 = tc_sg_orient2(u, w, q);
+  if (s1 * s2 > 0 || s3 * s4 > 0) return 0;
+  if (s1 == 0 && s2 == 0 && s3 == 0 && s4 == 0) { /* collinear: do the intervals overlap? */
+    int ax = fabs(q.x - p.x) + fabs(w.x - u.x) >= fabs(q.y - p.y) + fabs(w.y - u.y);
+    double p0 = ax ? p.x : p.y, p1 = ax ? q.x : q.y, u0 = ax ? u.x : u.y, u1 = ax ? w.x : w.y;
+    double plo = p0 < p1 ? p0 : p1, phi = p0 < p1 ? p1 : p0, ulo = u0 < u1 ? u0 : u1, uhi = u0 < u1 ? u1 : u0;
+    return (plo > ulo ? plo : ulo) <= (phi < uhi ? phi : uhi);
+  }
+  return 1;
+}
+
+/* Is 2D point p in triangle (a, b, c) grown by tol? */
+TC_FN int tc_sg_in_tri2(tc_sg_d2 p, tc_sg_d2 a, tc_sg_d2 b, tc_sg_d2 c, double tol) {
+  double area = (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+  double sgn = area >= 0.0 ? 1.0 : -1.0;
+  for (int k = 0; k < 3; ++k) {
+    tc_sg_d2 u = k == 0 ? a : k == 1 ? b : c, w = k == 0 ? b : k == 1 ? c : a;
+    double ex = w.x - u.x, ey = w.y - u.y, len = sqrt(ex * ex + ey * ey);
+    if (sgn * (ex * (p.y - u.y) - ey * (p.x - u.x)) < -tol * len) return 0;
+  }
+  return 1;
+}
+
+/* Does the closed segment (p, q) meet the closed triangle (a, b, c), up to 1e-9 times their
+ * size? A segment within that distance of the triangle's plane is tested in the plane (in 2D,
+ * the dominant axis of the normal dropped); otherwise the point where it crosses the plane. */
+TC_FN int tc_sg_seg_tri(tc_d3 p, tc_d3 q, tc_d3 a, tc_d3 b, tc_d3 c) {
+  tc_d3 ab = b - a, ac = c - a, bc = c - b, pq = q - p;
+  tc_d3 n = cross(ab, ac);
+  double ln = sqrt(dot(n, n));
+  if (!(ln > 0.0)) return 1; /* a degenerate triangle: cannot tell */
+  double s2 = dot(ab, ab), t2;
+  t2 = dot(ac, ac), s2 = s2 > t2 ? s2 : t2;
+  t2 = dot(bc, bc), s2 = s2 > t2 ? s2 : t2;
+  t2 = dot(pq, pq), s2 = s2 > t2 ? s2 : t2;
+  double tol = 1e-9 * sqrt(s2);
+  double dp = dot(n, p - a) / ln, dq = dot(n, q - a) / ln; /* signed distances to the plane */
+  if ((dp > tol && dq > tol) || (dp < -tol && dq < -tol)) return 0;
+  double nx = fabs(n.x), ny = fabs(n.y), nz = fabs(n.z);
+  int drop = nx >= ny && nx >= nz ? 0 : ny >= nz ? 1 : 2;
+  tc_sg_d2 a2 = tc_sg_proj(a, drop), b2 = tc_sg_proj(b, drop), c2 = tc_sg_proj(c, drop);
+  if (fabs(dp) <= tol && fabs(dq) <= tol) { /* in the plane */
+    tc_sg_d2 p2 = tc_sg_proj(p, drop), q2 = tc_sg_proj(q, drop);
+    return tc_sg_in_tri2(p2, a2, b2, c2, tol) || tc_sg_in_tri2(q2, a2, b2, c2, tol) ||
+           tc_sg_seg_seg2(p2, q2, a2, b2) || tc_sg_seg_seg2(p2, q2, b2, c2) || tc_sg_seg_seg2(p2, q2, c2, a2);
+  }
+  double t = dp / (dp - dq); /* dp != dq: they are not both within tol, nor on one side */
+  t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+  return tc_sg_in_tri2(tc_sg_proj(p + pq * t, drop), a2, b2, c2, tol);
+}
+
+/* Do triangles A and B (vertex ids ia, ib; positions pa, pb) intersect other than in what they
+ * share? Sharing an edge (or all three vertices): not tested. Sharing one vertex s: they meet
+ * elsewhere iff the edge opposite s of one meets the other. Sharing none: iff an edge of one
+ * meets the other. */
+TC_FN int tc_sg_tri_tri(const int* ia, const tc_d3* pa, const int* ib, const tc_d3* pb) {
+  int sa = -1, sb = -1, shared = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (ia[i] == ib[j]) {
+        ++shared;
+        sa = i;
+        sb = j;
+      }
+  if (shared >= 2) return 0;
+  if (shared == 1)
+    return tc_sg_seg_tri(pa[(sa + 1) % 3], pa[(sa + 2) % 3], pb[0], pb[1], pb[2]) ||
+           tc_sg_seg_tri(pb[(sb + 1) % 3], pb[(sb + 2) % 3], pa[0], pa[1], pa[2]);
+  for (int i = 0; i < 3; ++i) {
+    if (tc_sg_seg_tri(pa[i], pa[(i + 1) % 3], pb[0], pb[1], pb[2])) return 1;
+    if (tc_sg_seg_tri(pb[i], pb[(i + 1) % 3], pa[0], pa[1], pa[2])) return 1;
+  }
+  return 0;
+}
+
+#ifndef __OPENCL_C_VERSION__
+}  // namespace tc::geo
+#endif
+
+#endif
