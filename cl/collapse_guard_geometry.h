@@ -2,9 +2,11 @@
  * as OpenCL C and as C++ (namespace tc::geo, as geometry.h), so that the host (the sequential
  * method, the tests) can run the very test the device runs.
  *
- * Floating point with a tolerance: a contact within 1e-9 times the triangles' size counts, so
- * rounding never hides a pair that intersects exactly; the price is that triangles closer than
- * that are reported too. Pairs sharing an edge are not tested (they can only overlap when
+ * Floating point with a tolerance: every side / inside decision is made on a distance compared
+ * with 1e-9 times the triangles' size, and a contact within it counts, so rounding never hides
+ * a pair that intersects exactly (and flat faces of CAD models, whose points are coplanar and
+ * collinear only up to rounding, get consistent answers); the price is that triangles closer
+ * than that are reported too. Pairs sharing an edge are not tested (they can only overlap when
  * coplanar, which the tets between them exclude in a valid mesh).
  */
 #ifndef TETCOLLAPSE_COLLAPSE_GUARD_GEOMETRY_H
@@ -29,23 +31,26 @@ TC_FN tc_sg_d2 tc_sg_proj(tc_d3 p, int drop) {
   return r;
 }
 
-/* Sign of the 2D orientation of (a, b, c); 0 when rounding could change it. */
-TC_FN int tc_sg_orient2(tc_sg_d2 a, tc_sg_d2 b, tc_sg_d2 c) {
-  double l = (b.x - a.x) * (c.y - a.y), r = (b.y - a.y) * (c.x - a.x);
-  double det = l - r, eb = 4.0e-16 * (fabs(l) + fabs(r));
-  return det > eb ? 1 : det < -eb ? -1 : 0;
+/* Side of 2D point c of the line through a and b: 0 within distance tol, else -1 / 1. */
+TC_FN int tc_sg_side2(tc_sg_d2 a, tc_sg_d2 b, tc_sg_d2 c, double tol) {
+  double ex = b.x - a.x, ey = b.y - a.y, len = sqrt(ex * ex + ey * ey);
+  double det = ex * (c.y - a.y) - ey * (c.x - a.x); /* len x signed distance */
+  return det > tol * len ? 1 : det < -tol * len ? -1 : 0;
 }
 
-/* Do the closed 2D segments (p, q) and (u, w) meet (an uncertain sign counts as touching)? */
-TC_FN int tc_sg_seg_seg2(tc_sg_d2 p, tc_sg_d2 q, tc_sg_d2 u, tc_sg_d2 w) {
-  int s1 = tc_sg_orient2(p, q, u), s2 = tc_sg_orient2(p, q, w);
-  int s3 = tc_sg_orient2(u, w, p), s4 = tc_sg_orient2(u, w, q);
+/* Do the 2D segments (p, q) and (u, w) come within tol of crossing or overlapping? (Signs from
+ * distances, not from exact orientations: the points of a straight CAD edge, rounded, are
+ * collinear only up to rounding, and exact signs then disagree with each other.) */
+TC_FN int tc_sg_seg_seg2(tc_sg_d2 p, tc_sg_d2 q, tc_sg_d2 u, tc_sg_d2 w, double tol) {
+  int s1 = tc_sg_side2(p, q, u, tol), s2 = tc_sg_side2(p, q, w, tol);
+  int s3 = tc_sg_side2(u, w, p, tol), s4 = tc_sg_side2(u, w, q, tol);
   if (s1 * s2 > 0 || s3 * s4 > 0) return 0;
-  if (s1 == 0 && s2 == 0 && s3 == 0 && s4 == 0) { /* collinear: do the intervals overlap? */
-    int ax = fabs(q.x - p.x) + fabs(w.x - u.x) >= fabs(q.y - p.y) + fabs(w.y - u.y);
-    double p0 = ax ? p.x : p.y, p1 = ax ? q.x : q.y, u0 = ax ? u.x : u.y, u1 = ax ? w.x : w.y;
-    double plo = p0 < p1 ? p0 : p1, phi = p0 < p1 ? p1 : p0, ulo = u0 < u1 ? u0 : u1, uhi = u0 < u1 ? u1 : u0;
-    return (plo > ulo ? plo : ulo) <= (phi < uhi ? phi : uhi);
+  if ((s1 == 0 && s2 == 0) || (s3 == 0 && s4 == 0)) { /* collinear: do the intervals overlap? */
+    double dx = q.x - p.x, dy = q.y - p.y, len = sqrt(dx * dx + dy * dy);
+    if (!(len > 0.0)) return 1;
+    double tu = (dx * (u.x - p.x) + dy * (u.y - p.y)) / len, tw = (dx * (w.x - p.x) + dy * (w.y - p.y)) / len;
+    double lo = tu < tw ? tu : tw, hi = tu < tw ? tw : tu;
+    return lo <= len + tol && hi >= -tol;
   }
   return 1;
 }
@@ -83,7 +88,8 @@ TC_FN int tc_sg_seg_tri(tc_d3 p, tc_d3 q, tc_d3 a, tc_d3 b, tc_d3 c) {
   if (fabs(dp) <= tol && fabs(dq) <= tol) { /* in the plane */
     tc_sg_d2 p2 = tc_sg_proj(p, drop), q2 = tc_sg_proj(q, drop);
     return tc_sg_in_tri2(p2, a2, b2, c2, tol) || tc_sg_in_tri2(q2, a2, b2, c2, tol) ||
-           tc_sg_seg_seg2(p2, q2, a2, b2) || tc_sg_seg_seg2(p2, q2, b2, c2) || tc_sg_seg_seg2(p2, q2, c2, a2);
+           tc_sg_seg_seg2(p2, q2, a2, b2, tol) || tc_sg_seg_seg2(p2, q2, b2, c2, tol) ||
+           tc_sg_seg_seg2(p2, q2, c2, a2, tol);
   }
   double t = dp / (dp - dq); /* dp != dq: they are not both within tol, nor on one side */
   t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;

@@ -45,6 +45,16 @@ TEST(CollapseRegressions, TriangleTestOfTheGuard) {
                        {at(0.1, 0), at(0.14, 0.07), at(0.15, 0.01)}));
   EXPECT_TRUE(tri_tri({0, 1, 2}, {at(0, 0), at(0.05, 0.07), at(0.04, 0)}, {3, 4, 5},
                       {at(0.03, 0.01), at(0.14, 0.07), at(0.15, 0.01)}));
+  // coplanar (z exact), an edge of each on one straight line (up to rounding), apart along it:
+  // from multicomp_007, where exact signs of the rounded points disagreed
+  EXPECT_FALSE(tri_tri({13, 81, 72},
+                       {tc_d3{1.9376086433856654, 0.17976180263523509, 0.10107281077289502},
+                        tc_d3{1.7913260503699655, 0.17976180263523509, 0.10107281077289502},
+                        tc_d3{1.8834299052317025, 0.2608242322440436, 0.10107281077289502}},
+                       {73, 80, 74},
+                       {tc_d3{1.8292511670777396, 0.3418866618528522, 0.10107281077289502},
+                        tc_d3{1.645043457354266, 0.17976180263523509, 0.10107281077289502},
+                        tc_d3{1.7750724289237767, 0.4229490914616607, 0.10107281077289502}}));
   // one shared vertex: a flat fan's two non-adjacent triangles are apart; folded over, not
   EXPECT_FALSE(tri_tri({0, 1, 2}, {o, x, tc_d3{1, 1, 0}}, {0, 3, 4}, {o, tc_d3{-1, 1, 0}, tc_d3{-1, 0, 0}}));
   EXPECT_TRUE(tri_tri({0, 1, 2}, {o, x, tc_d3{1, 1, 0}}, {0, 3, 4}, {o, tc_d3{1, 0.2, 0}, tc_d3{1, 0.6, 0}}));
