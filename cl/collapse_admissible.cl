@@ -41,7 +41,8 @@ inline int tcc_ring_has(__global const int* tets, __global const uint* vt_off, _
 /* The link condition and the volume test of the edge (a, b), a < b, which passed Q with the
  * direction bits dir; returns TCC_OK or the refusal (TCC_REFUSED_LINK / TCC_REFUSED_VOLUME). */
 inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int dir, __global const int* tets,
-                                 __global const uint* vt_off, __global const int* vt, __global const uint* nb_off,
+                                 __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
+                                 __global const uint* nb_off,
                                  __global const int* nb, __global const int* nb_edge, __global const int* labels,
                                  int use_labels, __global const double* pts, __global const uchar* vflags,
                                  __global const uchar* eflags, double eps_v,
@@ -109,17 +110,23 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
     for (int k = 0; k < 3 && ok; ++k) {
       if (!inside[pairs[k][0]] || !inside[pairs[k][1]]) continue;
       int c = o[pairs[k][0]], d = o[pairs[k][1]];
-      if (!tcc_ring_has(tets, vt_off, vt, b, c, d, -1)) continue; /* (b,c,d) is no triangle */
       int in_lk = 0;
       for (int m = 0; m < np; ++m)
         if ((pc[m] == c && pd[m] == d) || (pc[m] == d && pd[m] == c)) in_lk = 1;
       if (!in_lk) {
-        ok = 0;
-        break;
+        /* (ii) triangles (a,c,d) and (b,c,d) need the tet (a,b,c,d) */
+        if (tcc_ring_has(tets, vt_off, vt, b, c, d, -1)) ok = 0;
+        continue;
       }
-      if (tcc_triangle_kind(tets, vt_off, vt, labels, use_labels, a, c, d) &&
-          tcc_triangle_kind(tets, vt_off, vt, labels, use_labels, b, c, d))
-        ok = 0;
+      /* (c,d) in lk(ab): (b,c,d) is a face of the tet (a,b,c,d). (iii) no S-faces (a,c,d) and
+       * (b,c,d); an S-face has S vertices only. (a,c,d) is the face of t opposite its fourth
+       * vertex: S when no tet or several are across it, or a tet of another label. */
+      if (!(fa & smask) || !(fb & smask)) continue;
+      int z = 0;
+      while (q[z] == a || q[z] == c || q[z] == d) ++z;
+      int across = tet_nbr[4 * t + z];
+      int acd_on_s = across < 0 || (use_labels && labels[t] != labels[across]);
+      if (acd_on_s && tcc_triangle_kind(tets, vt_off, vt, labels, use_labels, b, c, d)) ok = 0;
     }
   }
   if (!ok) return TCC_REFUSED_LINK;
@@ -155,7 +162,8 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
 }
 
 __kernel void admissible(uint ne, __global const int* edges, __global const uint* marked, __global const int* tets,
-                         __global const uint* vt_off, __global const int* vt, __global const uint* nb_off,
+                         __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
+                         __global const uint* nb_off,
                          __global const int* nb, __global const int* nb_edge, __global const int* labels,
                          int use_labels, __global const double* pts, __global const uchar* vflags,
                          __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
@@ -176,7 +184,7 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
     reason[e] = TCC_REFUSED_Q;
     return;
   }
-  uchar r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, nb_off, nb, nb_edge, labels, use_labels, pts,
+  uchar r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts,
                                 vflags, eflags, eps_v, q_min);
   reason[e] = r;
   if (r != TCC_OK) return;
@@ -232,7 +240,8 @@ __kernel void lazy_pass1_decide(uint n, int first, __global const uint* list, __
                                 __global uint* next_n, __global const uint* cand, __global const int* edges,
                                 __global const int* slot, __global int* slot_next, __global uchar* state,
                                 __global int* vaff, __global const int* tets, __global const uint* vt_off,
-                                __global const int* vt, __global const uint* nb_off, __global const int* nb,
+                                __global const int* vt, __global const int* tet_nbr, __global const uint* nb_off,
+                                __global const int* nb,
                                 __global const int* nb_edge, __global const int* labels, int use_labels,
                                 __global const double* pts, __global const uchar* vflags,
                                 __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
@@ -248,7 +257,7 @@ __kernel void lazy_pass1_decide(uint n, int first, __global const uint* list, __
   /* a verdict carried from an earlier iteration (the rings of a and b are unchanged since) */
   uchar r = verdict[e];
   if (r == TCC_VERDICT_UNKNOWN) {
-    r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, nb_off, nb, nb_edge, labels, use_labels, pts,
+    r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts,
                             vflags, eflags, eps_v, q_min);
     verdict[e] = r;
     atomic_inc(&counters[4]);

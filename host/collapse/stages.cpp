@@ -323,7 +323,7 @@ uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
   ensure(s.reason, ctx, c.ne);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   run(ctx, "collapse_admissible.cl", "admissible", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(dm.tets),
-      B(c.vt_off), B(c.vt), B(c.nb_off), B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points),
+      B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points),
       B(c.vflags), B(c.vclass), B(c.eflags), I(p.mode), I(p.paper_rule ? 1 : 0), p.eps_v, p.min_quality, B(s.adm), B(s.dir),
       B(s.reason), B(s.counters));
   return counter(s, 1);
@@ -457,7 +457,8 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   ensure(s.cand_edges, ctx, c.ne);
   const uint32_t n = dev::compact_indices(ctx, s.cand, s.cand_edges, c.ne);
   cl::Kernel decide = ctx.kernel(A, "lazy_pass1_decide");
-  set_args_from(decide, kDecideArgs, "lazy_pass1_decide", B(dm.tets), B(c.vt_off), B(c.vt), B(c.nb_off), B(c.nb),
+  set_args_from(decide, kDecideArgs, "lazy_pass1_decide", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off),
+                B(c.nb),
                 B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass), B(c.eflags), mode,
                 paper_rule, p.eps_v, p.min_quality, B(s.dir), B(s.reason), B(s.counters), B(s.verdict));
   pass1_rounds(ctx, decide, s, c, dm.nv, n, "lazy_pass1_decide");
