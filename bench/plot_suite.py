@@ -260,7 +260,7 @@ def markdown(r):
 
     if "table2" in parts:
         t = parts["table2"]["data"]
-        out += ["#### Table 2: W1, robot 514k to 2 x median edge length, eps_c 0", ""]
+        out += [f"#### Table 2: {t['mesh']} to 2 x median edge length, eps_c 0", ""]
         if t.get("status") != "ok":
             out += [f"skipped ({t.get('message')})", ""]
         else:
@@ -292,7 +292,7 @@ def markdown(r):
 
     if "fig9" in parts:
         m = parts["fig9"]["data"]
-        out += ["#### Fig. 9: W1 with eps_c (ours)", ""]
+        out += [f"#### Fig. 9: {m['mesh']} to 2 x median edge length, eps_c swept (ours)", ""]
         if m.get("status") != "ok":
             out += [f"skipped ({m.get('message')})", ""]
         else:

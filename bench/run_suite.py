@@ -120,7 +120,7 @@ def mem_total_gib():
 def git_info():
     def git(*args):
         p = subprocess.run(["git", "-C", ROOT, *args], capture_output=True, text=True)
-        return p.stdout.strip() if p.returncode == 0 else None
+        return p.stdout.rstrip("\n") if p.returncode == 0 else None  # keep the leading blank of "git status"
     status = git("status", "--porcelain", "--untracked-files=no", "--", "host", "cl", "include", "CMakeLists.txt")
     # other people's uncommitted edits in the source folders end up in the binary: say which
     return {"commit": git("rev-parse", "HEAD"), "describe": git("log", "-1", "--format=%h %s"),
@@ -590,7 +590,8 @@ def main():
     result = {
         "suite": "tetcollapse benchmark suite, issue 6 (paper section 4: Fig. 7, Fig. 8, Table 2, Fig. 9)",
         "label": a.label,
-        "note": ("SMOKE RUN (--quick): 1 repetition, subset of meshes; not a measurement to quote"
+        "note": (f"SMOKE RUN: {a.reps} repetition(s), meshes {sorted(set(a.fig7_meshes + a.fig8_meshes + [a.w1_mesh]))}; "
+                 "a test of the scripts, not a measurement to quote"
                  if a.label == "smoke" else "medians of repeated runs; ratios within this run"),
         "command": " ".join([os.path.relpath(sys.argv[0], ROOT)] + sys.argv[1:]),
         "date_utc": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
