@@ -145,6 +145,7 @@ bool SequentialRun::step() {
     }
     target_ = o_.target_factor * report_.median_edge_length;
   }
+  if (it_ == 0) sm_.build_guard(target_);
   // marking, Q, link and volume; the admissible edges into the queue
   const bool reuse = o_.reuse_across_iterations;
   const uint32_t prev = uint32_t(it_);  // touched_ value of the previous iteration (0: the input)
@@ -192,6 +193,12 @@ bool SequentialRun::step() {
       const int d = sm_.predicate(e.a, e.b, fe);
       if (d < 0 || !sm_.admissible(e.a, e.b, fe, d)) continue;
       dir = uint8_t(d);
+    }
+    if (!sm_.guard_ok(e.a, e.b, dir)) {
+      // refused by the surface guard, which looks beyond the star: its end points count as
+      // touched, so the edge is tested again next iteration (S nearby may have moved away)
+      touched_[e.a] = touched_[e.b] = cur;
+      continue;
     }
     sm_.collapse(e.a, e.b, dir);
     ++s.collapsed;

@@ -2,10 +2,12 @@
 #include "collapse/sequential_mesh.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <string>
 
 #include "collapse/stages.hpp"  // collapse_detail::Reason
+#include "collapse_guard_geometry.h"  // tc::geo::tc_sg_tri_tri, the device guard's own test
 #include "collapse_predicate.h"
 #include "tetcollapse/error.hpp"
 
@@ -27,6 +29,25 @@ tc_d3 face_normal(const std::vector<double>& pts, const int32_t* q, int f) {
   tc_d3 p1 = geo::tc_point(pts.data(), q[geo::TC_TET_FACES[f][1]]);
   tc_d3 p2 = geo::tc_point(pts.data(), q[geo::TC_TET_FACES[f][2]]);
   return geo::normalize(geo::cross(p1 - p0, p2 - p0));
+}
+
+// Bounding box of a triangle, and whether two are apart (tcc_sg_boxes_apart of the guard).
+// (std::min / max rather than fmin / fmax: they differ only for NaN coordinates)
+void box_of(const tc_d3* p, tc_d3& lo, tc_d3& hi) {
+  lo = hi = p[0];
+  for (int k = 1; k < 3; ++k) {
+    lo = {std::min(lo.x, p[k].x), std::min(lo.y, p[k].y), std::min(lo.z, p[k].z)};
+    hi = {std::max(hi.x, p[k].x), std::max(hi.y, p[k].y), std::max(hi.z, p[k].z)};
+  }
+}
+bool boxes_apart(const tc_d3& alo, const tc_d3& ahi, const tc_d3& blo, const tc_d3& bhi) {
+  return alo.x > bhi.x || alo.y > bhi.y || alo.z > bhi.z || blo.x > ahi.x || blo.y > ahi.y || blo.z > ahi.z;
+}
+bool boxes_apart(const tc_d3* a, const tc_d3* b) {
+  tc_d3 alo, ahi, blo, bhi;
+  box_of(a, alo, ahi);
+  box_of(b, blo, bhi);
+  return boxes_apart(alo, ahi, blo, bhi);
 }
 
 // Does the face of q opposite local vertex f run from x to y (x, y consecutive in its order)?
@@ -594,6 +615,15 @@ int32_t SeqMesh::collapse(int32_t a, int32_t b, uint8_t dir) {
   if (on_s)
     for (int32_t u : touched_)
       if (valive_[u] && (vflags_[u] || u == s)) classify(u, vflags_[u], vclass_[u]);
+  // the S faces that changed (moved, renamed, or owned by another tet now) all contain s
+  if (on_s && guard_on_) {
+    const int32_t* rs = ring(s);
+    for (uint32_t i = 0; i < rlen_[s]; ++i) {
+      const int32_t* q = tet(rs[i]);
+      for (int f = 0; f < 4; ++f)
+        if (q[f] != s && owned_sface(rs[i], f)) guard_insert(rs[i], f);
+    }
+  }
   return s;
 }
 
@@ -655,6 +685,193 @@ void SeqMesh::compact(std::vector<int32_t>& vmap, std::vector<int32_t>& kept) {
   mark_.resize(n);  // stale stamps are all older than the next one
   lmark_.resize(n);
   rebuild_rings();
+  if (guard_on_) build_guard(guard_h_req_);
+}
+
+// --- surface guard ---
+
+int32_t SeqMesh::across(int32_t t, int f) const {
+  const int32_t* q = tet(t);
+  int32_t p[3];
+  int n = 0;
+  for (int j = 0; j < 4; ++j)
+    if (j != f) p[n++] = q[j];
+  int count = 0;
+  int32_t other = -1;
+  const int32_t* r = ring(p[0]);  // every tet of the face contains p[0]
+  for (uint32_t i = 0; i < rlen_[p[0]]; ++i) {
+    const int32_t u = r[i];
+    if (u != t && has(tet(u), p[1]) && has(tet(u), p[2])) {
+      if (count == 0) other = u;
+      ++count;
+    }
+  }
+  return count == 0 ? -1 : count == 1 ? other : -2;
+}
+
+uint8_t SeqMesh::owned_sface(int32_t t, int f) const {
+  const int32_t o = across(t, f);
+  if (o < 0) return TCC_BOUNDARY;
+  if (labels_ && label(t) != label(o)) return label(t) < label(o) ? TCC_INTERFACE : 0;
+  return 0;
+}
+
+void SeqMesh::guard_cells(const tc_d3* p, int (&lo)[3], int (&hi)[3]) const {
+  tc_d3 blo, bhi;
+  box_of(p, blo, bhi);
+  const double l[3] = {blo.x, blo.y, blo.z}, h[3] = {bhi.x, bhi.y, bhi.z}, o[3] = {guard_org_.x, guard_org_.y, guard_org_.z};
+  for (int c = 0; c < 3; ++c) {
+    auto cell = [&](double v) {
+      const double x = std::floor((v - o[c]) / guard_h_);
+      return !(x > 0.0) ? 0 : x >= double(guard_dim_[c]) ? guard_dim_[c] - 1 : int(x);
+    };
+    lo[c] = cell(l[c]);
+    hi[c] = cell(h[c]);
+  }
+}
+
+void SeqMesh::guard_insert(int32_t t, int f) {
+  const int32_t* q = tet(t);
+  const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]),
+                      point(q[geo::TC_TET_FACES[f][2]])};
+  int lo[3], hi[3];
+  guard_cells(p, lo, hi);
+  for (int k = lo[2]; k <= hi[2]; ++k)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int i = lo[0]; i <= hi[0]; ++i) cells_[guard_key(i, j, k)].push_back(4 * t + f);
+}
+
+void SeqMesh::build_guard(double h) {
+  guard_on_ = true;
+  guard_h_req_ = h;
+  cells_.clear();
+  gseen_.assign(4 * size_t(nt_), 0);
+  gstamp_ = 0;
+  // the S faces (all three vertices on S, owned), their mean extent and the bounding box
+  std::vector<int32_t> faces;
+  double extent = 0;
+  tc_d3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+  for (int32_t v = 0; v < nv_; ++v) {
+    if (!valive_[v]) continue;
+    const tc_d3 p = point(v);
+    lo = {std::fmin(lo.x, p.x), std::fmin(lo.y, p.y), std::fmin(lo.z, p.z)};
+    hi = {std::fmax(hi.x, p.x), std::fmax(hi.y, p.y), std::fmax(hi.z, p.z)};
+  }
+  for (int32_t t = 0; t < nt_; ++t) {
+    if (!talive_[t]) continue;
+    const int32_t* q = tet(t);
+    for (int f = 0; f < 4; ++f) {
+      bool all_s = true;
+      for (int j = 0; j < 4 && all_s; ++j) all_s = j == f || vflags_[q[j]] != 0;
+      if (!all_s || !owned_sface(t, f)) continue;
+      faces.push_back(4 * t + f);
+      const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]),
+                          point(q[geo::TC_TET_FACES[f][2]])};
+      tc_d3 flo, fhi;
+      box_of(p, flo, fhi);
+      extent += std::fmax(fhi.x - flo.x, std::fmax(fhi.y - flo.y, fhi.z - flo.z));
+    }
+  }
+  guard_h_ = faces.empty() ? h : extent / double(faces.size());  // a few S faces per cell
+  const double span = std::fmax(hi.x - lo.x, std::fmax(hi.y - lo.y, hi.z - lo.z));
+  if (!(guard_h_ > 0) || !std::isfinite(guard_h_)) guard_h_ = std::isfinite(span) && span > 0 ? span : 1.0;
+  guard_h_ = std::fmax(guard_h_, span / double(1 << 20));  // cell coordinates fit 21 bits
+  guard_org_ = std::isfinite(lo.x) ? lo : tc_d3{0, 0, 0};
+  const double d[3] = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
+  for (int c = 0; c < 3; ++c)
+    guard_dim_[c] = std::isfinite(d[c]) ? std::max(1, std::min(1 << 20, int(std::floor(d[c] / guard_h_)) + 1)) : 1;
+  for (int32_t e : faces) guard_insert(e >> 2, e & 3);
+}
+
+bool SeqMesh::guard_ok(int32_t a, int32_t b, uint8_t dir) {
+  if (!guard_on_) return true;
+  if (a > b) std::swap(a, b);
+  const bool remove_b = (dir & TCC_DIR_REMOVE_V1) != 0;
+  const int32_t x = remove_b ? b : a, y = remove_b ? a : b;
+  const tc_d3 p = placement(a, b, dir), py = point(y);
+  const bool moves_y = !(py.x == p.x && py.y == p.y && py.z == p.z);
+  if (!vflags_[x] && !(moves_y && vflags_[y])) return true;  // S is not touched
+  // the new S triangles (tcc_sg_new_tri)
+  newtris_.clear();
+  for (int side = 0; side < 2; ++side) {
+    const int32_t z = side == 0 ? x : y, w = side == 0 ? y : x;
+    const int32_t* rz = ring(z);
+    for (uint32_t i = 0; i < rlen_[z]; ++i) {
+      const int32_t t = rz[i];
+      const int32_t* q = tet(t);
+      if (has(q, w)) continue;  // removed by the collapse, or seen from ring(x)
+      for (int f = 0; f < 4; ++f) {
+        if (q[f] == z) continue;  // the face opposite z does not contain it
+        // a face taken below is on S now, or glued to one through a removed tet: either way its
+        // two vertices other than z are on S now (cheap, and it spares most ring scans)
+        bool others_on_s = true;
+        for (int j = 0; j < 4 && others_on_s; ++j) others_on_s = j == f || q[j] == z || vflags_[q[j]] != 0;
+        if (!others_on_s) continue;
+        const int32_t o = across(t, f);
+        bool take;
+        if (o >= 0 && has(tet(o), x) && has(tet(o), y)) {  // glued through the removed tet o
+          const int32_t ac = across(o, local(tet(o), z));
+          take = ac < 0 || (labels_ && label(t) != label(ac));
+        } else {
+          if (side == 1 && !moves_y) continue;  // unchanged
+          take = o < 0 || (labels_ && label(t) != label(o));
+        }
+        if (!take) continue;
+        NewTri nt;
+        for (int k = 0; k < 3; ++k) {
+          int32_t v = q[geo::TC_TET_FACES[f][k]];
+          if (v == x) v = y;
+          nt.id[k] = v;
+          nt.pos[k] = v == y ? p : point(v);
+        }
+        newtris_.push_back(nt);
+      }
+    }
+  }
+  // among themselves (S folded over itself around y)
+  for (size_t i = 0; i < newtris_.size(); ++i)
+    for (size_t j = i + 1; j < newtris_.size(); ++j)
+      if (!boxes_apart(newtris_[i].pos, newtris_[j].pos) &&
+          geo::tc_sg_tri_tri(newtris_[i].id, newtris_[i].pos, newtris_[j].id, newtris_[j].pos))
+        return false;
+  // against the current S faces near them, but those the collapse moves or removes
+  for (const NewTri& nt : newtris_) {
+    if (++gstamp_ == 0) {
+      std::fill(gseen_.begin(), gseen_.end(), 0u);
+      gstamp_ = 1;
+    }
+    tc_d3 nlo, nhi;
+    box_of(nt.pos, nlo, nhi);
+    int lo[3], hi[3];
+    guard_cells(nt.pos, lo, hi);
+    for (int k = lo[2]; k <= hi[2]; ++k)
+      for (int j = lo[1]; j <= hi[1]; ++j)
+        for (int i = lo[0]; i <= hi[0]; ++i) {
+          auto it = cells_.find(guard_key(i, j, k));
+          if (it == cells_.end()) continue;
+          for (int32_t e : it->second) {
+            if (gseen_[e] == gstamp_) continue;
+            gseen_[e] = gstamp_;
+            const int32_t t = e >> 2;
+            const int f = e & 3;
+            if (!talive_[t]) continue;
+            const int32_t* q = tet(t);
+            int32_t fid[3];
+            bool replaced = false;
+            for (int c = 0; c < 3; ++c) {
+              fid[c] = q[geo::TC_TET_FACES[f][c]];
+              replaced = replaced || fid[c] == x || (moves_y && fid[c] == y);
+            }
+            if (replaced) continue;  // a face the collapse moves or removes
+            const tc_d3 fpos[3] = {point(fid[0]), point(fid[1]), point(fid[2])};
+            tc_d3 flo, fhi;
+            box_of(fpos, flo, fhi);
+            if (boxes_apart(nlo, nhi, flo, fhi) || !owned_sface(t, f)) continue;
+            if (geo::tc_sg_tri_tri(nt.id, nt.pos, fid, fpos)) return false;
+          }
+        }
+  }
+  return true;
 }
 
 }  // namespace tc::sequential_detail

@@ -25,6 +25,7 @@
 #pragma once
 
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "geometry.h"
@@ -95,6 +96,16 @@ class SeqMesh {
   // flags or class differ (0 when the incremental updates are right).
   int64_t verify_classes();
 
+  // Surface guard (the device's: cl/collapse_guard.cl). build_guard() indexes the current
+  // S faces in a hash grid of cells of the mean extent of an S face (h when there is none);
+  // collapses keep it current and compact() rebuilds it. guard_ok() tells whether the collapse
+  // of (a, b) in direction dir keeps S free of self-intersections: its new S triangles (those
+  // of tcc_sg_new_tri) against every current S face it does not replace, and among themselves,
+  // with the device's triangle test (cl/collapse_guard_geometry.h).
+  // Before build_guard() every collapse passes.
+  void build_guard(double h);
+  bool guard_ok(int32_t a, int32_t b, uint8_t dir);
+
  private:
   struct FaceAt {  // a face through v: tet t, local face f (opposite vertex f), key y << 32 | z of
     uint64_t key;   // its other vertices y < z
@@ -126,6 +137,11 @@ class SeqMesh {
   void classify(int32_t v, uint8_t& flags, uint8_t& cls);
   bool ring_has(int32_t x, int32_t y, int32_t z, int32_t w) const;
   uint8_t triangle_kind(int32_t x, int32_t y, int32_t z) const;
+  int32_t across(int32_t t, int f) const;      // tet_nbr: -1 none, -2 several, else the tet
+  uint8_t owned_sface(int32_t t, int f) const;  // tcc_owned_sface
+  void guard_insert(int32_t t, int f);
+  void guard_cells(const geo::tc_d3* p, int (&lo)[3], int (&hi)[3]) const;
+  uint64_t guard_key(int i, int j, int k) const { return (uint64_t(k) << 42) | (uint64_t(j) << 21) | uint64_t(i); }
   bool link_ok(int32_t a, int32_t b, uint8_t fe);
   uint8_t volume_and_quality(int32_t a, int32_t b, int dir) const;
   geo::tc_d3 placement(int32_t a, int32_t b, unsigned dir) const;
@@ -151,6 +167,20 @@ class SeqMesh {
   uint32_t stamp_ = 0;
   std::vector<int32_t> cn_, pc_, pd_, rr_, touched_, tab_;
   std::vector<FaceAt> faces_;
+  // surface guard: cells of the grid -> S faces (4 t + f) registered there, possibly stale
+  // (a dead tet, a face no longer on S, or one registered again after it moved): checked on use
+  struct NewTri {
+    int32_t id[3];
+    geo::tc_d3 pos[3];
+  };
+  bool guard_on_ = false;
+  double guard_h_req_ = 0, guard_h_ = 1;
+  geo::tc_d3 guard_org_{0, 0, 0};
+  int guard_dim_[3] = {1, 1, 1};
+  std::unordered_map<uint64_t, std::vector<int32_t>> cells_;
+  std::vector<uint32_t> gseen_;
+  uint32_t gstamp_ = 0;
+  std::vector<NewTri> newtris_;
   std::vector<SFace> sfaces_;
   std::vector<int32_t> us_;
 };

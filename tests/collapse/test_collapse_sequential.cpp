@@ -454,6 +454,65 @@ TEST(SequentialCollapse, StopRuleAndIterationLimit) {
   EXPECT_EQ(m.tets, in.tets);
 }
 
+// --- the surface guard (as tests/collapse/test_collapse_regressions.cpp for the device) ---
+
+namespace {
+
+void add_tet(Mesh& m, int a, int b, int c, int d) {
+  auto p = [&](int i) { return geo::tc_point(m.points.data(), i); };
+  if (geo::tc_orient3d(p(a), p(b), p(c), p(d)) < 0) std::swap(b, c);
+  m.tets.insert(m.tets.end(), {a, b, c, d});
+}
+
+// Four tets under a square whose top is a shallow dimple (v4, a face vertex: its only collapses
+// flatten the top to z = 0), and optionally a tet standing on its tip in the dimple's void,
+// below z = 0: flattening would push the top through it.
+Mesh dimple_and_tip(bool with_b, double lift = 0) {
+  Mesh m;
+  m.points = {-1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0, 0, 0, -0.05, 0, 0, -1};
+  for (int i = 0; i < 4; ++i) add_tet(m, 4, i, (i + 1) % 4, 5);
+  if (with_b) {
+    m.points.insert(m.points.end(), {0.2, 0.1, -0.02 + lift, 0.7, 0.1, 0.5 + lift, -0.1, 0.6, 0.5 + lift, -0.1, -0.4,
+                                     0.5 + lift});
+    add_tet(m, 6, 7, 8, 9);
+  }
+  return m;
+}
+
+}  // namespace
+
+TEST(SequentialGuard, FlatteningDoesNotPushTheSurfaceIntoAnotherBody) {
+  CollapseOptions o;
+  o.target_length = 10;  // every edge is marked
+  for (double q : {0.1, 0.0}) {
+    o.min_quality = q;
+    // alone, the dimple is flattened; with the tip in its void it is not; with the tip lifted
+    // clear of z = 0 it is again
+    for (int c = 0; c < 3; ++c) {
+      const Mesh in = c == 0 ? dimple_and_tip(false) : dimple_and_tip(true, c == 2 ? 0.03 : 0.0);
+      ASSERT_TRUE(check(in, in).valid);
+      Mesh out = in;
+      collapse_sequential(out, o);
+      EXPECT_EQ(out.num_vertices(), in.num_vertices() - (c == 1 ? 0 : 1)) << "case " << c << " qmin " << q;
+      CheckReport r = check(out, in);
+      EXPECT_TRUE(r.valid) << "case " << c << "\n" << check_report_text(r);
+    }
+  }
+  // the guard is what refuses it: the local checks admit the collapse
+  Mesh in = dimple_and_tip(true);
+  SeqMesh sm(in, seq_params_from(o));
+  std::vector<std::pair<int32_t, uint8_t>> admitted;
+  for (int32_t c = 0; c < 4; ++c) {
+    const Verdict v = sm.check(c, 4);
+    if (v.reason != kOk) continue;
+    admitted.push_back({c, v.dir});
+    EXPECT_TRUE(sm.guard_ok(c, 4, v.dir)) << "no guard yet";
+  }
+  EXPECT_FALSE(admitted.empty());
+  sm.build_guard(0.1);
+  for (auto [c, dir] : admitted) EXPECT_FALSE(sm.guard_ok(c, 4, dir)) << "corner " << c;
+}
+
 // --- refusals ---
 
 TEST(SequentialCollapse, CornersAreNeverRemoved) {
