@@ -12,7 +12,9 @@
 //   * Q is cl/collapse_predicate.h itself (compiled as C++); the link condition with the
 //     virtual vertex, the volume test and the quality guard follow tcc_link_and_volume
 //     (cl/collapse_admissible.cl) step by step, including its list limits (TCC_MAX_LINK);
-//   * geometry from cl/geometry.h (tc::geo).
+//   * geometry from cl/geometry.h (tc::geo);
+//   * the surface guard of cl/collapse_guard.cl (guard_ok), with its triangle test
+//     (cl/collapse_guard_geometry.h) and its choice of the new S triangles.
 //
 // Keeping the classes current. A collapse r -> s changes only faces through s (renamed from r,
 // glued where a tet of the edge disappears, or moved with s), so the flags and classes that can

@@ -9,8 +9,11 @@
 //   2. pop the queue until empty. An edge whose star an earlier collapse of this iteration
 //      changed (an end point in touched()) is checked again on the current mesh: still an edge,
 //      still marked, and every check passes with the current classes; an edge whose cost changed
-//      (an end point moved) goes back into the queue with its new cost. The others collapse
-//      with the verdict of step 1, which still holds since nothing they depend on changed;
+//      (an end point moved) goes back into the queue with its new cost. The others keep the
+//      verdict of step 1, which still holds since nothing they depend on changed. Last, the
+//      surface guard of the parallel pipeline (SeqMesh::guard_ok, cl/collapse_guard.cl), which
+//      looks beyond the star: a collapse whose new S triangles would cross S is refused (its end
+//      points then count as touched, so the edge is tested again next iteration);
 //   3. the dead vertices and tets are dropped from the arrays (order kept).
 // Iterations repeat until one collapses fewer than max(eps_c, 1) edges, or max_iterations.
 // Edges created by a collapse (the removed vertex's edges, now at the survivor) wait for the
