@@ -310,6 +310,10 @@ __kernel void conn_edge_flags(uint ne, __global const int* edges, __global const
   uint e = get_global_id(0);
   if (e >= ne) return;
   int a = edges[2 * e], b = edges[2 * e + 1];
+  if (!vflags[a] || !vflags[b]) { /* an S-edge joins two S vertices (most edges: checked first) */
+    eflags[e] = 0;
+    return;
+  }
   if (carry && !ndirty[a]) { /* ring(a), which decides the flags, is unchanged */
     int eo = tcc_edge_id(prev_nb_off, prev_nb, prev_nb_edge, vold[a], vold[b]);
     if (eo >= 0) {
@@ -318,10 +322,6 @@ __kernel void conn_edge_flags(uint ne, __global const int* edges, __global const
     }
   }
   uint flags = 0;
-  if (!vflags[a] || !vflags[b]) { /* an S-edge joins two S vertices */
-    eflags[e] = 0;
-    return;
-  }
   int ns = 0;
   int ft[2], ff[2];
   for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {

@@ -7,6 +7,7 @@
 #include "collapse/guard_surface.hpp"
 #include "collapse/stages.hpp"
 #include "tetcollapse/collapse.hpp"
+#include "tetcollapse/error.hpp"
 #include "geometry.h"
 
 namespace tc {
@@ -90,6 +91,10 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   if (!(options.target_length > 0) && !(options.target_factor > 0))
     throw std::invalid_argument("target_factor must be > 0 when target_length is not given");
 
+  if (options.conflicts == CollapseOptions::AtomicMin && !ctx.info().int64_atomics_extended)
+    throw DeviceError("device '" + ctx.info().name +
+                      "' lacks cl_khr_int64_extended_atomics (64-bit atomic min), which --conflicts atomic-min needs; "
+                      "use --conflicts two-pass");
   CollapseReport report;
   report.device = ctx.info().name;
   report.vertices_in = mesh.num_vertices();
