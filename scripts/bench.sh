@@ -17,7 +17,8 @@ fi
 
 out=$root/bench/results/suite.json
 for a in "$@"; do [ "$a" = --quick ] && out=$root/bench/results/smoke.json; done
+outarg=(--out "$out")
 prev=
-for a in "$@"; do [ "$prev" = --out ] && out=$a; prev=$a; done
-/usr/bin/python3 "$root/bench/run_suite.py" --cli "$build/tetcollapse" --out "$out" "$@"
+for a in "$@"; do [ "$prev" = --out ] && { out=$a; outarg=(); }; prev=$a; done
+/usr/bin/python3 "$root/bench/run_suite.py" --cli "$build/tetcollapse" "${outarg[@]}" "$@"
 /usr/bin/python3 "$root/bench/plot_suite.py" "$out" --markdown "${out%.json}.md"
