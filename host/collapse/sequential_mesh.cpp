@@ -696,9 +696,12 @@ int32_t SeqMesh::across(int32_t t, int f) const {
   int n = 0;
   for (int j = 0; j < 4; ++j)
     if (j != f) p[n++] = q[j];
+  // every tet of the face is in the ring of each of its vertices: scan the shortest
+  if (rlen_[p[1]] < rlen_[p[0]]) std::swap(p[0], p[1]);
+  if (rlen_[p[2]] < rlen_[p[0]]) std::swap(p[0], p[2]);
   int count = 0;
   int32_t other = -1;
-  const int32_t* r = ring(p[0]);  // every tet of the face contains p[0]
+  const int32_t* r = ring(p[0]);
   for (uint32_t i = 0; i < rlen_[p[0]]; ++i) {
     const int32_t u = r[i];
     if (u != t && has(tet(u), p[1]) && has(tet(u), p[2])) {
