@@ -59,7 +59,8 @@ def header_lines(r):
         f"Machine {m.get('hostname')}: {m.get('cpu_model')}, {m.get('cores')} cores, {m.get('mem_total_gib')} GiB; "
         f"load average before {r.get('load_before')}, after {r.get('load_after')}.",
         f"Devices: {devs or 'none'}.",
-        f"Repetitions: {r['settings']['reps']} (sequential {r['settings']['seq_reps']}), min_quality "
+        f"Repetitions: {r['settings']['reps']} (sequential {r['settings']['seq_reps']}"
+        + "".join(f", {k} {v}" for k, v in (r['settings'].get('method_reps') or {}).items()) + "), min_quality "
         f"{r['settings']['min_quality']}, boundary {r['settings']['boundary']}.",
     ]
     return lines
