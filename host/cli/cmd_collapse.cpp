@@ -235,6 +235,9 @@ void register_collapse(CLI::App& app, int& exit_code) {
     opt.conflicts = c->conflicts == "atomic-min" ? CollapseOptions::AtomicMin : CollapseOptions::TwoPass;
     if (opt.method == CollapseOptions::Sequential && !c->device.empty())
       throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
+    if (opt.method == CollapseOptions::Sequential && (!c->cost_cl.empty() || !c->sizing_field.empty()))
+      throw CLI::ValidationError(!c->cost_cl.empty() ? "--cost-cl" : "--sizing-field",
+                                 "needs the parallel method (it is compiled as OpenCL C); not with --method sequential");
     if (c->target_length > 0) opt.target_length = c->target_length;
     if (c->target_factor > 0) opt.target_factor = c->target_factor;
     if (!c->region.empty()) combine(opt.vertex_mask, region_mask(mesh, c->region));

@@ -571,9 +571,9 @@ TEST(SequentialCli, MethodSequentialWithCheck) {
   // a user cost is OpenCL C: refused with a message naming the method
   const std::string cost = dir.file("cost.cl");
   test::write_text(cost, "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return 0.0; }\n");
-  EXPECT_NE(test::run_command(cli + " " + in + " " + out + " --method sequential --cost-cl " + cost +
+  EXPECT_EQ(test::run_command(cli + " " + in + " " + out + " --method sequential --cost-cl " + cost +
                                   " --target-length 1",
                               &text),
-            0);
+            2);  // a usage error
   EXPECT_NE(text.find("sequential"), std::string::npos) << text;
 }
