@@ -52,12 +52,13 @@ inline int tcc_sg_collapse(int e, __global const int* edges, __global const ucha
  * differ. */
 inline int tcc_sg_new_tri(int t, int f, int side, int x, int y, int moves_y, double3 p, __global const int* tets,
                           __global const int* tet_nbr, __global const int* labels, int use_labels,
-                          __global const double* pts, int* id, double3* pos) {
+                          __global const double* pts, int* id, double3* pos, double3* old, int* is_glued) {
   __global const int* q = tets + 4 * t;
   int z = side == 0 ? x : y;
   if (q[f] == z) return 0; /* the face opposite z does not contain it */
   int other = tet_nbr[4 * t + f];
-  if (other >= 0 && tcc_has(tets, other, x) && tcc_has(tets, other, y)) { /* glued through o = other */
+  int glued = other >= 0 && tcc_has(tets, other, x) && tcc_has(tets, other, y);
+  if (glued) { /* through the removed tet o = other */
     int across = tet_nbr[4 * other + tcc_local(tets, other, z)];
     if (!(across < 0 || (use_labels && labels[t] != labels[across]))) return 0; /* interior after */
   } else {
@@ -66,23 +67,27 @@ inline int tcc_sg_new_tri(int t, int f, int side, int x, int y, int moves_y, dou
   }
   for (int k = 0; k < 3; ++k) {
     int v = q[TC_TET_FACES[f][k]];
+    old[k] = tc_point(pts, v);
     if (v == x) v = y;
     id[k] = v;
-    pos[k] = v == y ? p : tc_point(pts, v);
+    pos[k] = v == y ? p : old[k];
   }
+  *is_glued = glued;
   return 1;
 }
 
-/* Loop over the new S triangles of a collapse: BODY sees id[3], pos[3]. */
+/* Loop over the new S triangles of a collapse: BODY sees id[3], pos[3], the positions before
+ * old_[3] and glued_. */
 #define TCC_SG_FOR_NEW_TRIS(x, y, moves_y, p, id, pos, BODY)                                               \
-  for (int side_ = 0; side_ < 2; ++side_) {                                                               \
+  for (int side_ = 0, glued_ = 0; side_ < 2; ++side_) {                                                   \
     int z_ = side_ == 0 ? (x) : (y);                                                                        \
+    double3 old_[3];                                                                                        \
     for (uint i_ = vt_off[z_]; i_ < vt_off[z_ + 1]; ++i_) {                                                 \
       int t_ = vt[i_];                                                                                      \
       if (tcc_has(tets, t_, side_ == 0 ? (y) : (x))) continue; /* removed, or seen from ring(x) */         \
       for (int f_ = 0; f_ < 4; ++f_) {                                                                      \
         if (!tcc_sg_new_tri(t_, f_, side_, (x), (y), (moves_y), (p), tets, tet_nbr, labels, use_labels, pts, \
-                            id, pos))                                                                       \
+                            id, pos, old_, &glued_))                                                        \
           continue;                                                                                         \
         BODY                                                                                                \
       }                                                                                                     \
@@ -106,14 +111,30 @@ __kernel void sguard_queries(uint ne, __global const int* edges, __global const 
   int id[3];
   uint n = 0;
   double3 pos[3];
+  /* flat: every triangle before and after in one plane (that of the first, up to 1e-13 of its
+   * size), none glued */
+  int flat = 1;
+  double3 pn = (double3)(0.0, 0.0, 0.0), po = pn;
+  double ptol = 0.0;
   TCC_SG_FOR_NEW_TRIS(x, y, moves_y, p, id, pos, {
+    if (n == 0) {
+      pn = tcc_cross(old_[1] - old_[0], old_[2] - old_[0]);
+      po = old_[0];
+      double3 e = old_[1] - old_[0];
+      ptol = 1e-13 * sqrt(tcc_dot(e, e)) * sqrt(tcc_dot(pn, pn));
+    }
     ++n;
+    flat &= !glued_ && ptol > 0.0;
     for (int k = 0; k < 3; ++k) {
+      flat &= fabs(tcc_dot(pn, old_[k] - po)) <= ptol && fabs(tcc_dot(pn, pos[k] - po)) <= ptol;
       lo = fmin(lo, pos[k]);
       hi = fmax(hi, pos[k]);
     }
   })
-  if (n == 0) return;
+  /* A flat collapse re-triangulates a planar disk of S with its boundary polygon fixed (the
+   * triangles keep their orientation, being faces of positive tets): S does not change as a
+   * point set, and nothing can cross it. The usual case on the flat faces of CAD models. */
+  if (n == 0 || flat) return;
   uint slot = atomic_inc(qcount);
   qedge[slot] = (int)e;
   qntri[slot] = n;

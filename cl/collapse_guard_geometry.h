@@ -96,6 +96,31 @@ TC_FN int tc_sg_seg_tri(tc_d3 p, tc_d3 q, tc_d3 a, tc_d3 b, tc_d3 c) {
   return tc_sg_in_tri2(tc_sg_proj(p + pq * t, drop), a2, b2, c2, tol);
 }
 
+/* Are the vertices of B not shared with A all farther than 1e-9 times the two triangles' size
+ * from A's plane, on one side? (Then B meets A at most in what they share; the tolerance is at
+ * least that of tc_sg_seg_tri, so this never drops a pair that test would report.) */
+TC_FN int tc_sg_one_side(const int* ia, const tc_d3* pa, const int* ib, const tc_d3* pb) {
+  tc_d3 n = cross(pa[1] - pa[0], pa[2] - pa[0]);
+  double ln = sqrt(dot(n, n)), s2 = 0.0;
+  if (!(ln > 0.0)) return 0;
+  for (int k = 0; k < 3; ++k) {
+    tc_d3 ea = pa[(k + 1) % 3] - pa[k], eb = pb[(k + 1) % 3] - pb[k];
+    double la = dot(ea, ea), lb = dot(eb, eb);
+    s2 = s2 > la ? s2 : la;
+    s2 = s2 > lb ? s2 : lb;
+  }
+  double tol = 1e-9 * sqrt(s2);
+  int above = 0, below = 0, free = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (ib[k] == ia[0] || ib[k] == ia[1] || ib[k] == ia[2]) continue;
+    double d = dot(n, pb[k] - pa[0]) / ln;
+    ++free;
+    above += d > tol;
+    below += d < -tol;
+  }
+  return free > 0 && (above == free || below == free);
+}
+
 /* Do triangles A and B (vertex ids ia, ib; positions pa, pb) intersect other than in what they
  * share? Sharing an edge (or all three vertices): not tested. Sharing one vertex s: they meet
  * elsewhere iff the edge opposite s of one meets the other. Sharing none: iff an edge of one
@@ -110,6 +135,8 @@ TC_FN int tc_sg_tri_tri(const int* ia, const tc_d3* pa, const int* ib, const tc_
         sb = j;
       }
   if (shared >= 2) return 0;
+  /* cheap and most frequent: one triangle on one side of the other's plane */
+  if (tc_sg_one_side(ia, pa, ib, pb) || tc_sg_one_side(ib, pb, ia, pa)) return 0;
   if (shared == 1)
     return tc_sg_seg_tri(pa[(sa + 1) % 3], pa[(sa + 2) % 3], pb[0], pb[1], pb[2]) ||
            tc_sg_seg_tri(pb[(sb + 1) % 3], pb[(sb + 2) % 3], pa[0], pa[1], pa[2]);

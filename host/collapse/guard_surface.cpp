@@ -54,7 +54,7 @@ int cell_of(double v, double org, double h, int n) {
 
 // At most this many cells per axis: the grid is over the union of the query boxes, which
 // may be spread over the whole mesh.
-constexpr int kMaxCellsPerAxis = 64;
+constexpr int kMaxCellsPerAxis = 48;
 
 }  // namespace
 
@@ -90,22 +90,26 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
          dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
          tid.buffer(), tpos.buffer());
 
-  // The grid: cells at least as large as the largest query box (a box spans <= 2 cells per
-  // axis), at most kMaxCellsPerAxis per axis.
+  // The grid: cells twice the median query box (most boxes span <= 2 cells per axis, the large
+  // ones are entered in every cell they span), at most kMaxCellsPerAxis per axis.
   const std::vector<double> box = qbox.download_range(0, size_t(nq) * 6);
-  double lo[3], hi[3], h = 0;
+  double lo[3], hi[3];
   for (int a = 0; a < 3; ++a) {
     lo[a] = std::numeric_limits<double>::infinity();
     hi[a] = -lo[a];
   }
-  for (uint32_t q = 0; q < nq; ++q)
+  std::vector<double> extent(nq);
+  for (uint32_t q = 0; q < nq; ++q) {
+    extent[q] = 0;
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::min(lo[a], box[6 * q + a]);
       hi[a] = std::max(hi[a], box[6 * q + 3 + a]);
-      h = std::max(h, box[6 * q + 3 + a] - box[6 * q + a]);
+      extent[q] = std::max(extent[q], box[6 * q + 3 + a] - box[6 * q + a]);
     }
+  }
+  std::nth_element(extent.begin(), extent.begin() + nq / 2, extent.end());
   double ext = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-  h = std::max(h, ext / kMaxCellsPerAxis);
+  double h = std::max(2 * extent[nq / 2], ext / kMaxCellsPerAxis);
   if (!(h > 0) || !std::isfinite(h)) h = 1;  // all boxes one point
   int g[3];
   for (int a = 0; a < 3; ++a) g[a] = std::min(kMaxCellsPerAxis + 1, int(std::floor((hi[a] - lo[a]) / h)) + 1);
@@ -126,6 +130,9 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   for (size_t i = 0; i < ncells; ++i) off[i + 1] += off[i];
   std::vector<uint32_t> items(std::max<uint32_t>(off[ncells], 1)), cursor(off.begin(), off.end() - 1);
   for (uint32_t q = 0; q < nq; ++q) for_cells(q, [&](size_t cell) { items[cursor[cell]++] = q; });
+  if (kProfile)
+    std::fprintf(stderr, "  surface guard grid: h %g, %d x %d x %d cells, %u entries for %u queries\n", h, g[0], g[1],
+                 g[2], off[ncells], nq);
   ensure(cell_off, ctx, off.size());
   cell_off.upload(off);
   ensure(cell_items, ctx, items.size());
