@@ -18,8 +18,10 @@ import os
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-METHOD_NAMES = {"ours": "ours (two-pass)", "atomic-min": "atomic-min (Gautron & Kenzel)", "sequential": "CPU sequential"}
-METHOD_COLORS = {"ours": "tab:blue", "atomic-min": "tab:orange", "sequential": "tab:green"}
+METHOD_NAMES = {"ours": "ours (two-pass)", "atomic-min": "atomic-min (Gautron & Kenzel)", "sequential": "CPU sequential",
+                "sequential-paper": "CPU sequential, paper's reading"}
+METHOD_COLORS = {"ours": "tab:blue", "atomic-min": "tab:orange", "sequential": "tab:green",
+                 "sequential-paper": "tab:olive"}
 DEVICE_STYLES = ["o", "s", "^", "D", "v"]
 
 

@@ -204,6 +204,9 @@ void register_collapse(CLI::App& app, int& exit_code) {
                  "parallel (default): the OpenCL pipeline; sequential: the CPU priority-queue baseline\n"
                  "with the same checks (no OpenCL device needed)")
       ->check(CLI::IsMember({"parallel", "sequential"}));
+  app.add_flag("--sequential-skip-invalidated", c->opt.sequential_skip_invalidated,
+               "Sequential method: skip (until the next iteration) an edge whose star an earlier\n"
+               "collapse of the iteration changed, as the paper's baseline; default: re-check it");
   app.add_option("--conflicts", c->conflicts,
                  "Conflict detection of the parallel method: two-pass (default, the paper's) or\n"
                  "atomic-min (Gautron and Kenzel 2023; needs 64-bit atomics on the device)")

@@ -180,7 +180,9 @@ bool SequentialRun::step() {
     heap_.pop_back();
     if (!sm_.alive(e.a) || !sm_.alive(e.b)) continue;
     uint8_t dir = e.dir;
-    if (!reuse || touched_[e.a] == cur || touched_[e.b] == cur) {
+    const bool invalidated = touched_[e.a] == cur || touched_[e.b] == cur;
+    if (invalidated && o_.sequential_skip_invalidated) continue;  // the paper's reading: next iteration
+    if (!reuse || invalidated) {
       if (!sm_.is_edge(e.a, e.b)) continue;
       const double cost = sm_.length(e.a, e.b);
       if (!marked(e.a, e.b, cost)) continue;

@@ -81,6 +81,11 @@ struct CollapseOptions {
   // collapse), the same checks and predicate, no device needed (collapse_sequential).
   enum Method { Parallel, Sequential };
   Method method = Parallel;
+  // Sequential method: an edge whose star an earlier collapse of the same iteration changed is
+  // re-checked on the current mesh and collapsed when it still passes (false, default: the
+  // best sequential baseline), or skipped until the next iteration (true: the paper's "skip
+  // if the collapse has been invalidated by a prior collapse", fewer collapses per iteration).
+  bool sequential_skip_invalidated = false;
   // Conflict detection of the parallel method. TwoPass: the paper's two passes (default).
   // AtomicMin: Gautron and Kenzel 2023, every admissible edge propagates a 64-bit descriptor
   // (cost bits high, edge index low) with atomic_min to the tets of both one-rings and

@@ -309,6 +309,23 @@ TEST(SequentialCollapse, CubesStayValidInEveryMode) {
   }
 }
 
+// The paper's reading of its baseline (--sequential-skip-invalidated): an edge an earlier
+// collapse of the iteration changed waits for the next iteration instead of being re-checked.
+// Still valid; fewer collapses in the first iteration, so at least as many iterations.
+TEST(SequentialCollapse, SkippingInvalidatedEdgesStaysValidAndNeedsMoreIterations) {
+  const Mesh in = read_mesh(test::project_mesh("bracket.msh"));
+  Mesh m1, m2;
+  CollapseOptions o;
+  o.min_quality = 0;
+  const CollapseReport recheck = expect_valid_run(in, m1, o, "bracket re-check");
+  o.sequential_skip_invalidated = true;
+  const CollapseReport skip = expect_valid_run(in, m2, o, "bracket skip");
+  ASSERT_FALSE(recheck.iterations.empty());
+  ASSERT_FALSE(skip.iterations.empty());
+  EXPECT_LT(skip.iterations[0].collapsed, recheck.iterations[0].collapsed);
+  EXPECT_GT(skip.iterations.size(), recheck.iterations.size());
+}
+
 TEST(SequentialCollapse, BracketAndSharedMeshesStayValid) {
   Mesh m;
   CollapseOptions o;
