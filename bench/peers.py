@@ -10,6 +10,8 @@ Runs, on mesh M with the uniform target edge length L, in this order:
   tetcollapse_q0        ... --min-quality 0                            (the paper: no quality guard)
   mmg3d_hsiz            mmg3d_O3 IN.mesh -hsiz L                        (MMG3D, surface remeshed too)
   mmg3d_hsiz_nosurf     mmg3d_O3 IN.mesh -hsiz L -nosurf                (MMG3D, surface kept)
+  mmg3d_hmin            mmg3d_O3 IN.mesh -hmin L                        (MMG3D, size from the input's edges,
+  mmg3d_hmin_nosurf     mmg3d_O3 IN.mesh -hmin L -nosurf                 at least L: coarsening only)
   cgal_remesh           bench_peer_cgal M OUT.mesh L                    (CGAL tetrahedral_isotropic_remeshing,
                                                                         boundary protected)
   tetgen_rR             tetgen -rRm IN  (IN.node/.ele/.face, IN.mtr = L at every node)
@@ -46,7 +48,8 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-ALL_PEERS = ["tetcollapse", "tetcollapse_q0", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "cgal_remesh", "tetgen_rR", "tetgen_rR_keepbnd"]
+ALL_PEERS = ["tetcollapse", "tetcollapse_q0", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "mmg3d_hmin", "mmg3d_hmin_nosurf",
+             "cgal_remesh", "tetgen_rR", "tetgen_rR_keepbnd"]
 
 
 class PeerFailed(Exception):
@@ -237,14 +240,19 @@ def main():
                                  "pip's mmgpy wheel ships mmg3d_O3)")
             src = converted(".mesh")
             out = os.path.join(d, "out.mesh")
-            cmd = [mmg, "-v", "1", "-in", src, "-out", out, "-hsiz", repr(L)]
+            cmd = [mmg, "-v", "1", "-in", src, "-out", out]
+            # -hsiz: uniform size L everywhere (refines where the input is coarser than L);
+            # -hmin: the size MMG derives from the input's edge lengths, but never below L
+            # (coarsens only, like tetcollapse)
+            cmd += ["-hmin", repr(L)] if "_hmin" in peer else ["-hsiz", repr(L)]
             if peer.endswith("nosurf"):
                 cmd.append("-nosurf")
 
             def alg(stdout, stderr):
                 # "MMG3DLIB: ELAPSED TIME  1.23s": the library call (analysis + remeshing), no file I/O
-                m = re.search(r"MMG3DLIB: ELAPSED TIME\s+([0-9.]+)s", stdout)
-                return float(m.group(1)) if m else None
+                # (MMG writes "12.345s", "5m12s" or "1h05m12s")
+                m = re.search(r"MMG3DLIB: ELAPSED TIME\s+(?:(\d+)h)?(?:(\d+)m)?([0-9.]+)s", stdout)
+                return 3600 * int(m.group(1) or 0) + 60 * int(m.group(2) or 0) + float(m.group(3)) if m else None
             return cmd, out, alg
         if peer == "cgal_remesh":
             if not cgal:

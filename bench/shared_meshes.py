@@ -144,7 +144,7 @@ def table(rows, meta):
                  "`bench/results/shared_meshes.json`.")
     lines.append("")
     lines.append("| mesh | tets in | mode | tets out | reduction | iterations | collapse s | total s | --check | "
-                 "Hausdorff rel | min dihedral out |")
+                 "Hausdorff rel | min dihedral in -> out |")
     lines.append("|---|---:|---|---:|---:|---:|---:|---:|---|---:|---:|")
     for r in rows:
         check = r.get("check") or (f"exit {r.get('exit_code')}")
@@ -154,7 +154,8 @@ def table(rows, meta):
             r["mesh"], fmt(r.get("tets_in"), ","), r["mode"], fmt(r.get("tets_out"), ","),
             fmt(None if r.get("tet_reduction") is None else 100 * r["tet_reduction"], ".1f") + "%",
             fmt(r.get("iterations"), "d"), fmt(r.get("seconds_collapse"), ".2f"), fmt(r.get("seconds_total"), ".2f"),
-            check, fmt(r.get("hausdorff_rel"), ".2g"), fmt(r.get("min_dihedral_deg"), ".2f")))
+            check, fmt(r.get("hausdorff_rel"), ".2g"),
+            fmt(r.get("min_dihedral_in_deg"), ".2f") + " -> " + fmt(r.get("min_dihedral_deg"), ".2f")))
     bad = [(r, problems(r)) for r in rows if problems(r)]
     lines.append("")
     if bad:
@@ -217,8 +218,14 @@ def main():
     built = datetime.datetime.fromtimestamp(os.path.getmtime(tc), datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     rows = []
     for path in meshes:
+        info = subprocess.run([tc, "info", path, "--json"], capture_output=True, text=True, timeout=a.timeout)
+        try:
+            min_in = json.loads(info.stdout).get("min_dihedral_deg")
+        except ValueError:
+            min_in = None
         for mode in modes:
             r = run_one(tc, os.path.abspath(path), mode, work, a.timeout)
+            r["min_dihedral_in_deg"] = min_in
             rows.append(r)
             why = problems(r)
             print(f"{r['mesh']:45s} {mode:8s} tets {r.get('tets_in')} -> {r.get('tets_out')}  "
