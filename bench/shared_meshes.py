@@ -14,7 +14,8 @@ and then, on the output when one was written, `tetcollapse check OUT.vtu --refer
 for the numbers --check does not put in the statistics (boundary Hausdorff distance, topology,
 output quality). Writes one JSON object per (mesh, mode) to --out-json (default
 bench/results/shared_meshes.json) and replaces the section "Every shared mesh at its median
-edge length (issue 5)" of --readme (default bench/README.md) with a table of the results.
+edge length (issue 5)" of --readme (default bench/README.md) with a table of the results
+(--from-json F: only that, from a results file).
 Expected for every mesh that is valid on input: exit 0, check valid, boundary topology
 unchanged, and in strict mode a Hausdorff distance of 0. Anything else is listed under the table.
 """
@@ -195,7 +196,13 @@ def main():
     ap.add_argument("--readme", default=os.path.join(HERE, "README.md"), help="'' to leave the README alone")
     ap.add_argument("--work-dir", default=None)
     ap.add_argument("--timeout", type=float, default=3600)
+    ap.add_argument("--from-json", default=None, help="run nothing: rewrite the README section from this results file")
     a = ap.parse_args()
+    if a.from_json:
+        with open(a.from_json) as f:
+            res = json.load(f)
+        replace_section(a.readme, table(res["runs"], res["meta"]))
+        return
     tc = a.tetcollapse or default_tetcollapse()
     if not tc or not os.access(tc, os.X_OK):
         sys.exit("shared_meshes.py: no tetcollapse binary (give --tetcollapse PATH)")
