@@ -11,6 +11,7 @@
 // Prints one JSON object on stdout: seconds_build (tet soup -> triangulation),
 // seconds_remesh, seconds (their sum: what bench/peers.py reports), tets_in, tets_out,
 // vertices_out. File I/O is not timed.
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cstdio>
