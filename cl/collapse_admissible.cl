@@ -77,10 +77,23 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
     ++np;
   }
   int ok = 1;
+  const uint smask = TCC_BOUNDARY | TCC_INTERFACE;
+  /* (iii) with w, inside the tets (a,b,c,d) of the edge: no S-faces (a,c,d) and (b,c,d) (the
+   * triangle (c,d,w) would be in lk(a) and lk(b) but not in lk(ab); e.g. a lone tet, which the
+   * collapse would flatten away). An S-face has S vertices only. */
+  if ((fa & smask) && (fb & smask))
+    for (uint i = vt_off[a]; i < vt_off[a + 1] && ok; ++i) {
+      int t = vt[i];
+      int la = tcc_local(tets, t, a), lb = tcc_local(tets, t, b);
+      if (lb < 0) continue;
+      int xa = tet_nbr[4 * t + lb], xb = tet_nbr[4 * t + la]; /* across (a,c,d) and (b,c,d) */
+      int acd = xa < 0 || (use_labels && labels[t] != labels[xa]);
+      int bcd = xb < 0 || (use_labels && labels[t] != labels[xb]);
+      if (acd && bcd) ok = 0;
+    }
   /* (i) vertices, and w */
   for (int k = 0; k < ncn && ok; ++k)
     if (!tcc_in(pc, np, cn[k]) && !tcc_in(pd, np, cn[k])) ok = 0;
-  const uint smask = TCC_BOUNDARY | TCC_INTERFACE;
   if (ok && (fa & smask) && (fb & smask) && !(fe & smask)) ok = 0;
   /* (ii) with w: S-edges (a,c) and (b,c) need the S-face (a,b,c) */
   for (int k = 0; k < ncn && ok; ++k) {

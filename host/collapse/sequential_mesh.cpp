@@ -492,6 +492,10 @@ bool SeqMesh::link_ok(int32_t a, int32_t b, uint8_t fe) {
     lmark_[o[0]] = lmark_[o[1]] = sL;
   }
   if (pc_.size() > kMaxLink) return false;
+  // (iii) with w, inside the tets (a,b,c,d) of the edge: no S-faces (a,c,d) and (b,c,d)
+  if ((fa & kSMask) && (fb & kSMask))
+    for (size_t m = 0; m < pc_.size(); ++m)
+      if (triangle_kind(a, pc_[m], pd_[m]) && triangle_kind(b, pc_[m], pd_[m])) return false;
   // (i) every common neighbour is a vertex of lk(ab); and w: a, b both on S needs an S-edge
   for (int32_t c : cn_)
     if (lmark_[c] != sL) return false;

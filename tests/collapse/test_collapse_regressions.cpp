@@ -18,6 +18,7 @@
 #include "test_support.hpp"
 #include "tetcollapse/check.hpp"
 #include "tetcollapse/collapse.hpp"
+#include "tetcollapse/io.hpp"
 
 namespace {
 
@@ -172,3 +173,27 @@ TEST(CollapseRegressions, GuardRefusesOnlyWhatIntersects) {
 }
 
 }  // namespace
+
+// Free mode flattened lone tets away: an edge (a, b) of a tet whose faces (a,c,d) and (b,c,d)
+// are both on S fails the link condition with the virtual vertex w (the triangle (c,d,w) is in
+// lk(a) and lk(b) but not in lk(ab)); the check used to look only at the tets of ring(a)
+// without b. Both methods, every boundary mode: a lone tet, and two tets of two materials,
+// keep all their tets.
+TEST(CollapseRegressions, LoneTetsAreNotFlattenedAway) {
+  tc::Context ctx;
+  for (const char* name : {"tet.mesh", "two_tets.mesh"}) {
+    const tc::Mesh in = tc::read_mesh(std::string(TC_PROJECT_MESHES) + "/" + name);
+    for (auto mode : {tc::CollapseOptions::Free, tc::CollapseOptions::Features, tc::CollapseOptions::Strict})
+      for (auto method : {tc::CollapseOptions::Parallel, tc::CollapseOptions::Sequential}) {
+        SCOPED_TRACE(std::string(name) + " mode " + std::to_string(int(mode)) + " method " + std::to_string(int(method)));
+        tc::Mesh m = in;
+        tc::CollapseOptions o;
+        o.boundary = mode;
+        o.method = method;
+        o.target_length = 100;  // every edge marked
+        tc::collapse(m, o, ctx);
+        EXPECT_EQ(m.num_tets(), in.num_tets());
+        EXPECT_TRUE(tc::check_mesh(m, tc::CheckOptions{}, &in).valid);
+      }
+  }
+}
