@@ -90,7 +90,8 @@ struct EdgeState {
 
 enum Reason : uint8_t {
   kOk = 0, kNotMarked = 1, kRefusedQ = 2, kRefusedLink = 3, kRefusedVolume = 4, kRefusedQuality = 6,
-  kUntested = 5  // lazy filter: passed Q, never tested because a cheaper rival won
+  kUntested = 5,  // lazy filter: passed Q, never tested because a cheaper rival won
+  kRefusedSurface = 7  // the surface guard (guard_surface.hpp)
 };
 
 struct StageParams {
