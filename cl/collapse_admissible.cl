@@ -46,7 +46,7 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
                                  __global const int* nb, __global const int* nb_edge, __global const int* labels,
                                  int use_labels, __global const double* pts, __global const uchar* vflags,
                                  __global const uchar* eflags, double eps_v,
-                                 double q_min) {
+                                 double q_min, __global const double* tet_quality) {
   /* --- link condition --- */
   int cn[TCC_MAX_LINK], pc[TCC_MAX_LINK], pd[TCC_MAX_LINK];
   int ncn = 0, np = 0;
@@ -161,10 +161,11 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
       __global const int* q = tets + 4 * t;
       double3 c[4];
       for (int k = 0; k < 4; ++k) c[k] = q[k] == x ? p : tc_point(pts, q[k]);
-      if (!(tc_tet_volume(c[0], c[1], c[2], c[3]) >= eps_v)) return TCC_REFUSED_VOLUME;
+      double vol = tc_tet_volume(c[0], c[1], c[2], c[3]);
+      if (!(vol >= eps_v)) return TCC_REFUSED_VOLUME;
       if (q_min > 0.0) {
-        double qn = tc_tet_quality(c[0], c[1], c[2], c[3]);
-        double qo = tc_tet_quality(tc_point(pts, q[0]), tc_point(pts, q[1]), tc_point(pts, q[2]), tc_point(pts, q[3]));
+        double qn = tc_tet_quality_v(c[0], c[1], c[2], c[3], vol);
+        double qo = tet_quality[t]; /* tc_tet_quality of t now (tet_quality kernel) */
         q_new = qn < q_new ? qn : q_new;
         q_old = qo < q_old ? qo : q_old;
       }
@@ -174,14 +175,23 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
   return TCC_OK;
 }
 
+/* tet_quality[t] = tc_tet_quality of tet t (the quality guard's "before", once per iteration
+ * instead of once per test that looks at t). */
+__kernel void tet_quality(uint nt, __global const int* tets, __global const double* pts, __global double* quality) {
+  uint t = get_global_id(0);
+  if (t >= nt) return;
+  __global const int* q = tets + 4 * t;
+  quality[t] = tc_tet_quality(tc_point(pts, q[0]), tc_point(pts, q[1]), tc_point(pts, q[2]), tc_point(pts, q[3]));
+}
+
 __kernel void admissible(uint ne, __global const int* edges, __global const uint* marked, __global const int* tets,
                          __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
                          __global const uint* nb_off,
                          __global const int* nb, __global const int* nb_edge, __global const int* labels,
                          int use_labels, __global const double* pts, __global const uchar* vflags,
                          __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
-                         double eps_v, double q_min, __global uint* adm, __global uchar* edge_dir, __global uchar* reason,
-                         __global uint* counters) {
+                         double eps_v, double q_min, __global const double* tet_quality, __global uint* adm,
+                         __global uchar* edge_dir, __global uchar* reason, __global uint* counters) {
   uint e = get_global_id(0);
   if (e >= ne) return;
   adm[e] = 0u;
@@ -198,7 +208,7 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
     return;
   }
   uchar r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts,
-                                vflags, eflags, eps_v, q_min);
+                                vflags, eflags, eps_v, q_min, tet_quality);
   reason[e] = r;
   if (r != TCC_OK) return;
   adm[e] = 1u;
@@ -258,8 +268,9 @@ __kernel void lazy_pass1_decide(uint n, int first, __global const uint* list, __
                                 __global const int* nb_edge, __global const int* labels, int use_labels,
                                 __global const double* pts, __global const uchar* vflags,
                                 __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
-                                double eps_v, double q_min, __global uchar* edge_dir, __global uchar* reason,
-                                __global uint* counters, __global uchar* verdict) {
+                                double eps_v, double q_min, __global const double* tet_quality,
+                                __global uchar* edge_dir, __global uchar* reason, __global uint* counters,
+                                __global uchar* verdict) {
   uint i = get_global_id(0);
   if (i >= n) return;
   int e;
@@ -271,7 +282,7 @@ __kernel void lazy_pass1_decide(uint n, int first, __global const uint* list, __
   uchar r = verdict[e];
   if (r == TCC_VERDICT_UNKNOWN) {
     r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts,
-                            vflags, eflags, eps_v, q_min);
+                            vflags, eflags, eps_v, q_min, tet_quality);
     verdict[e] = r;
     atomic_inc(&counters[4]);
   }

@@ -122,12 +122,16 @@ TC_FN double tc_max_dihedral(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3) {
 
 /* Mean-ratio style quality 6*sqrt(2)*V / l_rms^3: 1 for a regular tet, -> 0 for slivers,
  * negative when inverted (the "qmin" of ../shared/meshes/SOURCES.md). */
-TC_FN double tc_tet_quality(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3) {
+/* The same with the tet's volume tc_tet_volume(p0, p1, p2, p3) already at hand (same bits). */
+TC_FN double tc_tet_quality_v(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3, double volume) {
   double s = dot(p1 - p0, p1 - p0) + dot(p2 - p0, p2 - p0) + dot(p3 - p0, p3 - p0) +
              dot(p2 - p1, p2 - p1) + dot(p3 - p1, p3 - p1) + dot(p3 - p2, p3 - p2);
   double lrms = sqrt(s / 6.0);
   if (lrms <= 0.0) return 0.0;
-  return 6.0 * sqrt(2.0) * tc_tet_volume(p0, p1, p2, p3) / (lrms * lrms * lrms);
+  return 6.0 * sqrt(2.0) * volume / (lrms * lrms * lrms);
+}
+TC_FN double tc_tet_quality(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3) {
+  return tc_tet_quality_v(p0, p1, p2, p3, tc_tet_volume(p0, p1, p2, p3));
 }
 
 #ifndef __OPENCL_C_VERSION__

@@ -317,6 +317,16 @@ uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   return counter(s, 0);
 }
 
+namespace {
+// The quality guard's per-tet qualities of the current mesh (a placeholder when it is off).
+const cl::Buffer& tet_qualities(Context& ctx, DeviceMesh& dm, EdgeState& s, const StageParams& p) {
+  ensure(s.tet_quality, ctx, p.min_quality > 0 ? dm.nt : 1);
+  if (p.min_quality > 0)
+    run(ctx, "collapse_admissible.cl", "tet_quality", dm.nt, "", U(dm.nt), B(dm.tets), B(dm.points), B(s.tet_quality));
+  return s.tet_quality.buffer();
+}
+}  // namespace
+
 uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p) {
   ensure(s.adm, ctx, c.ne);
   ensure(s.dir, ctx, c.ne);
@@ -324,7 +334,8 @@ uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   run(ctx, "collapse_admissible.cl", "admissible", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(dm.tets),
       B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points),
-      B(c.vflags), B(c.vclass), B(c.eflags), I(p.mode), I(p.paper_rule ? 1 : 0), p.eps_v, p.min_quality, B(s.adm), B(s.dir),
+      B(c.vflags), B(c.vclass), B(c.eflags), I(p.mode), I(p.paper_rule ? 1 : 0), p.eps_v, p.min_quality,
+      tet_qualities(ctx, dm, s, p), B(s.adm), B(s.dir),
       B(s.reason), B(s.counters));
   return counter(s, 1);
 }
@@ -460,7 +471,8 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   set_args_from(decide, kDecideArgs, "lazy_pass1_decide", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off),
                 B(c.nb),
                 B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass), B(c.eflags), mode,
-                paper_rule, p.eps_v, p.min_quality, B(s.dir), B(s.reason), B(s.counters), B(s.verdict));
+                paper_rule, p.eps_v, p.min_quality, tet_qualities(ctx, dm, s, p), B(s.dir), B(s.reason), B(s.counters),
+                B(s.verdict));
   pass1_rounds(ctx, decide, s, c, dm.nv, n, "lazy_pass1_decide");
   run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1),
       B(s.vaff), B(s.counters));

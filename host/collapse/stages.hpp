@@ -48,6 +48,7 @@ struct EdgeState {
   DeviceBuffer<double> cost;
   DeviceBuffer<uint32_t> marked, adm, p1, fin;
   DeviceBuffer<uint8_t> state;      // conflict passes: 0 undecided, 1 in, 2 out
+  DeviceBuffer<double> tet_quality; // quality guard: tc_tet_quality per tet (collapse_admissible.cl)
   DeviceBuffer<uint32_t> cand;      // lazy filter: marked and passing Q
   // Conflict rounds (collapse_conflict.cl): candidate edges, worklists of their slots, the
   // length of the next worklist, stored rivals per slot (pass 2) and their count.
