@@ -196,6 +196,7 @@ def main():
     ap.add_argument("--readme", default=os.path.join(HERE, "README.md"), help="'' to leave the README alone")
     ap.add_argument("--work-dir", default=None)
     ap.add_argument("--timeout", type=float, default=3600)
+    ap.add_argument("--commit", default=None, help="the commit the binary was built from (default: HEAD of the work tree)")
     ap.add_argument("--from-json", default=None, help="run nothing: rewrite the README section from this results file")
     a = ap.parse_args()
     if a.from_json:
@@ -220,8 +221,8 @@ def main():
 
     # The binary's build time and the commit at the start of the run (the tree is shared by
     # several people: the binary may hold uncommitted work of its build time).
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
+    commit = a.commit or subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                                        text=True).stdout.strip()
     built = datetime.datetime.fromtimestamp(os.path.getmtime(tc), datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     rows = []
     for path in meshes:
