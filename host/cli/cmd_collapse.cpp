@@ -131,6 +131,8 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, double sec
         .field("tets", it.tets)
         .field("edges", it.edges)
         .field("marked", it.marked)
+        .field("passed_q", it.passed_q)
+        .field("tested", it.tested)
         .field("admissible", it.admissible)
         .field("after_pass1", it.after_pass1)
         .field("after_pass2", it.after_pass2)
