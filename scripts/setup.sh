@@ -2,7 +2,9 @@
 # Installs every Debian package tetcollapse needs to build, test and benchmark.
 # Idempotent: when everything is there it installs nothing and does not touch apt.
 #   scripts/setup.sh              build + test dependencies
-#   scripts/setup.sh --with-tools also the mesh tools used by scripts/ (gmsh + its Python module, tetgen, matplotlib)
+#   scripts/setup.sh --with-tools also the mesh tools used by scripts/ and bench/ (gmsh + its Python
+#                                 module, tetgen, matplotlib, clang for fuzzing; MMG3D, which Debian
+#                                 does not package, from PyPI's mmgpy wheel for the peers benchmark)
 set -euo pipefail
 
 packages=(
@@ -23,8 +25,19 @@ for p in "${packages[@]}"; do
   fi
 done
 
+# MMG3D (bench/peers.py): not in Debian; the mmgpy wheel on PyPI ships the mmg3d_O3 binary
+install_mmg() {
+  [[ "${1:-}" == "--with-tools" ]] || return 0
+  command -v mmg3d_O3 >/dev/null && return 0
+  echo "setup: installing MMG3D (PyPI mmgpy 0.17.1) into /opt/mmgpy"
+  /usr/bin/python3 -m pip install -q --no-deps --target /opt/mmgpy mmgpy==0.17.1 &&
+    ln -sf /opt/mmgpy/mmgpy/bin/mmg3d_O3 /usr/local/bin/mmg3d_O3 ||
+    echo "setup: MMG3D not installed (the peers benchmark will skip it)" >&2
+}
+
 if ((${#missing[@]} == 0)); then
   echo "setup: all ${#packages[@]} packages present"
+  install_mmg "${1:-}"
   exit 0
 fi
 
@@ -37,4 +50,5 @@ echo "setup: installing ${missing[*]}"
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+install_mmg "${1:-}"
 echo "setup: done"
