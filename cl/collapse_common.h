@@ -14,21 +14,10 @@
 #pragma OPENCL FP_CONTRACT OFF
 #include "geometry.h"
 
-/* Bits of vflags / eflags. */
-#define TCC_BOUNDARY 1u  /* on a face with one tet */
-#define TCC_INTERFACE 2u /* on a face between tets of different labels */
-#define TCC_RIDGE 4u     /* eflags only: a ridge (feature) edge */
-
-/* Vertex classes (tc::VertexClass) */
-#define TCC_INTERIOR 0
-#define TCC_FACE 1
-#define TCC_RIDGEV 2
-#define TCC_CORNER 3
-
-/* Boundary modes (tc::CollapseOptions::Boundary) */
-#define TCC_STRICT 0
-#define TCC_FEATURES 1
-#define TCC_FREE 2
+/* Flags (TCC_BOUNDARY, TCC_INTERFACE, TCC_RIDGE), vertex classes (TCC_INTERIOR .. TCC_CORNER),
+ * boundary modes (TCC_STRICT, TCC_FEATURES, TCC_FREE), edge_dir bits (TCC_DIR_*) and the
+ * predicate Q: cl/collapse_predicate.h, shared with the sequential method. */
+#include "collapse_predicate.h"
 
 /* Refusal reasons written by the admissible filter (tc::collapse::Reason). */
 #define TCC_OK 0
@@ -147,12 +136,6 @@ inline double3 tcc_face_normal(__global const double* pts, __global const int* t
   double3 p2 = tc_point(pts, q[TC_TET_FACES[f][2]]);
   return tcc_normalize(tcc_cross(p1 - p0, p2 - p0));
 }
-
-/* Collapse direction of an admissible edge, written by the admissible filter (edge_dir):
- * bit 0 set: the removed vertex is v1 (survivor v0), else the removed vertex is v0;
- * bit 1 set: midpoint placement, else the survivor keeps its position. */
-#define TCC_DIR_REMOVE_V1 1u
-#define TCC_DIR_MIDPOINT 2u
 
 inline double3 tcc_placement(__global const double* pts, int v0, int v1, uint dir) {
   double3 p0 = tc_point(pts, v0), p1 = tc_point(pts, v1);

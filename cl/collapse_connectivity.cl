@@ -45,6 +45,25 @@ inline void tcc_sort_segment(__global int* a, uint n) {
 #define TCC_MAX_NB 64
 #endif
 
+/* Inserts u into the ascending list s[0..*m) unless it is there. */
+inline void tcc_insert_sorted(__global int* s, uint* m, int u) {
+  uint j = *m;
+  while (j > 0 && s[j - 1] > u) --j;
+  if (j > 0 && s[j - 1] == u) return;
+  for (uint k = *m; k > j; --k) s[k] = s[k - 1];
+  s[j] = u;
+  ++*m;
+}
+
+/* |N(v)| and the number of its entries above v (the edges v owns). */
+inline void tcc_count_neighbours(__global const int* s, uint m, uint v, __global uint* nb_count,
+                                 __global uint* up_count) {
+  uint up = 0;
+  for (uint i = 0; i < m; ++i) up += s[i] > (int)v ? 1u : 0u;
+  nb_count[v] = m;
+  up_count[v] = up;
+}
+
 /* Sorts ring(v) (unless sort == 0: carried rings are sorted); then gathers N(v) into scratch[3 vt_off[v] ..], sorted and unique, and counts
  * it (nb_count) and its part above v (up_count). */
 __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __global const uint* vt_off,
@@ -93,19 +112,8 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
       }
     }
     if (nr <= 16) {
-      for (int r = 0; r < nr; ++r) {
-        int u = ren[r];
-        uint j = m;
-        while (j > 0 && s[j - 1] > u) --j;
-        if (j > 0 && s[j - 1] == u) continue;
-        for (uint k2 = m; k2 > j; --k2) s[k2] = s[k2 - 1];
-        s[j] = u;
-        ++m;
-      }
-      uint up = 0;
-      for (uint i = 0; i < m; ++i) up += s[i] > (int)v ? 1u : 0u;
-      nb_count[v] = m;
-      up_count[v] = up;
+      for (int r = 0; r < nr; ++r) tcc_insert_sorted(s, &m, ren[r]);
+      tcc_count_neighbours(s, m, v, nb_count, up_count);
       return;
     }
   }
@@ -132,20 +140,12 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
         for (uint k2 = 0; k2 < m; ++k2) s[k2] = loc[k2];
         big = 1;
       }
-      uint j = m;
-      while (j > 0 && s[j - 1] > u) --j;
-      if (j > 0 && s[j - 1] == u) continue;
-      for (uint k2 = m; k2 > j; --k2) s[k2] = s[k2 - 1];
-      s[j] = u;
-      ++m;
+      tcc_insert_sorted(s, &m, u);
     }
   }
   if (!big)
     for (uint k2 = 0; k2 < m; ++k2) s[k2] = loc[k2];
-  uint up = 0;
-  for (uint i = 0; i < m; ++i) up += s[i] > (int)v ? 1u : 0u;
-  nb_count[v] = m;
-  up_count[v] = up;
+  tcc_count_neighbours(s, m, v, nb_count, up_count);
 }
 
 /* Copies N(v) to nb[] and writes the edges owned by v (u > v) and their ids. */

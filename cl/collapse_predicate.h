@@ -3,9 +3,7 @@
  * (host/collapse/sequential_mesh.cpp): written once, compiled as OpenCL C and as C++ (names in
  * namespace tc::rules there), like cl/geometry.h. Pure integer logic.
  *
- * The constants repeat those of cl/collapse_common.h (which is OpenCL-only) with identical
- * definitions; a translation unit that sees both gets a macro-redefinition diagnostic if they
- * ever differ. */
+ * The constants here are the ones every kernel uses (cl/collapse_common.h includes this file). */
 #ifndef TETCOLLAPSE_COLLAPSE_PREDICATE_H
 #define TETCOLLAPSE_COLLAPSE_PREDICATE_H
 

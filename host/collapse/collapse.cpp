@@ -80,6 +80,19 @@ double median_edge_length(const Mesh& mesh) {
   return median_of(std::move(len));
 }
 
+double volume_threshold(const Mesh& mesh, const CollapseOptions& options) {
+  if (!options.eps_v_relative) return options.eps_v;
+  double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  for (size_t i = 0; i + 2 < mesh.points.size(); i += 3)
+    for (int c = 0; c < 3; ++c) {
+      lo[c] = std::min(lo[c], mesh.points[i + c]);
+      hi[c] = std::max(hi[c], mesh.points[i + c]);
+    }
+  double d2 = 0;
+  for (int c = 0; c < 3; ++c) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
+  return options.eps_v * d2 * std::sqrt(d2);
+}
+
 CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
   if (options.method == CollapseOptions::Sequential) return collapse_sequential(mesh, options);
   if (options.max_iterations < 0) throw std::invalid_argument("max_iterations must be >= 0");
@@ -101,17 +114,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   report.tets_in = mesh.num_tets();
 
   StageParams p = params_from(options);
-  if (options.eps_v_relative) {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t i = 0; i + 2 < mesh.points.size(); i += 3)
-      for (int c = 0; c < 3; ++c) {
-        lo[c] = std::min(lo[c], mesh.points[i + c]);
-        hi[c] = std::max(hi[c], mesh.points[i + c]);
-      }
-    double d2 = 0;
-    for (int c = 0; c < 3; ++c) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
-    p.eps_v = options.eps_v * d2 * std::sqrt(d2);
-  }
+  p.eps_v = volume_threshold(mesh, options);
   report.eps_v = p.eps_v;
 
   const double t_start = now();

@@ -33,17 +33,7 @@ SeqParams checked_params(const Mesh& mesh, const CollapseOptions& o) {
     throw std::invalid_argument("vertex_mask has " + std::to_string(o.vertex_mask.size()) + " entries for " +
                                 std::to_string(mesh.num_vertices()) + " vertices");
   SeqParams p = seq_params_from(o);
-  if (o.eps_v_relative) {  // eps_v x (bounding-box diagonal)^3, as collapse() computes it
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t i = 0; i + 2 < mesh.points.size(); i += 3)
-      for (int c = 0; c < 3; ++c) {
-        lo[c] = std::min(lo[c], mesh.points[i + c]);
-        hi[c] = std::max(hi[c], mesh.points[i + c]);
-      }
-    double d2 = 0;
-    for (int c = 0; c < 3; ++c) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
-    p.eps_v = o.eps_v * d2 * std::sqrt(d2);
-  }
+  p.eps_v = volume_threshold(mesh, o);  // as collapse() computes it
   return p;
 }
 

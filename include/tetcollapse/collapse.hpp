@@ -154,4 +154,8 @@ CollapseReport collapse_sequential(Mesh& mesh, const CollapseOptions& options);
 // Median edge length of a mesh (unique edges), on the host. 0 for a mesh without tets.
 double median_edge_length(const Mesh& mesh);
 
+// The volume threshold a run uses: options.eps_v, or with eps_v_relative options.eps_v x (the
+// bounding-box diagonal of the mesh)^3.
+double volume_threshold(const Mesh& mesh, const CollapseOptions& options);
+
 }  // namespace tc
