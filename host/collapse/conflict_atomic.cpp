@@ -13,12 +13,6 @@ namespace tc::collapse_detail {
 
 namespace {
 
-template <class T>
-void ensure(DeviceBuffer<T>& b, Context& ctx, size_t n) {
-  if (!b.buffer()()) b = DeviceBuffer<T>(ctx, n);
-  else b.resize(n);
-}
-
 // The fewest bits k >= 1 with ne - 1 < 2^k: the low bits of a descriptor that hold the index.
 cl_uint index_bits(uint32_t ne) {
   cl_uint k = 1;

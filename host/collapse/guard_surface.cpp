@@ -20,11 +20,10 @@ namespace tc::collapse_detail {
 
 namespace {
 
+// ensure (stages.hpp) with at least one element: no zero-sized OpenCL buffers.
 template <class T>
-void ensure(DeviceBuffer<T>& b, Context& ctx, size_t n) {
-  n = std::max<size_t>(n, 1);  // no zero-sized OpenCL buffers
-  if (!b.buffer()()) b = DeviceBuffer<T>(ctx, n);
-  else b.resize(n);
+void ensure_nonempty(DeviceBuffer<T>& b, Context& ctx, size_t n) {
+  ensure(b, ctx, std::max<size_t>(n, 1));
 }
 
 // TETCOLLAPSE_PROFILE=1 prints the wall time of every launch on stderr (as stages.cpp does).
@@ -62,10 +61,10 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
                            uint32_t chosen) {
   last_queries = 0;
   if (chosen == 0) return 0;
-  ensure(qedge, ctx, chosen);
-  ensure(qbox, ctx, size_t(chosen) * 6);
-  ensure(qntri, ctx, chosen);
-  ensure(qcount, ctx, 1);
+  ensure_nonempty(qedge, ctx, chosen);
+  ensure_nonempty(qbox, ctx, size_t(chosen) * 6);
+  ensure_nonempty(qntri, ctx, chosen);
+  ensure_nonempty(qcount, ctx, 1);
   qcount.fill(0u);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   const cl::Buffer& labels = dm.labels[0].buffer();
@@ -82,10 +81,10 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   std::vector<uint32_t> off_tri(nq + 1, 0);
   for (uint32_t q = 0; q < nq; ++q) off_tri[q + 1] = off_tri[q] + counts[q];
   const uint32_t ntri = off_tri[nq];
-  ensure(qoff, ctx, nq + 1);
+  ensure_nonempty(qoff, ctx, nq + 1);
   qoff.upload(off_tri);
-  ensure(tid, ctx, size_t(ntri) * 3);
-  ensure(tpos, ctx, size_t(ntri) * 9);
+  ensure_nonempty(tid, ctx, size_t(ntri) * 3);
+  ensure_nonempty(tpos, ctx, size_t(ntri) * 9);
   launch(ctx, "sguard_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(), s.dir.buffer(),
          dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
          tid.buffer(), tpos.buffer());
@@ -133,12 +132,12 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   if (kProfile)
     std::fprintf(stderr, "  surface guard grid: h %g, %d x %d x %d cells, %u entries for %u queries\n", h, g[0], g[1],
                  g[2], off[ncells], nq);
-  ensure(cell_off, ctx, off.size());
+  ensure_nonempty(cell_off, ctx, off.size());
   cell_off.upload(off);
-  ensure(cell_items, ctx, items.size());
+  ensure_nonempty(cell_items, ctx, items.size());
   cell_items.upload(items);
 
-  ensure(qbad, ctx, nq);
+  ensure_nonempty(qbad, ctx, nq);
   qbad.fill(0u);
   launch(ctx, "sguard_surface", dm.nt, cl_uint(dm.nt), c.edges.buffer(), s.dir.buffer(), dm.points.buffer(),
          dm.tets.buffer(), c.tet_nbr.buffer(), labels, use_labels, qedge.buffer(), qbox.buffer(), qoff.buffer(),

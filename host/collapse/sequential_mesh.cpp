@@ -60,27 +60,8 @@ bool runs(const int32_t* q, int f, int32_t x, int32_t y) {
 
 SeqMesh::SeqMesh(Mesh& mesh, const SeqParams& params)
     : mesh_(mesh), points_(&mesh.points), tets_(&mesh.tets), p_(params) {
-  // the same refusals as the device pipeline's upload (host/collapse/stages.cpp)
-  if (mesh.points.size() % 3 != 0 || mesh.tets.size() % 4 != 0)
-    throw InputError("<mesh>", "point or tet array length is not a multiple of 3 or 4");
+  collapse_detail::check_collapse_input(mesh);  // the same refusals as the device pipeline
   const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
-  if (nv >= std::numeric_limits<int32_t>::max() || nt >= std::numeric_limits<int32_t>::max() / 12)
-    throw InputError("<mesh>", "mesh too large for 32-bit indices: " + std::to_string(nv) + " vertices, " +
-                                   std::to_string(nt) + " tets");
-  for (int64_t t = 0; t < nt; ++t) {
-    const int32_t* q = &mesh.tets[4 * t];
-    for (int i = 0; i < 4; ++i) {
-      if (q[i] < 0 || q[i] >= nv)
-        throw InputError("<mesh>", "tet " + std::to_string(t) + " has vertex index " + std::to_string(q[i]) +
-                                       " outside [0, " + std::to_string(nv) + ")");
-      for (int j = 0; j < i; ++j)
-        if (q[i] == q[j]) throw InputError("<mesh>", "tet " + std::to_string(t) + " repeats vertex " + std::to_string(q[i]));
-    }
-  }
-  for (const Labels& l : mesh.tet_labels)
-    if (l.values.size() != size_t(nt))
-      throw InputError("<mesh>", "label array '" + l.name + "' has " + std::to_string(l.values.size()) +
-                                     " values for " + std::to_string(nt) + " tets");
   auto check_fields = [](const std::vector<Field>& fields, int64_t count, const char* kind) {
     for (const Field& f : fields)
       if (f.components <= 0 || f.values.size() != size_t(count) * size_t(f.components))

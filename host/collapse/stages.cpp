@@ -16,12 +16,6 @@ namespace tc::collapse_detail {
 
 namespace {
 
-template <class T>
-void ensure(DeviceBuffer<T>& b, Context& ctx, size_t n) {
-  if (!b.buffer()()) b = DeviceBuffer<T>(ctx, n);
-  else b.resize(n);
-}
-
 template <class... A>
 void set_args(cl::Kernel& k, const char* what, const A&... a) {
   detail::cl_call(what, [&] {
@@ -80,13 +74,13 @@ StageParams params_from(const CollapseOptions& o) {
   return p;
 }
 
-void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm) {
-  const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
+void check_collapse_input(const Mesh& mesh) {
   if (mesh.points.size() % 3 != 0 || mesh.tets.size() % 4 != 0)
     throw InputError("<mesh>", "point or tet array length is not a multiple of 3 or 4");
+  const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
   // Edges and N(v) entries must fit 31-bit indices: 12 nt scratch slots bound both.
   if (nv >= std::numeric_limits<int32_t>::max() || nt >= std::numeric_limits<int32_t>::max() / 12)
-    throw InputError("<mesh>", "mesh too large for the device pipeline's 32-bit indices: " + std::to_string(nv) +
+    throw InputError("<mesh>", "mesh too large for the collapse's 32-bit indices: " + std::to_string(nv) +
                                    " vertices, " + std::to_string(nt) + " tets");
   for (int64_t t = 0; t < nt; ++t) {
     const int32_t* q = &mesh.tets[4 * t];
@@ -98,15 +92,21 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
         if (q[i] == q[j]) throw InputError("<mesh>", "tet " + std::to_string(t) + " repeats vertex " + std::to_string(q[i]));
     }
   }
+  for (const Labels& l : mesh.tet_labels)
+    if (l.values.size() != size_t(nt))
+      throw InputError("<mesh>", "label array '" + l.name + "' has " + std::to_string(l.values.size()) +
+                                     " values for " + std::to_string(nt) + " tets");
+}
+
+void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm) {
+  check_collapse_input(mesh);
+  const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
   dm.nv = uint32_t(nv);
   dm.nt = uint32_t(nt);
   dm.points = DeviceBuffer<double>(ctx, mesh.points);
   dm.tets = DeviceBuffer<int32_t>(ctx, mesh.tets);
   dm.labels.clear();
   for (const Labels& l : mesh.tet_labels) {
-    if (l.values.size() != size_t(nt))
-      throw InputError("<mesh>", "label array '" + l.name + "' has " + std::to_string(l.values.size()) +
-                                     " values for " + std::to_string(nt) + " tets");
     dm.labels.emplace_back(ctx, l.values);
   }
   dm.has_labels = !dm.labels.empty() && o.use_labels;
@@ -358,17 +358,19 @@ uint32_t prepare_candidates(Context& ctx, EdgeState& s, const DeviceBuffer<uint3
 // Runs `round` (its arguments from kRoundArgs on already set) over all n candidate slots,
 // then over the worklist of those still waiting, until none is left undecided. Every round
 // decides at least the undecided candidate of smallest (cost, index), so this terminates.
-void worklist_rounds(Context& ctx, cl::Kernel& round, EdgeState& s, uint32_t n, const char* what) {
+// The worklist loop of the conflict rounds: round(n, first, cur) enqueues one round over the n
+// entries of s.work[cur] (all candidates when first), which appends those still undecided to
+// s.work[1 - cur] via s.work_n; repeats until none is left.
+template <class Round>
+void rounds(Context& ctx, EdgeState& s, uint32_t n, const char* what, const Round& round) {
   ensure(s.work_n, ctx, 1);
   ensure(s.work[0], ctx, n);
   ensure(s.work[1], ctx, n);
   int cur = 0;
   for (cl_int first = 1; n > 0; first = 0) {
     s.work_n.fill(0);
-    set_args(round, what, U(n), first, B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n), B(s.cand_edges),
-             B(s.rivals), B(s.rcount));
     auto t0 = std::chrono::steady_clock::now();
-    ctx.launch(round, n, what);
+    round(n, first, cur);
     uint32_t next = 0;
     s.work_n.download(&next, 1);
     if (kProfile)
@@ -377,6 +379,14 @@ void worklist_rounds(Context& ctx, cl::Kernel& round, EdgeState& s, uint32_t n, 
     n = next;
     cur = 1 - cur;
   }
+}
+
+void worklist_rounds(Context& ctx, cl::Kernel& round, EdgeState& s, uint32_t n, const char* what) {
+  rounds(ctx, s, n, what, [&](uint32_t m, cl_int first, int cur) {
+    set_args(round, what, U(m), first, B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n), B(s.cand_edges),
+             B(s.rivals), B(s.rcount));
+    ctx.launch(round, m, what);
+  });
 }
 
 // Sets the round kernel's arguments from `first_arg` on.
@@ -401,32 +411,19 @@ constexpr cl_uint kDecideArgs = 11;
 // undecided. s.vaff must be -1 everywhere; it ends with the IN edge at each vertex.
 void pass1_rounds(Context& ctx, cl::Kernel& decide, EdgeState& s, const Connectivity& c, uint32_t nv, uint32_t n,
                   const char* what) {
-  ensure(s.work_n, ctx, 1);
-  ensure(s.work[0], ctx, n);
-  ensure(s.work[1], ctx, n);
   ensure(s.slot[0], ctx, nv);
   ensure(s.slot[1], ctx, nv);
   s.slot[0].fill(-1);
   s.slot[1].fill(-1);
   cl::Kernel claim = ctx.kernel("collapse_conflict.cl", "pass1_claim");
-  int cur = 0;
-  for (cl_int first = 1; n > 0; first = 0) {
-    s.work_n.fill(0);
-    auto t0 = std::chrono::steady_clock::now();
-    set_args(claim, "pass1_claim", U(n), first, B(s.work[cur]), B(s.cand_edges), B(c.edges), B(s.cost), B(s.vaff),
+  rounds(ctx, s, n, what, [&](uint32_t m, cl_int first, int cur) {
+    set_args(claim, "pass1_claim", U(m), first, B(s.work[cur]), B(s.cand_edges), B(c.edges), B(s.cost), B(s.vaff),
              B(s.slot[cur]), B(s.state));
-    ctx.launch(claim, n, "pass1_claim");
-    set_args(decide, what, U(n), first, B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n), B(s.cand_edges), B(c.edges),
+    ctx.launch(claim, m, "pass1_claim");
+    set_args(decide, what, U(m), first, B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n), B(s.cand_edges), B(c.edges),
              B(s.slot[cur]), B(s.slot[1 - cur]), B(s.state), B(s.vaff));
-    ctx.launch(decide, n, what);
-    uint32_t next = 0;
-    s.work_n.download(&next, 1);
-    if (kProfile)
-      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s\n", what, n,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    n = next;
-    cur = 1 - cur;
-  }
+    ctx.launch(decide, m, what);
+  });
 }
 }  // namespace
 

@@ -89,6 +89,18 @@ struct EdgeState {
   DeviceBuffer<int32_t> upd_vt, upd_tet_nbr;
 };
 
+// A device buffer of n elements: allocated on first use, else resized (DeviceBuffer::resize).
+template <class T>
+void ensure(DeviceBuffer<T>& b, Context& ctx, size_t n) {
+  if (!b.buffer()()) b = DeviceBuffer<T>(ctx, n);
+  else b.resize(n);
+}
+
+// The refusals both methods share (tc::InputError): array lengths, sizes beyond 32-bit indices
+// (12 nt scratch slots must fit), tet vertex indices out of range or repeated, label arrays of
+// the wrong length.
+void check_collapse_input(const Mesh& mesh);
+
 enum Reason : uint8_t {
   kOk = 0, kNotMarked = 1, kRefusedQ = 2, kRefusedLink = 3, kRefusedVolume = 4, kRefusedQuality = 6,
   kUntested = 5,  // lazy filter: passed Q, never tested because a cheaper rival won
