@@ -256,25 +256,16 @@ __kernel void lazy_init(uint ne, __global const int* edges, __global const uint*
   atomic_inc(&counters[5]);
 }
 
-/* The decision half of a pass-1 round (pass1_claim in collapse_conflict.cl is the other): an
- * edge whose turn comes is tested (or takes the verdict carried from an earlier iteration) and
- * is IN when it passes, OUT otherwise. */
-__kernel void lazy_pass1_decide(uint n, int first, __global const uint* list, __global uint* next,
-                                __global uint* next_n, __global const uint* cand, __global const int* edges,
-                                __global const int* slot, __global int* slot_next, __global uchar* state,
-                                __global int* vaff, __global const int* tets, __global const uint* vt_off,
-                                __global const int* vt, __global const int* tet_nbr, __global const uint* nb_off,
-                                __global const int* nb,
-                                __global const int* nb_edge, __global const int* labels, int use_labels,
-                                __global const double* pts, __global const uchar* vflags,
-                                __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
-                                double eps_v, double q_min, __global const double* tet_quality,
-                                __global uchar* edge_dir, __global uchar* reason, __global uint* counters,
-                                __global uchar* verdict) {
-  uint i = get_global_id(0);
-  if (i >= n) return;
-  int e;
-  if (tcc_pass1_turn(i, first, list, next, next_n, cand, edges, slot, slot_next, state, &e) <= 0) return;
+/* The turn of edge e in the lazy filter: its link and volume tests (or the verdict carried
+ * from an earlier iteration), then IN (vaff of both end points) or OUT. */
+inline void tcc_lazy_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
+                            __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                            __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
+                            __global const int* nb_edge, __global const int* labels, int use_labels,
+                            __global const double* pts, __global const uchar* vflags, __global const uchar* vclass,
+                            __global const uchar* eflags, int mode, int paper_rule, double eps_v, double q_min,
+                            __global const double* tet_quality, __global uchar* edge_dir, __global uchar* reason,
+                            __global uint* counters, __global uchar* verdict) {
   int a = edges[2 * e], b = edges[2 * e + 1];
   uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
   int dir = tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule);
@@ -295,5 +286,69 @@ __kernel void lazy_pass1_decide(uint n, int first, __global const uint* list, __
     vaff[b] = e;
   } else {
     state[e] = TCC_OUT;
+  }
+}
+
+/* The decision half of a pass-1 round (pass1_claim in collapse_conflict.cl is the other): an
+ * edge whose turn comes is tested (or takes the verdict carried from an earlier iteration) and
+ * is IN when it passes, OUT otherwise. */
+__kernel void lazy_pass1_decide(uint n, int first, __global const uint* list, __global uint* next,
+                                __global uint* next_n, __global const uint* cand, __global const int* edges,
+                                __global const int* slot, __global int* slot_next, __global uchar* state,
+                                __global int* vaff, __global const int* tets, __global const uint* vt_off,
+                                __global const int* vt, __global const int* tet_nbr, __global const uint* nb_off,
+                                __global const int* nb,
+                                __global const int* nb_edge, __global const int* labels, int use_labels,
+                                __global const double* pts, __global const uchar* vflags,
+                                __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
+                                double eps_v, double q_min, __global const double* tet_quality,
+                                __global uchar* edge_dir, __global uchar* reason, __global uint* counters,
+                                __global uchar* verdict) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  int e;
+  if (tcc_pass1_turn(i, first, list, next, next_n, cand, edges, slot, slot_next, state, &e) > 0)
+    tcc_lazy_decide(e, edges, state, vaff, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass, eflags, mode,
+                    paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict);
+}
+
+/* The remaining pass-1 rounds in one work-group, when few candidates are left: a round then
+ * costs two barriers instead of two launches and a read-back (about 90 us on PoCL). The same
+ * rounds as pass1_claim + lazy_pass1_decide per launch, so the same result. On entry the
+ * host's state: n entries in the worklist `cur` (all candidates when first), slots[cur] for
+ * this round's claims, cnt[0] = cnt[1] = 0; the worklists and slots alternate as on the host,
+ * round r appending to cnt[cur]. */
+__kernel void lazy_pass1_rounds(uint n, int first, int cur, __global uint* list0, __global uint* list1,
+                                __global uint* cnt, __global const uint* cand, __global const int* edges,
+                                __global const double* cost, __global int* slot0, __global int* slot1,
+                                __global uchar* state, __global int* vaff, __global const int* tets, __global const uint* vt_off,
+                                __global const int* vt, __global const int* tet_nbr, __global const uint* nb_off,
+                                __global const int* nb,
+                                __global const int* nb_edge, __global const int* labels, int use_labels,
+                                __global const double* pts, __global const uchar* vflags,
+                                __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
+                                double eps_v, double q_min, __global const double* tet_quality,
+                                __global uchar* edge_dir, __global uchar* reason, __global uint* counters,
+                                __global uchar* verdict) {
+  const uint lid = get_local_id(0), ls = get_local_size(0);
+  while (n > 0) {
+    __global uint* list = cur ? list1 : list0;
+    __global uint* next = cur ? list0 : list1;
+    __global int* slot = cur ? slot1 : slot0;
+    __global int* slot_next = cur ? slot0 : slot1;
+    for (uint i = lid; i < n; i += ls) tcc_pass1_claim(i, first, list, cand, edges, cost, vaff, slot, state);
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    for (uint i = lid; i < n; i += ls) {
+      int e;
+      if (tcc_pass1_turn(i, first, list, next, cnt + cur, cand, edges, slot, slot_next, state, &e) > 0)
+        tcc_lazy_decide(e, edges, state, vaff, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass, eflags, mode,
+                    paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict);
+    }
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    n = cnt[cur];
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    if (lid == 0) cnt[cur] = 0;
+    first = 0;
+    cur = 1 - cur;
   }
 }

@@ -42,14 +42,7 @@ __kernel void pass1_claim(uint n, int first, __global const uint* list, __global
                           volatile __global int* slot, __global uchar* state) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  int e = (int)cand[first ? i : list[i]];
-  int a = edges[2 * e], b = edges[2 * e + 1];
-  if (vaff[a] >= 0 || vaff[b] >= 0) {
-    state[e] = TCC_OUT;
-    return;
-  }
-  tcc_claim(slot + a, e, cost);
-  tcc_claim(slot + b, e, cost);
+  tcc_pass1_claim(i, first, list, cand, edges, cost, vaff, slot, state);
 }
 
 /* Pass 1 over admissible edges (every edge tested beforehand): a turn means IN. */
