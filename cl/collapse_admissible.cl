@@ -257,8 +257,8 @@ __kernel void lazy_init(uint ne, __global const int* edges, __global const uint*
 }
 
 /* The turn of edge e in the lazy filter: its link and volume tests (or the verdict carried
- * from an earlier iteration), then IN (vaff of both end points) or OUT. */
-inline void tcc_lazy_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
+ * from an earlier iteration), then IN (vaff of both end points; returns 1) or OUT (0). */
+inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
                             __global const int* tets, __global const uint* vt_off, __global const int* vt,
                             __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
                             __global const int* nb_edge, __global const int* labels, int use_labels,
@@ -284,71 +284,154 @@ inline void tcc_lazy_decide(int e, __global const int* edges, __global uchar* st
     state[e] = TCC_IN;
     vaff[a] = e;
     vaff[b] = e;
+    return 1;
+  }
+  state[e] = TCC_OUT;
+  return 0;
+}
+
+/* Pass 1 of the lazy filter, driven by the vertices whose first undecided edge changed.
+ *
+ * slot[v] is the first undecided candidate at v in (cost, index) order (-1 when none), and an
+ * edge whose turn comes (slot[a] == slot[b] == e: every edge before it at a and b is OUT) is
+ * in the turn list of the round. A round (lazy_p1_decide, lazy_p1_recompute, lazy_p1_turns):
+ *   decide     each edge of the turn list is tested (tcc_lazy_decide): IN makes every undecided
+ *              edge at a and b OUT and lists their other end points; OUT lists a and b;
+ *   recompute  slot[v] anew for the listed vertices (duplicates compute the same value);
+ *   turns      the edges now first at both end points, each once (queued[e] = round).
+ * Only the vertices where something was decided are looked at, so a pass costs about the
+ * number of candidates times the vertex degree, where rescanning every undecided candidate in
+ * every round (pass1_claim + conflict_pass1_decide) costs that times the number of rounds (about
+ * 100 on W1). Same decisions as those rounds: a decision depends only on final decisions of
+ * edges before it (see collapse_conflict.cl). Turn-list edges share no vertex, so their
+ * decisions do not race. The first turn list: lazy_p1_claim_all, lazy_p1_first_turns. */
+__kernel void lazy_p1_claim_all(uint n, __global const uint* cand, __global const int* edges,
+                                __global const double* cost, volatile __global int* slot) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  int e = (int)cand[i];
+  tcc_claim(slot + edges[2 * e], e, cost);
+  tcc_claim(slot + edges[2 * e + 1], e, cost);
+}
+
+__kernel void lazy_p1_first_turns(uint n, __global const uint* cand, __global const int* edges,
+                                  __global const int* slot, __global uint* tlist, __global uint* cnt) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  int e = (int)cand[i];
+  if (slot[edges[2 * e]] == e && slot[edges[2 * e + 1]] == e) tlist[atomic_inc(cnt)] = (uint)e;
+}
+
+inline void tcc_p1_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
+                          __global uint* dlist, __global uint* dn, __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                               __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
+                               __global const int* nb_edge, __global const int* labels, int use_labels,
+                               __global const double* pts, __global const uchar* vflags, __global const uchar* vclass,
+                               __global const uchar* eflags, int mode, int paper_rule, double eps_v, double q_min,
+                               __global const double* tet_quality, __global uchar* edge_dir, __global uchar* reason,
+                               __global uint* counters, __global uchar* verdict) {
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  if (tcc_lazy_decide(e, edges, state, vaff, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass,
+                      eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict)) {
+    for (int s = 0; s < 2; ++s) {
+      int x = s == 0 ? a : b;
+      for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) {
+        int g = nb_edge[j];
+        if (g == e || state[g] != TCC_UNDECIDED) continue;
+        state[g] = TCC_OUT; /* two IN edges may both do this: the same write, one more listing */
+        dlist[atomic_inc(dn)] = (uint)nb[j];
+      }
+    }
   } else {
-    state[e] = TCC_OUT;
+    dlist[atomic_inc(dn)] = (uint)a;
+    dlist[atomic_inc(dn)] = (uint)b;
   }
 }
 
-/* The decision half of a pass-1 round (pass1_claim in collapse_conflict.cl is the other): an
- * edge whose turn comes is tested (or takes the verdict carried from an earlier iteration) and
- * is IN when it passes, OUT otherwise. */
-__kernel void lazy_pass1_decide(uint n, int first, __global const uint* list, __global uint* next,
-                                __global uint* next_n, __global const uint* cand, __global const int* edges,
-                                __global const int* slot, __global int* slot_next, __global uchar* state,
-                                __global int* vaff, __global const int* tets, __global const uint* vt_off,
-                                __global const int* vt, __global const int* tet_nbr, __global const uint* nb_off,
-                                __global const int* nb,
-                                __global const int* nb_edge, __global const int* labels, int use_labels,
-                                __global const double* pts, __global const uchar* vflags,
-                                __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
-                                double eps_v, double q_min, __global const double* tet_quality,
-                                __global uchar* edge_dir, __global uchar* reason, __global uint* counters,
-                                __global uchar* verdict) {
-  uint i = get_global_id(0);
-  if (i >= n) return;
-  int e;
-  if (tcc_pass1_turn(i, first, list, next, next_n, cand, edges, slot, slot_next, state, &e) > 0)
-    tcc_lazy_decide(e, edges, state, vaff, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass, eflags, mode,
-                    paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict);
+inline void tcc_p1_recompute(int v, __global const uint* nb_off, __global const int* nb_edge,
+                             __global const uchar* state, __global const double* cost, __global int* slot) {
+  int m = -1;
+  for (uint j = nb_off[v]; j < nb_off[v + 1]; ++j) {
+    int g = nb_edge[j];
+    if (state[g] == TCC_UNDECIDED && (m < 0 || tcc_before(cost, g, m))) m = g;
+  }
+  slot[v] = m;
 }
 
-/* The remaining pass-1 rounds in one work-group, when few candidates are left: a round then
- * costs two barriers instead of two launches and a read-back (about 90 us on PoCL). The same
- * rounds as pass1_claim + lazy_pass1_decide per launch, so the same result. On entry the
- * host's state: n entries in the worklist `cur` (all candidates when first), slots[cur] for
- * this round's claims, cnt[0] = cnt[1] = 0; the worklists and slots alternate as on the host,
- * round r appending to cnt[cur]. */
-__kernel void lazy_pass1_rounds(uint n, int first, int cur, __global uint* list0, __global uint* list1,
-                                __global uint* cnt, __global const uint* cand, __global const int* edges,
-                                __global const double* cost, __global int* slot0, __global int* slot1,
-                                __global uchar* state, __global int* vaff, __global const int* tets, __global const uint* vt_off,
-                                __global const int* vt, __global const int* tet_nbr, __global const uint* nb_off,
-                                __global const int* nb,
-                                __global const int* nb_edge, __global const int* labels, int use_labels,
-                                __global const double* pts, __global const uchar* vflags,
-                                __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
-                                double eps_v, double q_min, __global const double* tet_quality,
-                                __global uchar* edge_dir, __global uchar* reason, __global uint* counters,
-                                __global uchar* verdict) {
+inline void tcc_p1_turn(int v, __global const int* edges, __global const int* slot, __global uint* tlist,
+                        __global uint* tn, volatile __global uint* queued, uint round) {
+  int m = slot[v];
+  if (m < 0 || slot[edges[2 * m]] != m || slot[edges[2 * m + 1]] != m) return;
+  if (atomic_xchg(queued + m, round) == round) return; /* listed from its other end point */
+  tlist[atomic_inc(tn)] = (uint)m;
+}
+
+/* Per-round kernels: cnt[0], cnt[1] count the two turn lists, cnt[2] the vertex list. */
+__kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const int* edges, __global uchar* state,
+                             __global int* vaff, __global uint* dlist, __global uint* cnt, __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                               __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
+                               __global const int* nb_edge, __global const int* labels, int use_labels,
+                               __global const double* pts, __global const uchar* vflags, __global const uchar* vclass,
+                               __global const uchar* eflags, int mode, int paper_rule, double eps_v, double q_min,
+                               __global const double* tet_quality, __global uchar* edge_dir, __global uchar* reason,
+                               __global uint* counters, __global uchar* verdict) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  tcc_p1_decide((int)tlist[i], edges, state, vaff, dlist, cnt + 2, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass,
+                      eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict);
+}
+
+__kernel void lazy_p1_recompute(uint n, __global const uint* dlist, __global const uint* nb_off,
+                                __global const int* nb_edge, __global const uchar* state, __global const double* cost,
+                                __global int* slot) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, cost, slot);
+}
+
+__kernel void lazy_p1_turns(uint n, __global const uint* dlist, __global const int* edges, __global const int* slot,
+                            __global uint* tlist, __global uint* cnt, uint which, __global uint* queued, uint round) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  tcc_p1_turn((int)dlist[i], edges, slot, tlist, cnt + which, queued, round);
+}
+
+/* The remaining rounds in one work-group, once the turn list is short: a round then costs
+ * barriers instead of three launches and two read-backs (about 90 us each on PoCL). Entry:
+ * the n edges of turn list `cur` (t0 or t1) are round `round`'s; cnt[0..2] (turn-list
+ * lengths, vertex-list length) are 0. */
+__kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __global uint* t1, __global uint* cnt,
+                           __global uint* dlist, __global uint* queued, __global const int* edges,
+                           __global const double* cost, __global int* slot, __global uchar* state, __global int* vaff,
+                           __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                               __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
+                               __global const int* nb_edge, __global const int* labels, int use_labels,
+                               __global const double* pts, __global const uchar* vflags, __global const uchar* vclass,
+                               __global const uchar* eflags, int mode, int paper_rule, double eps_v, double q_min,
+                               __global const double* tet_quality, __global uchar* edge_dir, __global uchar* reason,
+                               __global uint* counters, __global uchar* verdict) {
   const uint lid = get_local_id(0), ls = get_local_size(0);
   while (n > 0) {
-    __global uint* list = cur ? list1 : list0;
-    __global uint* next = cur ? list0 : list1;
-    __global int* slot = cur ? slot1 : slot0;
-    __global int* slot_next = cur ? slot0 : slot1;
-    for (uint i = lid; i < n; i += ls) tcc_pass1_claim(i, first, list, cand, edges, cost, vaff, slot, state);
+    __global uint* tl = cur ? t1 : t0;
+    __global uint* tnext = cur ? t0 : t1;
+    __global uint* cnext = cnt + (1 - cur);
+    for (uint i = lid; i < n; i += ls)
+      tcc_p1_decide((int)tl[i], edges, state, vaff, dlist, cnt + 2, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass,
+                      eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict);
     barrier(CLK_GLOBAL_MEM_FENCE);
-    for (uint i = lid; i < n; i += ls) {
-      int e;
-      if (tcc_pass1_turn(i, first, list, next, cnt + cur, cand, edges, slot, slot_next, state, &e) > 0)
-        tcc_lazy_decide(e, edges, state, vaff, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass, eflags, mode,
-                    paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict);
+    const uint nd = cnt[2];
+    for (uint i = lid; i < nd; i += ls) tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, cost, slot);
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    for (uint i = lid; i < nd; i += ls) tcc_p1_turn((int)dlist[i], edges, slot, tnext, cnext, queued, round + 1);
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    n = *cnext;
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    if (lid == 0) {
+      cnt[2] = 0;
+      *cnext = 0;
     }
     barrier(CLK_GLOBAL_MEM_FENCE);
-    n = cnt[cur];
-    barrier(CLK_GLOBAL_MEM_FENCE);
-    if (lid == 0) cnt[cur] = 0;
-    first = 0;
     cur = 1 - cur;
+    ++round;
   }
 }

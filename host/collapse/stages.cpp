@@ -361,31 +361,14 @@ uint32_t prepare_candidates(Context& ctx, EdgeState& s, const DeviceBuffer<uint3
 // The worklist loop of the conflict rounds: round(n, first, cur) enqueues one round over the n
 // entries of s.work[cur] (all candidates when first), which appends those still undecided to
 // s.work[1 - cur] via s.work_n; repeats until none is left.
-// When `tail` is given, the rounds left once at most kTailSize entries remain go to
-// tail(n, first, cur) instead, which runs them all in one launch (one work-group).
-constexpr uint32_t kTailSize = 2048;
-struct NoTail {
-  void operator()(uint32_t, cl_int, int) const {}
-};
-
-template <class Round, class Tail = NoTail>
-void rounds(Context& ctx, EdgeState& s, uint32_t n, const char* what, const Round& round, const Tail* tail = nullptr) {
-  ensure(s.work_n, ctx, 2);
+template <class Round>
+void rounds(Context& ctx, EdgeState& s, uint32_t n, const char* what, const Round& round) {
+  ensure(s.work_n, ctx, 3);  // 3: lazy_p1_rounds
   ensure(s.work[0], ctx, n);
   ensure(s.work[1], ctx, n);
   int cur = 0;
   for (cl_int first = 1; n > 0; first = 0) {
     s.work_n.fill(0);
-    if (tail && n <= kTailSize) {
-      auto t0 = std::chrono::steady_clock::now();
-      (*tail)(n, first, cur);
-      if (kProfile) {
-        ctx.finish();
-        std::fprintf(stderr, "  %-28s n=%-9u %8.4f s (all remaining rounds)\n", what, n,
-                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      }
-      return;
-    }
     auto t0 = std::chrono::steady_clock::now();
     round(n, first, cur);
     uint32_t next = 0;
@@ -427,7 +410,7 @@ constexpr cl_uint kDecideArgs = 11;
 // kDecideArgs on are already set) over the n candidates of s.cand_edges until none is left
 // undecided. s.vaff must be -1 everywhere; it ends with the IN edge at each vertex.
 void pass1_rounds(Context& ctx, cl::Kernel& decide, EdgeState& s, const Connectivity& c, uint32_t nv, uint32_t n,
-                  const char* what, cl::Kernel* tail_kernel = nullptr) {
+                  const char* what) {
   ensure(s.slot[0], ctx, nv);
   ensure(s.slot[1], ctx, nv);
   s.slot[0].fill(-1);
@@ -437,27 +420,69 @@ void pass1_rounds(Context& ctx, cl::Kernel& decide, EdgeState& s, const Connecti
     set_args(claim, "pass1_claim", U(m), first, B(s.work[cur]), B(s.cand_edges), B(c.edges), B(s.cost), B(s.vaff),
              B(s.slot[cur]), B(s.state));
     ctx.launch(claim, m, "pass1_claim");
-    if (kProfile) {
-      auto t0 = std::chrono::steady_clock::now();
-      ctx.finish();
-      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s\n", "pass1_claim", m,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    }
     set_args(decide, what, U(m), first, B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n), B(s.cand_edges), B(c.edges),
              B(s.slot[cur]), B(s.slot[1 - cur]), B(s.state), B(s.vaff));
     ctx.launch(decide, m, what);
   };
-  if (!tail_kernel) {
-    rounds(ctx, s, n, what, round);
-    return;
+  rounds(ctx, s, n, what, round);
+}
+}  // namespace
+
+namespace {
+// The turn list at most this long: the remaining rounds run in one work-group (lazy_p1_loop).
+constexpr uint32_t kLoopTurns = 128;
+
+// Pass 1 of the lazy filter over the n candidates of s.cand_edges (cl/collapse_admissible.cl,
+// lazy_p1_*): rounds over the turn list until it is empty. `decide` and `loop` have the
+// test's arguments set. s.vaff must be -1 everywhere.
+void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, uint32_t nv, uint32_t n, cl::Kernel& decide,
+                    cl::Kernel& loop) {
+  const std::string A = "collapse_admissible.cl";
+  ensure(s.slot[0], ctx, nv);
+  ensure(s.queued, ctx, c.ne);
+  ensure(s.work[0], ctx, n);
+  ensure(s.work[1], ctx, n);
+  ensure(s.dlist, ctx, 2 * size_t(n) + 1);  // an edge is listed at most twice per pass
+  ensure(s.work_n, ctx, 3);
+  s.slot[0].fill(-1);
+  s.queued.fill(0xffffffffu);
+  s.work_n.fill(0);
+  if (n == 0) return;
+  run(ctx, A, "lazy_p1_claim_all", n, "", U(n), B(s.cand_edges), B(c.edges), B(s.cost), B(s.slot[0]));
+  run(ctx, A, "lazy_p1_first_turns", n, "", U(n), B(s.cand_edges), B(c.edges), B(s.slot[0]), B(s.work[0]),
+      B(s.work_n));
+  uint32_t nt = 0;
+  s.work_n.download(&nt, 1);
+  cl::Kernel recompute = ctx.kernel(A, "lazy_p1_recompute"), turns = ctx.kernel(A, "lazy_p1_turns");
+  int cur = 0;
+  for (cl_uint round = 0; nt > 0; ++round, cur = 1 - cur) {
+    auto t0 = std::chrono::steady_clock::now();
+    s.work_n.fill(0);
+    if (nt <= kLoopTurns) {
+      set_args(loop, "lazy_p1_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(s.dlist),
+               B(s.queued), B(c.edges), B(s.cost), B(s.slot[0]), B(s.state), B(s.vaff));
+      ctx.launch(loop, ctx.group_size_for(loop), "lazy_p1_loop");
+      nt = 0;
+    } else {
+      set_args(decide, "lazy_p1_decide", U(nt), B(s.work[cur]), B(c.edges), B(s.state), B(s.vaff), B(s.dlist),
+               B(s.work_n));
+      ctx.launch(decide, nt, "lazy_p1_decide");
+      uint32_t nd = 0;
+      s.work_n.download(&nd, 1, 2);
+      set_args(recompute, "lazy_p1_recompute", U(nd), B(s.dlist), B(c.nb_off), B(c.nb_edge), B(s.state), B(s.cost),
+               B(s.slot[0]));
+      ctx.launch(recompute, nd, "lazy_p1_recompute");
+      set_args(turns, "lazy_p1_turns", U(nd), B(s.dlist), B(c.edges), B(s.slot[0]), B(s.work[1 - cur]), B(s.work_n),
+               cl_uint(1 - cur), B(s.queued), round + 1);
+      ctx.launch(turns, nd, "lazy_p1_turns");
+      s.work_n.download(&nt, 1, size_t(1 - cur));
+    }
+    if (kProfile) {
+      ctx.finish();
+      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s\n", "lazy_p1_round", nt,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
   }
-  // the tail: arguments from kDecideArgs - 2 on as the decide kernel's from kDecideArgs on
-  auto tail = [&](uint32_t m, cl_int first, int cur) {
-    set_args(*tail_kernel, what, U(m), first, cl_int(cur), B(s.work[0]), B(s.work[1]), B(s.work_n), B(s.cand_edges),
-             B(c.edges), B(s.cost), B(s.slot[0]), B(s.slot[1]), B(s.state), B(s.vaff));
-    ctx.launch(*tail_kernel, ctx.group_size_for(*tail_kernel), what);
-  };
-  rounds(ctx, s, n, what, round, &tail);
 }
 }  // namespace
 
@@ -498,15 +523,15 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
       restrict_clean ? B(s.vdirty) : B(c.vflags));
   ensure(s.cand_edges, ctx, c.ne);
   const uint32_t n = dev::compact_indices(ctx, s.cand, s.cand_edges, c.ne);
-  // the test's arguments, the same for the per-round kernel and the one-work-group tail
-  cl::Kernel decide = ctx.kernel(A, "lazy_pass1_decide"), tail = ctx.kernel(A, "lazy_pass1_rounds");
+  // the test's arguments, the same for the per-round kernel and the one-work-group loop
+  cl::Kernel decide = ctx.kernel(A, "lazy_p1_decide"), loop = ctx.kernel(A, "lazy_p1_loop");
   const cl::Buffer& quality = tet_qualities(ctx, dm, s, p);
-  for (auto [k, first] : {std::pair<cl::Kernel*, cl_uint>{&decide, kDecideArgs}, {&tail, kDecideArgs + 2}})
-    set_args_from(*k, first, "lazy_pass1_decide", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb),
+  for (auto [k, first] : {std::pair<cl::Kernel*, cl_uint>{&decide, 7}, {&loop, 13}})
+    set_args_from(*k, first, "lazy_p1_decide", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb),
                   B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass), B(c.eflags),
                   mode, paper_rule, p.eps_v, p.min_quality, quality, B(s.dir), B(s.reason), B(s.counters),
                   B(s.verdict));
-  pass1_rounds(ctx, decide, s, c, dm.nv, n, "lazy_pass1_decide", &tail);
+  lazy_p1_rounds(ctx, s, c, dm.nv, n, decide, loop);
   run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1),
       B(s.vaff), B(s.counters));
   uint32_t cnt[6];

@@ -54,6 +54,7 @@ struct EdgeState {
   // length of the next worklist, stored rivals per slot (pass 2) and their count.
   DeviceBuffer<uint32_t> cand_edges, work[2], work_n, rivals, rcount;
   DeviceBuffer<int32_t> slot[2];    // pass 1: per-vertex claims (collapse_conflict.cl)
+  DeviceBuffer<uint32_t> queued, dlist;  // lazy pass 1: turn-list stamps, vertex list (lazy_p1_*)
   DeviceBuffer<uint8_t> dir, reason;
   DeviceBuffer<int32_t> vaff;       // per vertex
   // marked, admissible, pass1, pass2, tested (lazy), passed Q (lazy)
