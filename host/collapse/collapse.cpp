@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "collapse/guard_surface.hpp"
+#include "collapse/spatial_order.hpp"
 #include "collapse/stages.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/error.hpp"
@@ -119,11 +120,20 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
 
   const double t_start = now();
   DeviceMesh dm, next;
-  upload_mesh(ctx, mesh, options, dm);
+  // origin: input vertex -> current vertex
+  std::vector<int32_t> origin0;
+  if (options.spatial_order) {
+    check_collapse_input(mesh);
+    SpatialOrder order = spatial_order(mesh);
+    upload_mesh(ctx, mesh, options, dm, &order);
+    origin0 = std::move(order.vertex_new);
+  } else {
+    upload_mesh(ctx, mesh, options, dm);
+    origin0.resize(dm.nv);
+    for (uint32_t i = 0; i < dm.nv; ++i) origin0[i] = int32_t(i);
+  }
   const uint32_t n_origin = dm.nv;
-  std::vector<int32_t> identity(n_origin);
-  for (uint32_t i = 0; i < n_origin; ++i) identity[i] = int32_t(i);
-  DeviceBuffer<int32_t> origin(ctx, identity);
+  DeviceBuffer<int32_t> origin(ctx, origin0);
   ctx.finish();
   report.seconds_upload = now() - t_start;
 

@@ -1,5 +1,6 @@
 // Host side of the collapse stages: buffer management and kernel launches (cl/collapse_*.cl).
 #include "collapse/stages.hpp"
+#include "collapse/spatial_order.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -98,21 +99,37 @@ void check_collapse_input(const Mesh& mesh) {
                                      " values for " + std::to_string(nt) + " tets");
 }
 
-void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm) {
+void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm, const SpatialOrder* order) {
   check_collapse_input(mesh);
   const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
+  // entity i of the device mesh is entity old(i) of `mesh` (the identity without an order)
+  auto vold = [&](int64_t i) { return order ? int64_t(order->vertex_old[size_t(i)]) : i; };
+  auto told = [&](int64_t i) { return order ? int64_t(order->tet_old[size_t(i)]) : i; };
+  auto gather = [&](const auto& values, int64_t count, size_t per, auto old) {
+    std::remove_cvref_t<decltype(values)> out(values.size());
+    for (int64_t i = 0; i < count; ++i)
+      for (size_t c = 0; c < per; ++c) out[size_t(i) * per + c] = values[size_t(old(i)) * per + c];
+    return out;
+  };
   dm.nv = uint32_t(nv);
   dm.nt = uint32_t(nt);
-  dm.points = DeviceBuffer<double>(ctx, mesh.points);
-  dm.tets = DeviceBuffer<int32_t>(ctx, mesh.tets);
+  if (!order) {
+    dm.points = DeviceBuffer<double>(ctx, mesh.points);
+    dm.tets = DeviceBuffer<int32_t>(ctx, mesh.tets);
+  } else {
+    dm.points = DeviceBuffer<double>(ctx, gather(mesh.points, nv, 3, vold));
+    std::vector<int32_t> tets = gather(mesh.tets, nt, 4, told);
+    for (int32_t& v : tets) v = order->vertex_new[size_t(v)];
+    dm.tets = DeviceBuffer<int32_t>(ctx, tets);
+  }
   dm.labels.clear();
-  for (const Labels& l : mesh.tet_labels) {
-    dm.labels.emplace_back(ctx, l.values);
+  for (const Labels& l : mesh.tet_labels) {  // lengths checked by check_collapse_input
+    dm.labels.emplace_back(ctx, order ? gather(l.values, nt, 1, told) : l.values);
   }
   dm.has_labels = !dm.labels.empty() && o.use_labels;
   if (dm.labels.empty()) dm.labels.emplace_back(ctx, 0);  // placeholder argument
   auto pack = [&](const std::vector<Field>& fields, int64_t count, const char* kind, uint32_t& comps,
-                  DeviceBuffer<double>& out) {
+                  DeviceBuffer<double>& out, auto old) {
     comps = 0;
     for (const Field& f : fields) {
       if (f.components <= 0 || f.values.size() != size_t(count) * size_t(f.components))
@@ -124,18 +141,19 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
     uint32_t c0 = 0;
     for (const Field& f : fields) {
       for (int64_t i = 0; i < count; ++i)
-        for (int c = 0; c < f.components; ++c) packed[size_t(i) * comps + c0 + c] = f.values[size_t(i) * f.components + c];
+        for (int c = 0; c < f.components; ++c)
+          packed[size_t(i) * comps + c0 + c] = f.values[size_t(old(i)) * f.components + c];
       c0 += uint32_t(f.components);
     }
     out = DeviceBuffer<double>(ctx, packed);
   };
-  pack(mesh.vertex_fields, nv, "vertex", dm.vfield_comps, dm.vfields);
-  pack(mesh.tet_fields, nt, "tet", dm.tfield_comps, dm.tfields);
+  pack(mesh.vertex_fields, nv, "vertex", dm.vfield_comps, dm.vfields, vold);
+  pack(mesh.tet_fields, nt, "tet", dm.tfield_comps, dm.tfields, told);
   dm.has_mask = !o.vertex_mask.empty();
   if (dm.has_mask && o.vertex_mask.size() != size_t(nv))
     throw std::invalid_argument("vertex_mask has " + std::to_string(o.vertex_mask.size()) + " entries for " +
                                 std::to_string(nv) + " vertices");
-  dm.vmask = DeviceBuffer<uint8_t>(ctx, o.vertex_mask);
+  dm.vmask = DeviceBuffer<uint8_t>(ctx, order && dm.has_mask ? gather(o.vertex_mask, nv, 1, vold) : o.vertex_mask);
 }
 
 uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p) {

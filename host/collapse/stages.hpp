@@ -120,7 +120,10 @@ struct StageParams {
 };
 StageParams params_from(const CollapseOptions& o);
 
-void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm);
+struct SpatialOrder;  // spatial_order.hpp
+// With an order, device vertex i is input vertex order->vertex_old[i] (tets likewise).
+void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm,
+                 const SpatialOrder* order = nullptr);
 
 // With carry (an EdgeState after note_compaction), the data (N(v), tet_nbr, vclass,
 // eflags) of the vertices whose rings did not change is copied from the previous iteration
