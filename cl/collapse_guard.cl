@@ -198,14 +198,16 @@ inline int tcc_sg_owner_cell(double3 alo, double3 ahi, __global const double* b,
 }
 
 /* Every current S face against the queries whose box it overlaps. */
-__kernel void sguard_surface(uint nt, __global const int* edges, __global const uchar* dir, __global const double* pts,
+__kernel void sguard_surface(uint n, __global const uint* stets, __global const int* edges, __global const uchar* dir,
+                             __global const double* pts,
                              __global const int* tets, __global const int* tet_nbr, __global const int* labels,
                              int use_labels, __global const int* qedge, __global const double* qbox,
                              __global const uint* qoff, __global const int* tid, __global const double* tpos,
                              double ox, double oy, double oz, double h, int gx, int gy, int gz,
                              __global const uint* cell_off, __global const uint* cell_items, __global uint* qbad) {
-  uint t = get_global_id(0);
-  if (t >= nt) return;
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  const uint t = stets[i];
   const double3 org = (double3)(ox, oy, oz);
   const int4 gd = (int4)(gx, gy, gz, 0);
   __global const int* tq = tets + 4 * t;

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "device/primitives.hpp"
 #include "tetcollapse/error.hpp"
 
 namespace tc::collapse_detail {
@@ -139,7 +140,13 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
 
   ensure_nonempty(qbad, ctx, nq);
   qbad.fill(0u);
-  launch(ctx, "sguard_surface", dm.nt, cl_uint(dm.nt), c.edges.buffer(), s.dir.buffer(), dm.points.buffer(),
+  // the tets owning an S face (conn_vertex_flags_faces), listed once per connectivity
+  if (stets_generation != c.generation) {
+    ensure_nonempty(stets, ctx, dm.nt);
+    n_stets = dev::compact_indices(ctx, c.owns_s, stets, dm.nt);
+    stets_generation = c.generation;
+  }
+  launch(ctx, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), c.edges.buffer(), s.dir.buffer(), dm.points.buffer(),
          dm.tets.buffer(), c.tet_nbr.buffer(), labels, use_labels, qedge.buffer(), qbox.buffer(), qoff.buffer(),
          tid.buffer(), tpos.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(h),
          cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());

@@ -294,8 +294,10 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
         B(c.vt_off));
   }
   c.up_count.fill(0);  // scratch reuse (its scan is done): S bits per vertex
+  ensure(c.owns_s, ctx, nt);
+  ++c.generation;
   run(ctx, F, "conn_vertex_flags_faces", nt, "", U(nt), B(dm.tets), B(c.tet_nbr), primary_labels(dm), use_labels,
-      B(c.up_count));
+      B(c.up_count), B(c.owns_s));
   run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(c.up_count), B(c.vflags));
   run(ctx, F, "conn_edge_flags", c.ne, "", U(c.ne), B(c.edges), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr),
       primary_labels(dm), use_labels, B(dm.points), p.eps_r, B(c.vflags), B(c.eflags), ci, nd, vo, pno, pnb, pne, pef);

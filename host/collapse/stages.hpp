@@ -37,6 +37,8 @@ struct Connectivity {
   DeviceBuffer<int32_t> edges;     // 2 per edge, sorted lexicographically
   DeviceBuffer<int32_t> tet_nbr;   // 4 per tet: tet across each face (collapse_common.h)
   DeviceBuffer<uint8_t> vflags, vclass, eflags;  // see collapse_common.h
+  DeviceBuffer<uint32_t> owns_s;   // per tet: 1 when it owns an S face (the surface guard's tets)
+  uint64_t generation = 0;         // incremented by every build_connectivity
   // scratch
   DeviceBuffer<uint32_t> count, cursor, up_count;
   DeviceBuffer<int32_t> scratch;
