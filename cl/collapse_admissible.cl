@@ -323,16 +323,16 @@ __kernel void lazy_p1_first_turns(uint n, __global const uint* cand, __global co
 }
 
 inline void tcc_p1_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
-                          __global uint* dlist, __global uint* dn, __global const int* tets, __global const uint* vt_off, __global const int* vt,
-                               __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
+                          __global uint* dlist, __global uint* dn, __global const int* tets,
+                               __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
                                __global const int* nb_edge, __global const int* labels, int use_labels,
                                __global const double* pts, __global const uchar* vflags, __global const uchar* vclass,
                                __global const uchar* eflags, int mode, int paper_rule, double eps_v, double q_min,
                                __global const double* tet_quality, __global uchar* edge_dir, __global uchar* reason,
                                __global uint* counters, __global uchar* verdict) {
   int a = edges[2 * e], b = edges[2 * e + 1];
-  if (tcc_lazy_decide(e, edges, state, vaff, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass,
-                      eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict)) {
+  if (tcc_lazy_decide(e, edges, state, vaff, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts,
+                      vflags, vclass, eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict)) {
     for (int s = 0; s < 2; ++s) {
       int x = s == 0 ? a : b;
       for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) {
@@ -343,14 +343,17 @@ inline void tcc_p1_decide(int e, __global const int* edges, __global uchar* stat
       }
     }
   } else {
-    dlist[atomic_inc(dn)] = (uint)a;
-    dlist[atomic_inc(dn)] = (uint)b;
+    uint base = atomic_add(dn, 2u);
+    dlist[base] = (uint)a;
+    dlist[base + 1] = (uint)b;
   }
 }
 
 inline void tcc_p1_recompute(int v, __global const uint* nb_off, __global const int* nb_edge,
                              __global const uchar* state, __global const double* cost, __global int* slot) {
-  int m = -1;
+  int m = slot[v];
+  if (m >= 0 && state[m] == TCC_UNDECIDED) return; /* decisions only remove edges: still first */
+  m = -1;
   for (uint j = nb_off[v]; j < nb_off[v + 1]; ++j) {
     int g = nb_edge[j];
     if (state[g] == TCC_UNDECIDED && (m < 0 || tcc_before(cost, g, m))) m = g;
