@@ -296,7 +296,8 @@ inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* sta
  * edge whose turn comes (slot[a] == slot[b] == e: every edge before it at a and b is OUT) is
  * in the turn list of the round. A round (lazy_p1_decide, lazy_p1_recompute, lazy_p1_turns):
  *   decide     each edge of the turn list is tested (tcc_lazy_decide): IN makes every undecided
- *              edge at a and b OUT and lists their other end points; OUT lists a and b;
+ *              edge at a and b OUT and lists their other end points where such an edge was
+ *              first; OUT lists a and b;
  *   recompute  slot[v] anew for the listed vertices (duplicates compute the same value);
  *   turns      the edges now first at both end points, each once (queued[e] = round).
  * Only the vertices where something was decided are looked at, so a pass costs about the
@@ -323,7 +324,7 @@ __kernel void lazy_p1_first_turns(uint n, __global const uint* cand, __global co
 }
 
 inline void tcc_p1_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
-                          __global uint* dlist, __global uint* dn, __global const int* tets,
+                          __global const int* slot, __global uint* dlist, __global uint* dn, __global const int* tets,
                                __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
                                __global const int* nb_edge, __global const int* labels, int use_labels,
                                __global const double* pts, __global const uchar* vflags, __global const uchar* vclass,
@@ -338,8 +339,11 @@ inline void tcc_p1_decide(int e, __global const int* edges, __global uchar* stat
       for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) {
         int g = nb_edge[j];
         if (g == e || state[g] != TCC_UNDECIDED) continue;
-        state[g] = TCC_OUT; /* two IN edges may both do this: the same write, one more listing */
-        dlist[atomic_inc(dn)] = (uint)nb[j];
+        state[g] = TCC_OUT; /* two IN edges may both do this: the same write */
+        /* the other end point y of g needs a new first edge only when g was it (slots change
+         * in lazy_p1_recompute only, so this read does not race) */
+        int y = nb[j];
+        if (slot[y] == g) dlist[atomic_inc(dn)] = (uint)y;
       }
     }
   } else {
@@ -371,7 +375,7 @@ inline void tcc_p1_turn(int v, __global const int* edges, __global const int* sl
 
 /* Per-round kernels: cnt[0], cnt[1] count the two turn lists, cnt[2] the vertex list. */
 __kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const int* edges, __global uchar* state,
-                             __global int* vaff, __global uint* dlist, __global uint* cnt, __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                             __global int* vaff, __global const int* slot, __global uint* dlist, __global uint* cnt, __global const int* tets, __global const uint* vt_off, __global const int* vt,
                                __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
                                __global const int* nb_edge, __global const int* labels, int use_labels,
                                __global const double* pts, __global const uchar* vflags, __global const uchar* vclass,
@@ -380,7 +384,7 @@ __kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const 
                                __global uint* counters, __global uchar* verdict) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  tcc_p1_decide((int)tlist[i], edges, state, vaff, dlist, cnt + 2, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass,
+  tcc_p1_decide((int)tlist[i], edges, state, vaff, slot, dlist, cnt + 2, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass,
                       eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict);
 }
 
@@ -419,7 +423,7 @@ __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __glo
     __global uint* tnext = cur ? t0 : t1;
     __global uint* cnext = cnt + (1 - cur);
     for (uint i = lid; i < n; i += ls)
-      tcc_p1_decide((int)tl[i], edges, state, vaff, dlist, cnt + 2, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass,
+      tcc_p1_decide((int)tl[i], edges, state, vaff, slot, dlist, cnt + 2, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass,
                       eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict);
     barrier(CLK_GLOBAL_MEM_FENCE);
     const uint nd = cnt[2];

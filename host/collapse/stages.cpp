@@ -484,8 +484,8 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, uint32_t 
       ctx.launch(loop, ctx.group_size_for(loop), "lazy_p1_loop");
       nt = 0;
     } else {
-      set_args(decide, "lazy_p1_decide", U(nt), B(s.work[cur]), B(c.edges), B(s.state), B(s.vaff), B(s.dlist),
-               B(s.work_n));
+      set_args(decide, "lazy_p1_decide", U(nt), B(s.work[cur]), B(c.edges), B(s.state), B(s.vaff), B(s.slot[0]),
+               B(s.dlist), B(s.work_n));
       ctx.launch(decide, nt, "lazy_p1_decide");
       uint32_t nd = 0;
       s.work_n.download(&nd, 1, 2);
@@ -546,7 +546,7 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   // the test's arguments, the same for the per-round kernel and the one-work-group loop
   cl::Kernel decide = ctx.kernel(A, "lazy_p1_decide"), loop = ctx.kernel(A, "lazy_p1_loop");
   const cl::Buffer& quality = tet_qualities(ctx, dm, s, p);
-  for (auto [k, first] : {std::pair<cl::Kernel*, cl_uint>{&decide, 7}, {&loop, 13}})
+  for (auto [k, first] : {std::pair<cl::Kernel*, cl_uint>{&decide, 8}, {&loop, 13}})
     set_args_from(*k, first, "lazy_p1_decide", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb),
                   B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass), B(c.eflags),
                   mode, paper_rule, p.eps_v, p.min_quality, quality, B(s.dir), B(s.reason), B(s.counters),
