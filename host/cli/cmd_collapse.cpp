@@ -116,6 +116,7 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, double sec
       .field("boundary", c.boundary)
       .field("method", c.method)
       .field("conflicts", c.conflicts)
+      .field("spatial_order", c.opt.spatial_order)
       .field("seconds_total", seconds_total)
       .field("seconds_collapse", r.seconds_total)
       .field("seconds_upload", r.seconds_upload)
@@ -213,6 +214,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
                  "Conflict detection of the parallel method: two-pass (default, the paper's) or\n"
                  "atomic-min (Gautron and Kenzel 2023; needs 64-bit atomics on the device)")
       ->check(CLI::IsMember({"two-pass", "atomic-min"}));
+  app.add_flag("!--no-spatial-order", c->opt.spatial_order,
+               "Parallel method: keep the input's numbering on the device (default: vertices along a\n"
+               "Morton curve, tets by their first vertex, for memory locality; the output then\n"
+               "follows that order)");
   app.add_option("--device", c->device, "OpenCL device: index or name substring (see 'tetcollapse devices');\n"
                                         "default: $TETCOLLAPSE_DEVICE, else the first GPU, else the first CPU");
   app.add_option("--stats", c->stats, "Write the run's statistics as JSON to this file ('-' for stdout)");

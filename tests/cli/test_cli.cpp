@@ -138,6 +138,14 @@ TEST(Cli, CoarsenWritesAValidMeshAndStats) {
                           "\"collapsed\":", "\"seconds_admissible\":", "\"check\":\"valid\""})
     EXPECT_NE(s.find(key), std::string::npos) << key << " not in " << s;
   ASSERT_EQ(run_command(cli() + " check -q " + q(result), &out), 0) << out;
+  EXPECT_NE(s.find("\"spatial_order\":true"), std::string::npos) << s;
+  // the input's numbering kept on the device: still valid, and said so in the statistics
+  ASSERT_EQ(run_command(cli() + " " + q(tc::test::project_mesh("bracket.msh")) + " " + q(result) +
+                            " --target-factor 1.5 --max-iterations 4 --no-spatial-order --check -q --stats " + q(stats),
+                        &out),
+            0)
+      << out;
+  EXPECT_NE(tc::test::read_text(stats).find("\"spatial_order\":false"), std::string::npos);
   // Quiet mode prints nothing on success.
   ASSERT_EQ(run_command(cli() + " -q " + q(tc::test::project_mesh("tet.mesh")) + " " + q(dir.file("t.mesh")), &out), 0);
   EXPECT_TRUE(out.empty()) << out;
