@@ -422,10 +422,11 @@ tc_d3 SeqMesh::placement(int32_t a, int32_t b, unsigned dir) const {
   return (dir & TCC_DIR_REMOVE_V1) ? p0 : p1;
 }
 
-// tcc_link_and_volume, over the current rings (a < b).
+// tcc_link_and_volume, over the current rings (a < b): the volume and quality test first.
 uint8_t SeqMesh::link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir) {
-  if (!link_ok(a, b, fe)) return kRefusedLink;
-  return volume_and_quality(a, b, dir);
+  const uint8_t r = volume_and_quality(a, b, dir);
+  if (r != kOk) return r;
+  return link_ok(a, b, fe) ? kOk : kRefusedLink;
 }
 
 bool SeqMesh::admissible(int32_t a, int32_t b, uint8_t fe, int dir) {
