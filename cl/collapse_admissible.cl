@@ -258,16 +258,23 @@ __kernel void lazy_init(uint ne, __global const int* edges, __global const uint*
   atomic_inc(&counters[5]);
 }
 
+/* The arguments of the lazy filter's test (tcc_lazy_decide), passed down unchanged by the
+ * kernels that decide turns: mesh, connectivity, flags, mode, thresholds, and the outputs. */
+#define TCC_TEST_PARAMS                                                                                     \
+  __global const int *tets, __global const uint *vt_off, __global const int *vt, __global const int *tet_nbr, \
+      __global const uint *nb_off, __global const int *nb, __global const int *nb_edge,                       \
+      __global const int *labels, int use_labels, __global const double *pts, __global const uchar *vflags,   \
+      __global const uchar *vclass, __global const uchar *eflags, int mode, int paper_rule, double eps_v,      \
+      double q_min, __global const double *tet_quality, __global uchar *edge_dir, __global uchar *reason,     \
+      __global uint *counters, __global uchar *verdict
+#define TCC_TEST_ARGS                                                                                       \
+  tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass, eflags, mode,     \
+      paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict
+
 /* The turn of edge e in the lazy filter: its link and volume tests (or the verdict carried
  * from an earlier iteration), then IN (vaff of both end points; returns 1) or OUT (0). */
 inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
-                            __global const int* tets, __global const uint* vt_off, __global const int* vt,
-                            __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
-                            __global const int* nb_edge, __global const int* labels, int use_labels,
-                            __global const double* pts, __global const uchar* vflags, __global const uchar* vclass,
-                            __global const uchar* eflags, int mode, int paper_rule, double eps_v, double q_min,
-                            __global const double* tet_quality, __global uchar* edge_dir, __global uchar* reason,
-                            __global uint* counters, __global uchar* verdict) {
+                            TCC_TEST_PARAMS) {
   int a = edges[2 * e], b = edges[2 * e + 1];
   uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
   int dir = tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule);
@@ -326,16 +333,9 @@ __kernel void lazy_p1_first_turns(uint n, __global const uint* cand, __global co
 }
 
 inline void tcc_p1_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
-                          __global const int* slot, __global uint* dlist, __global uint* dn, __global const int* tets,
-                               __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
-                               __global const int* nb_edge, __global const int* labels, int use_labels,
-                               __global const double* pts, __global const uchar* vflags, __global const uchar* vclass,
-                               __global const uchar* eflags, int mode, int paper_rule, double eps_v, double q_min,
-                               __global const double* tet_quality, __global uchar* edge_dir, __global uchar* reason,
-                               __global uint* counters, __global uchar* verdict) {
+                          __global const int* slot, __global uint* dlist, __global uint* dn, TCC_TEST_PARAMS) {
   int a = edges[2 * e], b = edges[2 * e + 1];
-  if (tcc_lazy_decide(e, edges, state, vaff, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts,
-                      vflags, vclass, eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict)) {
+  if (tcc_lazy_decide(e, edges, state, vaff, TCC_TEST_ARGS)) {
     for (int s = 0; s < 2; ++s) {
       int x = s == 0 ? a : b;
       for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) {
@@ -377,17 +377,11 @@ inline void tcc_p1_turn(int v, __global const int* edges, __global const int* sl
 
 /* Per-round kernels: cnt[0], cnt[1] count the two turn lists, cnt[2] the vertex list. */
 __kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const int* edges, __global uchar* state,
-                             __global int* vaff, __global const int* slot, __global uint* dlist, __global uint* cnt, __global const int* tets, __global const uint* vt_off, __global const int* vt,
-                               __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
-                               __global const int* nb_edge, __global const int* labels, int use_labels,
-                               __global const double* pts, __global const uchar* vflags, __global const uchar* vclass,
-                               __global const uchar* eflags, int mode, int paper_rule, double eps_v, double q_min,
-                               __global const double* tet_quality, __global uchar* edge_dir, __global uchar* reason,
-                               __global uint* counters, __global uchar* verdict) {
+                             __global int* vaff, __global const int* slot, __global uint* dlist, __global uint* cnt,
+                             TCC_TEST_PARAMS) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  tcc_p1_decide((int)tlist[i], edges, state, vaff, slot, dlist, cnt + 2, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass,
-                      eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict);
+  tcc_p1_decide((int)tlist[i], edges, state, vaff, slot, dlist, cnt + 2, TCC_TEST_ARGS);
 }
 
 __kernel void lazy_p1_recompute(uint n, __global const uint* dlist, __global const uint* nb_off,
@@ -412,21 +406,14 @@ __kernel void lazy_p1_turns(uint n, __global const uint* dlist, __global const i
 __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __global uint* t1, __global uint* cnt,
                            __global uint* dlist, __global uint* queued, __global const int* edges,
                            __global const double* cost, __global int* slot, __global uchar* state, __global int* vaff,
-                           __global const int* tets, __global const uint* vt_off, __global const int* vt,
-                               __global const int* tet_nbr, __global const uint* nb_off, __global const int* nb,
-                               __global const int* nb_edge, __global const int* labels, int use_labels,
-                               __global const double* pts, __global const uchar* vflags, __global const uchar* vclass,
-                               __global const uchar* eflags, int mode, int paper_rule, double eps_v, double q_min,
-                               __global const double* tet_quality, __global uchar* edge_dir, __global uchar* reason,
-                               __global uint* counters, __global uchar* verdict) {
+                           TCC_TEST_PARAMS) {
   const uint lid = get_local_id(0), ls = get_local_size(0);
   while (n > 0) {
     __global uint* tl = cur ? t1 : t0;
     __global uint* tnext = cur ? t0 : t1;
     __global uint* cnext = cnt + (1 - cur);
     for (uint i = lid; i < n; i += ls)
-      tcc_p1_decide((int)tl[i], edges, state, vaff, slot, dlist, cnt + 2, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass,
-                      eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict);
+      tcc_p1_decide((int)tl[i], edges, state, vaff, slot, dlist, cnt + 2, TCC_TEST_ARGS);
     barrier(CLK_GLOBAL_MEM_FENCE);
     const uint nd = cnt[2];
     for (uint i = lid; i < nd; i += ls) tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, cost, slot);
