@@ -324,12 +324,18 @@ __kernel void lazy_p1_claim_all(uint n, __global const uint* cand, __global cons
   tcc_claim(slot + edges[2 * e + 1], e, cost);
 }
 
+/* cnt[0]: the length of the first turn list; cnt[3]: how many of its edges have no verdict
+ * carried from an earlier iteration (those are tested; the host runs the rounds in one
+ * work-group once few are). */
 __kernel void lazy_p1_first_turns(uint n, __global const uint* cand, __global const int* edges,
-                                  __global const int* slot, __global uint* tlist, __global uint* cnt) {
+                                  __global const int* slot, __global uint* tlist, __global uint* cnt,
+                                  __global const uchar* verdict) {
   uint i = get_global_id(0);
   if (i >= n) return;
   int e = (int)cand[i];
-  if (slot[edges[2 * e]] == e && slot[edges[2 * e + 1]] == e) tlist[atomic_inc(cnt)] = (uint)e;
+  if (slot[edges[2 * e]] != e || slot[edges[2 * e + 1]] != e) return;
+  tlist[atomic_inc(cnt)] = (uint)e;
+  if (verdict[e] == TCC_VERDICT_UNKNOWN) atomic_inc(cnt + 3);
 }
 
 inline void tcc_p1_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
@@ -368,14 +374,17 @@ inline void tcc_p1_recompute(int v, __global const uint* nb_off, __global const 
 }
 
 inline void tcc_p1_turn(int v, __global const int* edges, __global const int* slot, __global uint* tlist,
-                        __global uint* tn, volatile __global uint* queued, uint round) {
+                        __global uint* tn, volatile __global uint* queued, uint round, __global const uchar* verdict,
+                        __global uint* untested) {
   int m = slot[v];
   if (m < 0 || slot[edges[2 * m]] != m || slot[edges[2 * m + 1]] != m) return;
   if (atomic_xchg(queued + m, round) == round) return; /* listed from its other end point */
   tlist[atomic_inc(tn)] = (uint)m;
+  if (verdict[m] == TCC_VERDICT_UNKNOWN) atomic_inc(untested);
 }
 
-/* Per-round kernels: cnt[0], cnt[1] count the two turn lists, cnt[2] the vertex list. */
+/* Per-round kernels: cnt[0], cnt[1] count the two turn lists, cnt[2] the vertex list, cnt[3]
+ * the edges of the new turn list that will be tested (no carried verdict). */
 __kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const int* edges, __global uchar* state,
                              __global int* vaff, __global const int* slot, __global uint* dlist, __global uint* cnt,
                              TCC_TEST_PARAMS) {
@@ -393,10 +402,11 @@ __kernel void lazy_p1_recompute(uint n, __global const uint* dlist, __global con
 }
 
 __kernel void lazy_p1_turns(uint n, __global const uint* dlist, __global const int* edges, __global const int* slot,
-                            __global uint* tlist, __global uint* cnt, uint which, __global uint* queued, uint round) {
+                            __global uint* tlist, __global uint* cnt, uint which, __global uint* queued, uint round,
+                            __global const uchar* verdict) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  tcc_p1_turn((int)dlist[i], edges, slot, tlist, cnt + which, queued, round);
+  tcc_p1_turn((int)dlist[i], edges, slot, tlist, cnt + which, queued, round, verdict, cnt + 3);
 }
 
 /* The remaining rounds in one work-group, once the turn list is short: a round then costs
@@ -418,7 +428,8 @@ __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __glo
     const uint nd = cnt[2];
     for (uint i = lid; i < nd; i += ls) tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, cost, slot);
     barrier(CLK_GLOBAL_MEM_FENCE);
-    for (uint i = lid; i < nd; i += ls) tcc_p1_turn((int)dlist[i], edges, slot, tnext, cnext, queued, round + 1);
+    for (uint i = lid; i < nd; i += ls)
+      tcc_p1_turn((int)dlist[i], edges, slot, tnext, cnext, queued, round + 1, verdict, cnt + 3);
     barrier(CLK_GLOBAL_MEM_FENCE);
     n = *cnext;
     barrier(CLK_GLOBAL_MEM_FENCE);

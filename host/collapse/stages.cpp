@@ -449,8 +449,10 @@ void pass1_rounds(Context& ctx, cl::Kernel& decide, EdgeState& s, const Connecti
 }  // namespace
 
 namespace {
-// The turn list at most this long: the remaining rounds run in one work-group (lazy_p1_loop).
-constexpr uint32_t kLoopTurns = 128;
+// The remaining rounds run in one work-group (lazy_p1_loop) once the turn list holds at most
+// kLoopTests edges to test (the others take the verdict carried from the previous iteration,
+// cheap) and at most kLoopTurns in all.
+constexpr uint32_t kLoopTests = 128, kLoopTurns = 4096;
 
 // Pass 1 of the lazy filter over the n candidates of s.cand_edges (cl/collapse_admissible.cl,
 // lazy_p1_*): rounds over the turn list until it is empty. `decide` and `loop` have the
@@ -463,22 +465,23 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, uint32_t 
   ensure(s.work[0], ctx, n);
   ensure(s.work[1], ctx, n);
   ensure(s.dlist, ctx, 2 * size_t(n) + 1);  // an edge is listed at most twice per pass
-  ensure(s.work_n, ctx, 3);
+  ensure(s.work_n, ctx, 4);
   s.slot[0].fill(-1);
   s.queued.fill(0xffffffffu);
   s.work_n.fill(0);
   if (n == 0) return;
   run(ctx, A, "lazy_p1_claim_all", n, "", U(n), B(s.cand_edges), B(c.edges), B(s.cost), B(s.slot[0]));
   run(ctx, A, "lazy_p1_first_turns", n, "", U(n), B(s.cand_edges), B(c.edges), B(s.slot[0]), B(s.work[0]),
-      B(s.work_n));
-  uint32_t nt = 0;
-  s.work_n.download(&nt, 1);
+      B(s.work_n), B(s.verdict));
+  uint32_t cnt[4];
+  s.work_n.download(cnt, 4);
+  uint32_t nt = cnt[0], nu = cnt[3];
   cl::Kernel recompute = ctx.kernel(A, "lazy_p1_recompute"), turns = ctx.kernel(A, "lazy_p1_turns");
   int cur = 0;
   for (cl_uint round = 0; nt > 0; ++round, cur = 1 - cur) {
     auto t0 = std::chrono::steady_clock::now();
     s.work_n.fill(0);
-    if (nt <= kLoopTurns) {
+    if (nu <= kLoopTests && nt <= kLoopTurns) {
       set_args(loop, "lazy_p1_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(s.dlist),
                B(s.queued), B(c.edges), B(s.cost), B(s.slot[0]), B(s.state), B(s.vaff));
       ctx.launch(loop, ctx.group_size_for(loop), "lazy_p1_loop");
@@ -493,9 +496,11 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, uint32_t 
                B(s.slot[0]));
       ctx.launch(recompute, nd, "lazy_p1_recompute");
       set_args(turns, "lazy_p1_turns", U(nd), B(s.dlist), B(c.edges), B(s.slot[0]), B(s.work[1 - cur]), B(s.work_n),
-               cl_uint(1 - cur), B(s.queued), round + 1);
+               cl_uint(1 - cur), B(s.queued), round + 1, B(s.verdict));
       ctx.launch(turns, nd, "lazy_p1_turns");
-      s.work_n.download(&nt, 1, size_t(1 - cur));
+      s.work_n.download(cnt, 4);
+      nt = cnt[1 - cur];
+      nu = cnt[3];
     }
     if (kProfile) {
       ctx.finish();
