@@ -82,13 +82,11 @@ __kernel void conflict_pass2_init(uint ne, __global const uint* p1, __global uch
 
 /* One round of pass 2 over the pass-1 edges: the rivals of e = (a, b) are the pass-1 edges
  * recorded (vaff) at the vertices of the tets of ring(a) and ring(b), i.e. at N(a) and N(b). */
-__kernel void conflict_pass2_round(uint n, int first, __global const uint* list, __global uint* next,
-                                   __global uint* next_n, __global const uint* cand, __global uint* rivals,
-                                   __global uint* rcount, __global const int* edges, __global const double* cost,
-                                   __global const uint* nb_off, __global const int* nb, __global const int* vaff,
-                                   __global uchar* state) {
-  uint i = get_global_id(0);
-  if (i >= n) return;
+inline void tcc_pass2_item(uint i, int first, __global const uint* list, __global uint* next,
+                           __global uint* next_n, __global const uint* cand, __global uint* rivals,
+                           __global uint* rcount, __global const int* edges, __global const double* cost,
+                           __global const uint* nb_off, __global const int* nb, __global const int* vaff,
+                           __global uchar* state) {
   uint c = first ? i : list[i];
   int e = (int)cand[c];
   int w = tcc_pass2_wait(e, edges[2 * e], edges[2 * e + 1], nb_off, nb, vaff, cost, state,
@@ -96,6 +94,40 @@ __kernel void conflict_pass2_round(uint n, int first, __global const uint* list,
   if (w < 0) state[e] = TCC_OUT;
   else if (w > 0) next[atomic_inc(next_n)] = c;
   else state[e] = TCC_IN;
+}
+
+__kernel void conflict_pass2_round(uint n, int first, __global const uint* list, __global uint* next,
+                                   __global uint* next_n, __global const uint* cand, __global uint* rivals,
+                                   __global uint* rcount, __global const int* edges, __global const double* cost,
+                                   __global const uint* nb_off, __global const int* nb, __global const int* vaff,
+                                   __global uchar* state) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  tcc_pass2_item(i, first, list, next, next_n, cand, rivals, rcount, edges, cost, nb_off, nb, vaff, state);
+}
+
+/* The remaining pass-2 rounds in one work-group, once few candidates are left (a round then
+ * costs barriers instead of a launch and a read-back, as lazy_p1_loop). Entry: n entries of
+ * worklist `cur` (l0 or l1; all candidates when first), *next_n = 0. */
+__kernel void conflict_pass2_loop(uint n, int first, int cur, __global uint* l0, __global uint* l1,
+                                  __global uint* next_n, __global const uint* cand, __global uint* rivals,
+                                  __global uint* rcount, __global const int* edges, __global const double* cost,
+                                  __global const uint* nb_off, __global const int* nb, __global const int* vaff,
+                                  __global uchar* state) {
+  const uint lid = get_local_id(0), ls = get_local_size(0);
+  while (n > 0) {
+    __global uint* list = cur ? l1 : l0;
+    __global uint* next = cur ? l0 : l1;
+    for (uint i = lid; i < n; i += ls)
+      tcc_pass2_item(i, first, list, next, next_n, cand, rivals, rcount, edges, cost, nb_off, nb, vaff, state);
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    n = *next_n;
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    if (lid == 0) *next_n = 0;
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    first = 0;
+    cur = 1 - cur;
+  }
 }
 
 /* fin = IN after pass 2; the vertices of dropped pass-1 edges are released. */

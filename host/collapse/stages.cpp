@@ -375,21 +375,30 @@ uint32_t prepare_candidates(Context& ctx, EdgeState& s, const DeviceBuffer<uint3
   return n;
 }
 
-// Runs `round` (its arguments from kRoundArgs on already set) over all n candidate slots,
-// then over the worklist of those still waiting, until none is left undecided. Every round
-// decides at least the undecided candidate of smallest (cost, index), so this terminates.
 // The worklist loop of the conflict rounds: round(n, first, cur) enqueues one round over the n
 // entries of s.work[cur] (all candidates when first), which appends those still undecided to
-// s.work[1 - cur] via s.work_n; repeats until none is left.
-template <class Round>
-void rounds(Context& ctx, EdgeState& s, uint32_t n, const char* what, const Round& round) {
-  ensure(s.work_n, ctx, 3);  // 3: lazy_p1_rounds
+// s.work[1 - cur] via s.work_n; repeats until none is left. Every round decides at least the
+// undecided candidate of smallest (cost, index), so this terminates. When `tail` is given, the rounds left once at most tail_size entries remain go to
+// tail(n, first, cur), which runs them all in one launch.
+template <class Round, class Tail = void (*)(uint32_t, cl_int, int)>
+void rounds(Context& ctx, EdgeState& s, uint32_t n, const char* what, const Round& round, const Tail* tail = nullptr,
+            uint32_t tail_size = 0) {
+  ensure(s.work_n, ctx, 4);  // 4: lazy_p1_rounds
   ensure(s.work[0], ctx, n);
   ensure(s.work[1], ctx, n);
   int cur = 0;
   for (cl_int first = 1; n > 0; first = 0) {
     s.work_n.fill(0);
     auto t0 = std::chrono::steady_clock::now();
+    if (tail && n <= tail_size) {
+      (*tail)(n, first, cur);
+      if (kProfile) {
+        ctx.finish();
+        std::fprintf(stderr, "  %-28s n=%-9u %8.4f s (all remaining rounds)\n", what, n,
+                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      }
+      return;
+    }
     round(n, first, cur);
     uint32_t next = 0;
     s.work_n.download(&next, 1);
@@ -399,14 +408,6 @@ void rounds(Context& ctx, EdgeState& s, uint32_t n, const char* what, const Roun
     n = next;
     cur = 1 - cur;
   }
-}
-
-void worklist_rounds(Context& ctx, cl::Kernel& round, EdgeState& s, uint32_t n, const char* what) {
-  rounds(ctx, s, n, what, [&](uint32_t m, cl_int first, int cur) {
-    set_args(round, what, U(m), first, B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n), B(s.cand_edges),
-             B(s.rivals), B(s.rcount));
-    ctx.launch(round, m, what);
-  });
 }
 
 // Sets the round kernel's arguments from `first_arg` on.
@@ -571,9 +572,24 @@ uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s
   ensure(s.fin, ctx, c.ne);
   run(ctx, F, "conflict_pass2_init", c.ne, "", U(c.ne), B(s.p1), B(s.state));
   const uint32_t n = prepare_candidates(ctx, s, s.p1, c.ne);
-  cl::Kernel round = ctx.kernel(F, "conflict_pass2_round");
+  cl::Kernel round = ctx.kernel(F, "conflict_pass2_round"), loop = ctx.kernel(F, "conflict_pass2_loop");
   set_round_args(round, "conflict_pass2_round", B(c.edges), B(s.cost), B(c.nb_off), B(c.nb), B(s.vaff), B(s.state));
-  worklist_rounds(ctx, round, s, n, "conflict_pass2_round");
+  set_args_from(loop, kRoundArgs + 1, "conflict_pass2_loop", B(c.edges), B(s.cost), B(c.nb_off), B(c.nb), B(s.vaff),
+                B(s.state));
+  // the last rounds (at most 2048 candidates left) in one work-group
+  auto tail = [&](uint32_t m, cl_int first, int cur) {
+    set_args(loop, "conflict_pass2_loop", U(m), first, cl_int(cur), B(s.work[0]), B(s.work[1]), B(s.work_n),
+             B(s.cand_edges), B(s.rivals), B(s.rcount));
+    ctx.launch(loop, ctx.group_size_for(loop), "conflict_pass2_loop");
+  };
+  rounds(
+      ctx, s, n, "conflict_pass2_round",
+      [&](uint32_t m, cl_int first, int cur) {
+        set_args(round, "conflict_pass2_round", U(m), first, B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n),
+                 B(s.cand_edges), B(s.rivals), B(s.rcount));
+        ctx.launch(round, m, "conflict_pass2_round");
+      },
+      &tail, 2048);
   run(ctx, F, "conflict_finalize", c.ne, "", U(c.ne), B(c.edges), B(s.p1), B(s.state), B(s.fin), B(s.vaff),
       B(s.counters));
   return counter(s, 3);
