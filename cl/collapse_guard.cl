@@ -205,9 +205,9 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
                              __global const uint* qoff, __global const int* tid, __global const double* tpos,
                              double ox, double oy, double oz, double h, int gx, int gy, int gz,
                              __global const uint* cell_off, __global const uint* cell_items, __global uint* qbad) {
-  uint i = get_global_id(0);
-  if (i >= n) return;
-  const uint t = stets[i];
+  const uint g = get_global_id(0);
+  if (g >= n) return;
+  const uint t = stets[g];
   const double3 org = (double3)(ox, oy, oz);
   const int4 gd = (int4)(gx, gy, gz, 0);
   __global const int* tq = tets + 4 * t;
