@@ -410,13 +410,16 @@ __kernel void lazy_p1_turns(uint n, __global const uint* dlist, __global const i
 }
 
 /* The remaining rounds in one work-group, once the turn list is short: a round then costs
- * barriers instead of three launches and two read-backs (about 90 us each on PoCL). Entry:
- * the n edges of turn list `cur` (t0 or t1) are round `round`'s; cnt[0..2] (turn-list
- * lengths, vertex-list length) are 0. */
+ * barriers instead of launches and read-backs (about 90 us each on PoCL). Entry: the n edges
+ * of turn list `cur` (t0 or t1) are round `round`'s; cnt[0..3] (turn-list lengths,
+ * vertex-list length, untested turns) are 0. Once a new turn list has more than max_tests
+ * edges to test (a single work-group would test them one after another), the loop stops and
+ * leaves resume[0..2] = (its length, its list, its round) for the host's per-round kernels;
+ * resume[0] stays 0 when every round is done. */
 __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __global uint* t1, __global uint* cnt,
                            __global uint* dlist, __global uint* queued, __global const int* edges,
                            __global const double* cost, __global int* slot, __global uchar* state, __global int* vaff,
-                           TCC_TEST_PARAMS) {
+                           uint max_tests, __global uint* resume, TCC_TEST_PARAMS) {
   const uint lid = get_local_id(0), ls = get_local_size(0);
   while (n > 0) {
     __global uint* tl = cur ? t1 : t0;
@@ -432,13 +435,23 @@ __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __glo
       tcc_p1_turn((int)dlist[i], edges, slot, tnext, cnext, queued, round + 1, verdict, cnt + 3);
     barrier(CLK_GLOBAL_MEM_FENCE);
     n = *cnext;
-    barrier(CLK_GLOBAL_MEM_FENCE);
-    if (lid == 0) {
-      cnt[2] = 0;
-      *cnext = 0;
-    }
+    const uint untested = cnt[3];
     barrier(CLK_GLOBAL_MEM_FENCE);
     cur = 1 - cur;
     ++round;
+    if (n > 0 && untested > max_tests) { /* the same value in every work item: a uniform exit */
+      if (lid == 0) {
+        resume[0] = n;
+        resume[1] = (uint)cur;
+        resume[2] = round;
+      }
+      return;
+    }
+    if (lid == 0) {
+      cnt[2] = 0;
+      cnt[3] = 0;
+      *cnext = 0;
+    }
+    barrier(CLK_GLOBAL_MEM_FENCE);
   }
 }

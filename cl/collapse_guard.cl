@@ -237,10 +237,10 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
             int replaced = 0;
             for (int a = 0; a < 3; ++a) replaced |= fid[a] == x || (moves_y && fid[a] == y);
             if (replaced) continue; /* the face is one the collapse moves or removes */
-            for (uint n = qoff[qi]; n < qoff[qi + 1]; ++n) {
+            for (uint r = qoff[qi]; r < qoff[qi + 1]; ++r) {
               int id[3];
               double3 pos[3];
-              tcc_sg_load_tri(tid, tpos, n, id, pos);
+              tcc_sg_load_tri(tid, tpos, r, id, pos);
               if (tcc_sg_boxes_apart(pos, fpos) || !tc_sg_tri_tri(id, pos, fid, fpos)) continue;
               uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
               qbad[qi] = code < 0x7ffffffeu ? code + 2u : 1u;

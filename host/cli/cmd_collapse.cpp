@@ -216,7 +216,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"two-pass", "atomic-min"}));
   app.add_flag("!--no-spatial-order", c->opt.spatial_order,
                "Parallel method: keep the input's numbering on the device (default: vertices along a\n"
-               "Morton curve, tets by their first vertex, for memory locality; the output then\n"
+               "Morton curve, tets by their smallest vertex, for memory locality; the output then\n"
                "follows that order)");
   app.add_option("--device", c->device, "OpenCL device: index or name substring (see 'tetcollapse devices');\n"
                                         "default: $TETCOLLAPSE_DEVICE, else the first GPU, else the first CPU");

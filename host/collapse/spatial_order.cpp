@@ -32,14 +32,15 @@ SpatialOrder spatial_order(const Mesh& mesh) {
     }
   double extent = 0;
   for (int c = 0; c < 3; ++c) extent = std::max(extent, hi[c] > lo[c] ? hi[c] - lo[c] : 0.0);
-  const double scale = extent > 0 ? double((1u << 21) - 1) / extent : 0;
+  // 0 when every point is the same, or when the extent overflows (coordinates near +-1e308)
+  const double scale = extent > 0 && std::isfinite(extent) ? double((1u << 21) - 1) / extent : 0;
   std::vector<uint64_t> code(nv);
   for (size_t v = 0; v < nv; ++v) {
     uint64_t k = 0;
     for (int c = 0; c < 3; ++c) {
       const double x = mesh.points[3 * v + c];
-      const double q = std::isfinite(x) ? (x - lo[c]) * scale : 0.0;  // non-finite: the collapse refuses them later
-      k |= spread3(uint64_t(std::clamp(q, 0.0, double((1u << 21) - 1)))) << c;
+      const double q = std::isfinite(x) && scale > 0 ? (x - lo[c]) * scale : 0.0;  // non-finite: refused later
+      k |= spread3(q > 0 ? uint64_t(std::min(q, double((1u << 21) - 1))) : 0) << c;
     }
     code[v] = k;
   }

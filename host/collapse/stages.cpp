@@ -3,6 +3,7 @@
 #include "collapse/spatial_order.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <functional>
 #include <cstdio>
@@ -295,7 +296,8 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   }
   c.up_count.fill(0);  // scratch reuse (its scan is done): S bits per vertex
   ensure(c.owns_s, ctx, nt);
-  ++c.generation;
+  static std::atomic<uint64_t> generations{0};  // unique across Connectivity objects
+  c.generation = ++generations;
   run(ctx, F, "conn_vertex_flags_faces", nt, "", U(nt), B(dm.tets), B(c.tet_nbr), primary_labels(dm), use_labels,
       B(c.up_count), B(c.owns_s));
   run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(c.up_count), B(c.vflags));
@@ -450,16 +452,14 @@ void pass1_rounds(Context& ctx, cl::Kernel& decide, EdgeState& s, const Connecti
 }  // namespace
 
 namespace {
-// The remaining rounds run in one work-group (lazy_p1_loop) once the turn list holds at most
-// kLoopTests edges to test (the others take the verdict carried from the previous iteration,
-// cheap) and at most kLoopTurns in all.
-constexpr uint32_t kLoopTests = 128, kLoopTurns = 4096;
-
 // Pass 1 of the lazy filter over the n candidates of s.cand_edges (cl/collapse_admissible.cl,
 // lazy_p1_*): rounds over the turn list until it is empty. `decide` and `loop` have the
-// test's arguments set. s.vaff must be -1 everywhere.
+// test's arguments set. s.vaff must be -1 everywhere. The rounds run in one work-group
+// (lazy_p1_loop) while the turn list holds at most p.loop_tests edges to test (the others take
+// the verdict carried from the previous iteration, cheap) and at most p.loop_turns in all; the
+// loop hands back to the per-round kernels when a list has more than p.loop_exit_tests to test.
 void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, uint32_t nv, uint32_t n, cl::Kernel& decide,
-                    cl::Kernel& loop) {
+                    cl::Kernel& loop, const StageParams& p) {
   const std::string A = "collapse_admissible.cl";
   ensure(s.slot[0], ctx, nv);
   ensure(s.queued, ctx, c.ne);
@@ -467,6 +467,7 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, uint32_t 
   ensure(s.work[1], ctx, n);
   ensure(s.dlist, ctx, 2 * size_t(n) + 1);  // an edge is listed at most twice per pass
   ensure(s.work_n, ctx, 4);
+  ensure(s.resume, ctx, 3);
   s.slot[0].fill(-1);
   s.queued.fill(0xffffffffu);
   s.work_n.fill(0);
@@ -478,15 +479,23 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, uint32_t 
   s.work_n.download(cnt, 4);
   uint32_t nt = cnt[0], nu = cnt[3];
   cl::Kernel recompute = ctx.kernel(A, "lazy_p1_recompute"), turns = ctx.kernel(A, "lazy_p1_turns");
-  int cur = 0;
-  for (cl_uint round = 0; nt > 0; ++round, cur = 1 - cur) {
+  int cur = 0;  // the list of this round
+  cl_uint round = 0;
+  while (nt > 0) {
     auto t0 = std::chrono::steady_clock::now();
     s.work_n.fill(0);
-    if (nu <= kLoopTests && nt <= kLoopTurns) {
+    const bool one_group = nu <= p.loop_tests && nt <= p.loop_turns;
+    if (one_group) {
+      s.resume.fill(0);
       set_args(loop, "lazy_p1_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(s.dlist),
-               B(s.queued), B(c.edges), B(s.cost), B(s.slot[0]), B(s.state), B(s.vaff));
+               B(s.queued), B(c.edges), B(s.cost), B(s.slot[0]), B(s.state), B(s.vaff), cl_uint(p.loop_exit_tests), B(s.resume));
       ctx.launch(loop, ctx.group_size_for(loop), "lazy_p1_loop");
-      nt = 0;
+      uint32_t r[3];
+      s.resume.download(r, 3);
+      nt = r[0];  // 0: every round done; else the loop stopped before a list with many to test
+      nu = UINT32_MAX;
+      cur = int(r[1]);
+      round = r[2];
     } else {
       set_args(decide, "lazy_p1_decide", U(nt), B(s.work[cur]), B(c.edges), B(s.state), B(s.vaff), B(s.slot[0]),
                B(s.dlist), B(s.work_n));
@@ -502,11 +511,14 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, uint32_t 
       s.work_n.download(cnt, 4);
       nt = cnt[1 - cur];
       nu = cnt[3];
+      cur = 1 - cur;
+      ++round;
     }
     if (kProfile) {
       ctx.finish();
-      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s\n", "lazy_p1_round", nt,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s%s\n", "lazy_p1_round", nt,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                   one_group ? " (one work-group)" : "");
     }
   }
 }
@@ -552,12 +564,12 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   // the test's arguments, the same for the per-round kernel and the one-work-group loop
   cl::Kernel decide = ctx.kernel(A, "lazy_p1_decide"), loop = ctx.kernel(A, "lazy_p1_loop");
   const cl::Buffer& quality = tet_qualities(ctx, dm, s, p);
-  for (auto [k, first] : {std::pair<cl::Kernel*, cl_uint>{&decide, 8}, {&loop, 13}})
+  for (auto [k, first] : {std::pair<cl::Kernel*, cl_uint>{&decide, 8}, {&loop, 15}})
     set_args_from(*k, first, "lazy_p1_decide", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb),
                   B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass), B(c.eflags),
                   mode, paper_rule, p.eps_v, p.min_quality, quality, B(s.dir), B(s.reason), B(s.counters),
                   B(s.verdict));
-  lazy_p1_rounds(ctx, s, c, dm.nv, n, decide, loop);
+  lazy_p1_rounds(ctx, s, c, dm.nv, n, decide, loop, p);
   run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1),
       B(s.vaff), B(s.counters));
   uint32_t cnt[6];
@@ -567,7 +579,7 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   return cnt[2];
 }
 
-uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s) {
+uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s, uint32_t loop_size) {
   const std::string F = "collapse_conflict.cl";
   ensure(s.fin, ctx, c.ne);
   run(ctx, F, "conflict_pass2_init", c.ne, "", U(c.ne), B(s.p1), B(s.state));
@@ -576,7 +588,7 @@ uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s
   set_round_args(round, "conflict_pass2_round", B(c.edges), B(s.cost), B(c.nb_off), B(c.nb), B(s.vaff), B(s.state));
   set_args_from(loop, kRoundArgs + 1, "conflict_pass2_loop", B(c.edges), B(s.cost), B(c.nb_off), B(c.nb), B(s.vaff),
                 B(s.state));
-  // the last rounds (at most 2048 candidates left) in one work-group
+  // the last rounds (at most loop_size candidates left) in one work-group
   auto tail = [&](uint32_t m, cl_int first, int cur) {
     set_args(loop, "conflict_pass2_loop", U(m), first, cl_int(cur), B(s.work[0]), B(s.work[1]), B(s.work_n),
              B(s.cand_edges), B(s.rivals), B(s.rcount));
@@ -589,7 +601,7 @@ uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s
                  B(s.cand_edges), B(s.rivals), B(s.rcount));
         ctx.launch(round, m, "conflict_pass2_round");
       },
-      &tail, 2048);
+      &tail, loop_size);
   run(ctx, F, "conflict_finalize", c.ne, "", U(c.ne), B(c.edges), B(s.p1), B(s.state), B(s.fin), B(s.vaff),
       B(s.counters));
   return counter(s, 3);

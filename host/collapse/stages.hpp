@@ -38,7 +38,7 @@ struct Connectivity {
   DeviceBuffer<int32_t> tet_nbr;   // 4 per tet: tet across each face (collapse_common.h)
   DeviceBuffer<uint8_t> vflags, vclass, eflags;  // see collapse_common.h
   DeviceBuffer<uint32_t> owns_s;   // per tet: 1 when it owns an S face (the surface guard's tets)
-  uint64_t generation = 0;         // incremented by every build_connectivity
+  uint64_t generation = 0;         // new (process-wide unique) at every build_connectivity
   // scratch
   DeviceBuffer<uint32_t> count, cursor, up_count;
   DeviceBuffer<int32_t> scratch;
@@ -56,7 +56,7 @@ struct EdgeState {
   // length of the next worklist, stored rivals per slot (pass 2) and their count.
   DeviceBuffer<uint32_t> cand_edges, work[2], work_n, rivals, rcount;
   DeviceBuffer<int32_t> slot[2];    // pass 1: per-vertex claims (collapse_conflict.cl)
-  DeviceBuffer<uint32_t> queued, dlist;  // lazy pass 1: turn-list stamps, vertex list (lazy_p1_*)
+  DeviceBuffer<uint32_t> queued, dlist, resume;  // lazy pass 1: turn-list stamps, vertex list, loop exit
   DeviceBuffer<uint8_t> dir, reason;
   DeviceBuffer<int32_t> vaff;       // per vertex
   // marked, admissible, pass1, pass2, tested (lazy), passed Q (lazy)
@@ -119,6 +119,12 @@ struct StageParams {
   double target = 0;
   int mask_mode = 0;  // 0 none, 1 both, 2 either
   std::string cost_source;  // user cost, "" for the edge length
+  // One work-group for the conflict rounds (no launch and read-back per round): lazy pass 1
+  // once at most loop_tests edges of a turn list are to be tested and loop_turns in all, back
+  // to per-round launches when a list has more than loop_exit_tests to test; pass 2
+  // (conflict_pass2's loop_size) once at most 2048 candidates wait. Results do not depend on
+  // them (tests set them to 0 and to the maximum).
+  uint32_t loop_tests = 128, loop_turns = 4096, loop_exit_tests = 512;
 };
 StageParams params_from(const CollapseOptions& o);
 
@@ -144,7 +150,7 @@ uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
 // number kept; passed_q and tested receive the number of marked edges passing Q and tested.
 uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                                uint32_t& passed_q, uint32_t& tested);
-uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
+uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, uint32_t loop_size = 2048);
 // Atomic-min conflict detection (host/collapse/conflict_atomic.cpp) over the admissible edges
 // of admissible(): replaces both conflict passes, with the same outputs as conflict_pass2.
 // Returns the number of edges to collapse.

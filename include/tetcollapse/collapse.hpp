@@ -124,7 +124,7 @@ struct CollapseOptions {
   // (same rules). 1 is the paper's algorithm and the default: on W1 (bench/README.md) a second
   // round collapses ~9% more per early iteration but needs more iterations in all (72 vs 68).
   int selection_rounds = 1;
-  // Parallel method: renumber vertices along a Morton curve and tets by their first vertex
+  // Parallel method: renumber vertices along a Morton curve and tets by their smallest new vertex
   // before the run (memory locality of the stages: W1 about 20% faster with TetGen's numbering).
   // The output's vertices and tets follow that order instead of the input's.
   bool spatial_order = true;

@@ -151,6 +151,33 @@ TEST(CollapsePipeline, DeterministicAcrossWorkGroupSizes) {
   }
 }
 
+// Adaptive marking by a vertex mask (one byte per input vertex): the mask travels through the
+// spatial order's renumbering and with the survivors.
+TEST(CollapsePipeline, MaskKeepsUnselectedVertices) {
+  Context ctx;
+  const Mesh in = test::cube_tets(6);
+  CollapseOptions o;
+  o.target_factor = 2;
+  o.vertex_mask.assign(size_t(in.num_vertices()), 0);
+  std::set<std::tuple<double, double, double>> outside;
+  for (int64_t v = 0; v < in.num_vertices(); ++v) {
+    if (in.points[3 * v] < 0.5) o.vertex_mask[v] = 1;
+    else outside.insert({in.points[3 * v], in.points[3 * v + 1], in.points[3 * v + 2]});
+  }
+  for (bool order : {true, false}) {
+    SCOPED_TRACE(order);
+    o.spatial_order = order;
+    Mesh m = in;
+    CollapseReport r = collapse(m, o, ctx);
+    EXPECT_LT(r.tets_out, r.tets_in);
+    CheckReport c = check(m, &in);
+    EXPECT_TRUE(c.valid) << check_report_text(c);
+    std::set<std::tuple<double, double, double>> out;
+    for (int64_t v = 0; v < m.num_vertices(); ++v) out.insert({m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]});
+    for (const auto& p : outside) EXPECT_TRUE(out.count(p)) << "an unselected vertex moved or went away";
+  }
+}
+
 TEST(CollapsePipeline, TrianglesAndEdgesAreRemapped) {
   Context ctx;
   Mesh m = test::cube_tets(4);

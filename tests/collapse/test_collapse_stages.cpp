@@ -371,9 +371,20 @@ namespace {
 
 // The lazy filter (lazy_admissible_pass1) against admissible() + conflict_pass1(): the same
 // pass-1 edges, directions, vaff, and the same pass-2 result; and it tests fewer edges.
-void expect_lazy_equals_full(Context& ctx, const Mesh& m, const CollapseOptions& o, double target) {
+// The one-work-group settings of the conflict rounds: lazy pass 1's loop_tests / loop_turns
+// and pass 2's loop size. The defaults, and per-round kernels only or one work-group only.
+struct LoopSettings {
+  uint32_t tests = StageParams{}.loop_tests, turns = StageParams{}.loop_turns, pass2 = 2048,
+           exit_tests = StageParams{}.loop_exit_tests;
+};
+
+void expect_lazy_equals_full(Context& ctx, const Mesh& m, const CollapseOptions& o, double target,
+                             LoopSettings loops = {}) {
   StageParams p = params_from(o);
   p.target = target;
+  p.loop_tests = loops.tests;
+  p.loop_turns = loops.turns;
+  p.loop_exit_tests = loops.exit_tests;
   DeviceMesh dm;
   Connectivity c;
   EdgeState full, lazy;
@@ -406,7 +417,7 @@ void expect_lazy_equals_full(Context& ctx, const Mesh& m, const CollapseOptions&
   EXPECT_EQ(mismatched_dir, 0);
   EXPECT_EQ(mismatched_reason, 0);
   EXPECT_EQ(lazy.vaff.download_range(0, dm.nv), vaff_full);
-  EXPECT_EQ(conflict_pass2(ctx, dm, c, lazy), n2);
+  EXPECT_EQ(conflict_pass2(ctx, dm, c, lazy, loops.pass2), n2);
   EXPECT_EQ(lazy.fin.download_range(0, c.ne), full.fin.download_range(0, c.ne));
   std::printf("marked %u, passed Q %u, admissible %u, tested lazily %u, pass 1 %u, pass 2 %u\n", marked, passed_q,
               n_adm, tested, n1, n2);
@@ -426,6 +437,24 @@ TEST(CollapseLazyFilter, SameAsTestingEveryEdgeOnCube) {
     expect_lazy_equals_full(ctx, m, o, 2 * h);
     o.paper_boundary_rule = true;
     expect_lazy_equals_full(ctx, m, o, 2 * h);
+  }
+}
+
+// The rounds of lazy pass 1 and pass 2 make the same decisions whether they run as separate
+// launches, in one work-group, or alternating (exit_tests 0: the one-work-group loop hands
+// back after every round with an edge to test, and is entered again at once).
+TEST(CollapseLazyFilter, SameWithAndWithoutTheOneWorkGroupRounds) {
+  Context ctx;
+  Mesh m = test::cube_tets(7);
+  const double h = 1.0 / 7;
+  const LoopSettings per_round{0, 0, 0, 0}, one_group{UINT32_MAX, UINT32_MAX, UINT32_MAX, UINT32_MAX},
+      hand_over{UINT32_MAX, UINT32_MAX, 16, 0};
+  for (const LoopSettings& l : {per_round, one_group, hand_over}) {
+    SCOPED_TRACE(l.tests);
+    CollapseOptions o;
+    expect_lazy_equals_full(ctx, m, o, 2 * h, l);
+    o.boundary = CollapseOptions::Free;
+    expect_lazy_equals_full(ctx, m, o, 2.5 * h, l);
   }
 }
 
