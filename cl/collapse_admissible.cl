@@ -178,12 +178,27 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
 }
 
 /* tet_quality[t] = tc_tet_quality of tet t (the quality guard's "before", once per iteration
- * instead of once per test that looks at t). */
-__kernel void tet_quality(uint nt, __global const int* tets, __global const double* pts, __global double* quality) {
+ * instead of once per test that looks at t). With only_missing, the entries carried through
+ * the compaction (tet_quality_carry) are kept and only those marked -1 are computed. */
+__kernel void tet_quality(uint nt, __global const int* tets, __global const double* pts, __global double* quality,
+                          int only_missing) {
   uint t = get_global_id(0);
-  if (t >= nt) return;
+  if (t >= nt || (only_missing && quality[t] >= 0.0)) return;
   __global const int* q = tets + 4 * t;
   quality[t] = tc_tet_quality(tc_point(pts, q[0]), tc_point(pts, q[1]), tc_point(pts, q[2]), tc_point(pts, q[3]));
+}
+
+/* Through the compaction: a kept tet none of whose vertices is an end point of a collapse
+ * (vaff) has the same vertices at the same places, so the same quality; the others get -1
+ * (computed again by tet_quality). Indices are the previous mesh's. */
+__kernel void tet_quality_carry(uint nt, __global const int* tets, __global const uint* keep,
+                                __global const uint* newidx, __global const int* vaff, __global const double* quality,
+                                __global double* out) {
+  uint t = get_global_id(0);
+  if (t >= nt || !keep[t]) return;
+  __global const int* q = tets + 4 * t;
+  int changed = vaff[q[0]] >= 0 || vaff[q[1]] >= 0 || vaff[q[2]] >= 0 || vaff[q[3]] >= 0;
+  out[newidx[t]] = changed ? -1.0 : quality[t];
 }
 
 __kernel void admissible(uint ne, __global const int* edges, __global const uint* marked, __global const int* tets,

@@ -340,11 +340,23 @@ uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
 }
 
 namespace {
-// The quality guard's per-tet qualities of the current mesh (a placeholder when it is off).
-const cl::Buffer& tet_qualities(Context& ctx, DeviceMesh& dm, EdgeState& s, const StageParams& p) {
-  ensure(s.tet_quality, ctx, p.min_quality > 0 ? dm.nt : 1);
-  if (p.min_quality > 0)
-    run(ctx, "collapse_admissible.cl", "tet_quality", dm.nt, "", U(dm.nt), B(dm.tets), B(dm.points), B(s.tet_quality));
+// The quality guard's per-tet qualities of the current mesh (a placeholder when it is off):
+// once per connectivity; after a compaction only the tets that changed (tet_quality_carry).
+const cl::Buffer& tet_qualities(Context& ctx, DeviceMesh& dm, const Connectivity& c, EdgeState& s,
+                                const StageParams& p) {
+  if (!(p.min_quality > 0)) {
+    ensure(s.tet_quality, ctx, 1);
+    s.quality_carried = false;
+    s.quality_generation = 0;
+    return s.tet_quality.buffer();
+  }
+  if (s.quality_generation == c.generation && s.tet_quality.size() == dm.nt) return s.tet_quality.buffer();
+  const cl_int only_missing = s.quality_carried && s.tet_quality.size() == dm.nt ? 1 : 0;
+  ensure(s.tet_quality, ctx, dm.nt);
+  run(ctx, "collapse_admissible.cl", "tet_quality", dm.nt, "", U(dm.nt), B(dm.tets), B(dm.points), B(s.tet_quality),
+      only_missing);
+  s.quality_carried = false;
+  s.quality_generation = c.generation;
   return s.tet_quality.buffer();
 }
 }  // namespace
@@ -357,7 +369,7 @@ uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
   run(ctx, "collapse_admissible.cl", "admissible", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(dm.tets),
       B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points),
       B(c.vflags), B(c.vclass), B(c.eflags), I(p.mode), I(p.paper_rule ? 1 : 0), p.eps_v, p.min_quality,
-      tet_qualities(ctx, dm, s, p), B(s.adm), B(s.dir),
+      tet_qualities(ctx, dm, c, s, p), B(s.adm), B(s.dir),
       B(s.reason), B(s.counters));
   return counter(s, 1);
 }
@@ -563,7 +575,7 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   const uint32_t n = dev::compact_indices(ctx, s.cand, s.cand_edges, c.ne);
   // the test's arguments, the same for the per-round kernel and the one-work-group loop
   cl::Kernel decide = ctx.kernel(A, "lazy_p1_decide"), loop = ctx.kernel(A, "lazy_p1_loop");
-  const cl::Buffer& quality = tet_qualities(ctx, dm, s, p);
+  const cl::Buffer& quality = tet_qualities(ctx, dm, c, s, p);
   for (auto [k, first] : {std::pair<cl::Kernel*, cl_uint>{&decide, 8}, {&loop, 15}})
     set_args_from(*k, first, "lazy_p1_decide", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb),
                   B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass), B(c.eflags),
@@ -640,6 +652,14 @@ void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connec
   next.nt = nt2;
   ensure(next.tets, ctx, size_t(nt2) * 4);
   run(ctx, F, "tet_write", nt, "", U(nt), B(dm.tets), B(tkeep), B(tnew), B(vmap), B(next.tets));
+  // the quality guard's qualities of the tets no collapse touched (tet_qualities)
+  s.quality_carried = s.quality_generation == c.generation && s.tet_quality.size() == nt && nt2 > 0;
+  if (s.quality_carried) {
+    ensure(s.tet_quality_next, ctx, nt2);
+    run(ctx, "collapse_admissible.cl", "tet_quality_carry", nt, "", U(nt), B(dm.tets), B(tkeep), B(tnew), B(s.vaff),
+        B(s.tet_quality), B(s.tet_quality_next));
+    std::swap(s.tet_quality, s.tet_quality_next);
+  }
   next.labels.resize(dm.labels.size());
   for (size_t l = 0; l < dm.labels.size(); ++l) {
     ensure(next.labels[l], ctx, dm.labels[l].size() == 0 ? 0 : nt2);

@@ -51,6 +51,9 @@ struct EdgeState {
   DeviceBuffer<uint32_t> marked, adm, p1, fin;
   DeviceBuffer<uint8_t> state;      // conflict passes: 0 undecided, 1 in, 2 out
   DeviceBuffer<double> tet_quality; // quality guard: tc_tet_quality per tet (collapse_admissible.cl)
+  DeviceBuffer<double> tet_quality_next;
+  uint64_t quality_generation = 0;  // tet_quality is complete for the connectivity of this generation
+  bool quality_carried = false;     // tet_quality holds the carried values (-1: to compute) of the mesh
   DeviceBuffer<uint32_t> cand;      // lazy filter: marked and passing Q
   // Conflict rounds (collapse_conflict.cl): candidate edges, worklists of their slots, the
   // length of the next worklist, stored rivals per slot (pass 2) and their count.
