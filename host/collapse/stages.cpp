@@ -652,8 +652,10 @@ void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connec
   next.nt = nt2;
   ensure(next.tets, ctx, size_t(nt2) * 4);
   run(ctx, F, "tet_write", nt, "", U(nt), B(dm.tets), B(tkeep), B(tnew), B(vmap), B(next.tets));
-  // the quality guard's qualities of the tets no collapse touched (tet_qualities)
-  s.quality_carried = s.quality_generation == c.generation && s.tet_quality.size() == nt && nt2 > 0;
+  // the quality guard's qualities of the tets no collapse touched (tet_qualities); like the
+  // connectivity, only when carrying was asked for (remember_for_carry), so that
+  // reuse_across_iterations = false computes every quality afresh and the tests compare both
+  s.quality_carried = s.update_next && s.quality_generation == c.generation && s.tet_quality.size() == nt && nt2 > 0;
   if (s.quality_carried) {
     ensure(s.tet_quality_next, ctx, nt2);
     run(ctx, "collapse_admissible.cl", "tet_quality_carry", nt, "", U(nt), B(dm.tets), B(tkeep), B(tnew), B(s.vaff),
