@@ -437,16 +437,11 @@ TEST(SequentialCollapse, MaskKeepsUnselectedVertices) {
   Mesh in = test::cube_tets(6);
   CollapseOptions o;
   o.target_factor = 2;
-  o.vertex_mask.assign(size_t(in.num_vertices()), 0);
-  std::set<std::tuple<double, double, double>> outside;
-  for (int64_t v = 0; v < in.num_vertices(); ++v) {
-    if (in.points[3 * v] < 0.5) o.vertex_mask[v] = 1;
-    else outside.insert({in.points[3 * v], in.points[3 * v + 1], in.points[3 * v + 2]});
-  }
+  std::set<test::Point3> outside;
+  o.vertex_mask = test::mask_x_below(in, 0.5, &outside);
   Mesh m;
   expect_valid_run(in, m, o, "mask");
-  std::set<std::tuple<double, double, double>> out;
-  for (int64_t v = 0; v < m.num_vertices(); ++v) out.insert({m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]});
+  const std::set<test::Point3> out = test::vertex_positions(m);
   for (const auto& p : outside) EXPECT_TRUE(out.count(p)) << "an unselected vertex moved or went away";
 }
 

@@ -84,4 +84,19 @@ int run_command(const std::string& cmd, std::string* output) {
   return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
 }
 
+std::vector<uint8_t> mask_x_below(const Mesh& m, double x_max, std::set<Point3>* unselected) {
+  std::vector<uint8_t> mask(size_t(m.num_vertices()), 0);
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    if (m.points[3 * v] < x_max) mask[size_t(v)] = 1;
+    else if (unselected) unselected->insert({m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]});
+  }
+  return mask;
+}
+
+std::set<Point3> vertex_positions(const Mesh& m) {
+  std::set<Point3> s;
+  for (int64_t v = 0; v < m.num_vertices(); ++v) s.insert({m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]});
+  return s;
+}
+
 }  // namespace tc::test

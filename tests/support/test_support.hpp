@@ -1,8 +1,11 @@
 // Helpers shared by the test executables.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "tetcollapse/mesh.hpp"
@@ -36,6 +39,13 @@ std::string read_text(const std::string& path);
 // Small meshes built in code.
 Mesh single_tet();             // the unit right-corner tet, positively oriented
 Mesh cube_tets(int n);         // [0,1]^3 split into n^3 cubes of 6 tets each (Kuhn), labels none
+
+// Adaptive marking tests: a vertex mask selecting the vertices with x < x_max; the positions
+// of the others (which no collapse may move or remove) go to *unselected.
+using Point3 = std::tuple<double, double, double>;
+std::vector<uint8_t> mask_x_below(const Mesh& m, double x_max, std::set<Point3>* unselected);
+// The vertex positions of a mesh.
+std::set<Point3> vertex_positions(const Mesh& m);
 
 // Runs a shell command, returns its exit code; its stdout+stderr go into *output.
 int run_command(const std::string& cmd, std::string* output);
