@@ -28,7 +28,7 @@ struct CollapseCli {
   double target_length = 0, target_factor = 0;
   std::string boundary = "features", method = "parallel", conflicts = "two-pass";
   std::string region, sizing_field, labels, cost_cl, device, stats;
-  bool check = false, quiet = false, no_labels = false;
+  bool check = false, quiet = false, no_labels = false, no_spatial_order = false;
 };
 
 std::vector<double> parse_numbers(const std::string& s, const std::string& what) {
@@ -214,7 +214,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
                  "Conflict detection of the parallel method: two-pass (default, the paper's) or\n"
                  "atomic-min (Gautron and Kenzel 2023; needs 64-bit atomics on the device)")
       ->check(CLI::IsMember({"two-pass", "atomic-min"}));
-  app.add_flag("!--no-spatial-order", c->opt.spatial_order,
+  app.add_flag("--no-spatial-order", c->no_spatial_order,
                "Parallel method: keep the input's numbering on the device (default: vertices along a\n"
                "Morton curve, tets by their smallest vertex, for memory locality; the output then\n"
                "follows that order)");
@@ -241,6 +241,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
                    : c->boundary == "free" ? CollapseOptions::Free
                                            : CollapseOptions::Features;
     opt.use_labels = !c->no_labels;
+    opt.spatial_order = !c->no_spatial_order;
     opt.method = c->method == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
     opt.conflicts = c->conflicts == "atomic-min" ? CollapseOptions::AtomicMin : CollapseOptions::TwoPass;
     if (opt.method == CollapseOptions::Sequential && !c->device.empty())
