@@ -180,12 +180,8 @@ __kernel void conn_lower_edges(uint nv, __global const uint* nb_off, __global co
     int u = nb[b + i];
     /* position of v among the upper part of N(u) */
     uint ub = nb_off[u + 1] - (edge_off[u + 1] - edge_off[u]);
-    uint lo = ub, hi = nb_off[u + 1];
-    while (lo < hi) {
-      uint mid = (lo + hi) >> 1;
-      if (nb[mid] < (int)v) lo = mid + 1;
-      else hi = mid;
-    }
+    uint lo = ub;
+    while (nb[lo] < (int)v) ++lo; /* v is in the upper part of N(u): a short scan */
     nb_edge[b + i] = (int)(edge_off[u] + (lo - ub));
   }
 }
