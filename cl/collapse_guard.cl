@@ -197,6 +197,26 @@ inline int tcc_sg_owner_cell(double3 alo, double3 ahi, __global const double* b,
          tcc_sg_cell(c.z, org.z, h, gd.z) == k;
 }
 
+/* Loop over the queries entered in the grid cells that the box [LO, HI] overlaps: the body
+ * (the variadic rest, so that it may hold commas) sees the cell (ci, cj, ck) and the query QI
+ * (`continue` goes to the next query). Needs ox, oy, oz, h, gx, gy, gz, cell_off and
+ * cell_items in scope. */
+#define TCC_SG_FOR_CELL_QUERIES(LO, HI, QI, ...)                                                              \
+  {                                                                                                          \
+    const int i0_ = tcc_sg_cell((LO).x, ox, h, gx), i1_ = tcc_sg_cell((HI).x, ox, h, gx);                    \
+    const int j0_ = tcc_sg_cell((LO).y, oy, h, gy), j1_ = tcc_sg_cell((HI).y, oy, h, gy);                    \
+    const int k0_ = tcc_sg_cell((LO).z, oz, h, gz), k1_ = tcc_sg_cell((HI).z, oz, h, gz);                    \
+    for (int ck = k0_; ck <= k1_; ++ck)                                                                      \
+      for (int cj = j0_; cj <= j1_; ++cj)                                                                    \
+        for (int ci = i0_; ci <= i1_; ++ci) {                                                                \
+          const uint c_ = ((uint)ck * (uint)gy + (uint)cj) * (uint)gx + (uint)ci;                            \
+          for (uint m_ = cell_off[c_]; m_ < cell_off[c_ + 1]; ++m_) {                                        \
+            const uint QI = cell_items[m_];                                                                  \
+            __VA_ARGS__                                                                                      \
+          }                                                                                                  \
+        }                                                                                                    \
+  }
+
 /* Every current S face against the queries whose box it overlaps. */
 __kernel void sguard_surface(uint n, __global const uint* stets, __global const int* edges, __global const uchar* dir,
                              __global const double* pts,
@@ -221,33 +241,24 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
       fpos[k] = tc_point(pts, fid[k]);
     }
     double3 lo = fmin(fmin(fpos[0], fpos[1]), fpos[2]), hi = fmax(fmax(fpos[0], fpos[1]), fpos[2]);
-    int i0 = tcc_sg_cell(lo.x, ox, h, gx), i1 = tcc_sg_cell(hi.x, ox, h, gx);
-    int j0 = tcc_sg_cell(lo.y, oy, h, gy), j1 = tcc_sg_cell(hi.y, oy, h, gy);
-    int k0 = tcc_sg_cell(lo.z, oz, h, gz), k1 = tcc_sg_cell(hi.z, oz, h, gz);
-    for (int k = k0; k <= k1; ++k)
-      for (int j = j0; j <= j1; ++j)
-        for (int i = i0; i <= i1; ++i) {
-          uint c = ((uint)k * (uint)gy + (uint)j) * (uint)gx + (uint)i;
-          for (uint m = cell_off[c]; m < cell_off[c + 1]; ++m) {
-            uint qi = cell_items[m];
-            if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qi, i, j, k, org, h, gd)) continue;
-            int x, y;
-            double3 p;
-            int moves_y = tcc_sg_collapse(qedge[qi], edges, dir, pts, &x, &y, &p);
-            int replaced = 0;
-            for (int a = 0; a < 3; ++a) replaced |= fid[a] == x || (moves_y && fid[a] == y);
-            if (replaced) continue; /* the face is one the collapse moves or removes */
-            for (uint r = qoff[qi]; r < qoff[qi + 1]; ++r) {
-              int id[3];
-              double3 pos[3];
-              tcc_sg_load_tri(tid, tpos, r, id, pos);
-              if (tcc_sg_boxes_apart(pos, fpos) || !tc_sg_tri_tri(id, pos, fid, fpos)) continue;
-              uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
-              qbad[qi] = code < 0x7ffffffeu ? code + 2u : 1u;
-              break;
-            }
-          }
-        }
+    TCC_SG_FOR_CELL_QUERIES(lo, hi, qi, {
+      if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qi, ci, cj, ck, org, h, gd)) continue;
+      int x, y;
+      double3 p;
+      int moves_y = tcc_sg_collapse(qedge[qi], edges, dir, pts, &x, &y, &p);
+      int replaced = 0;
+      for (int a = 0; a < 3; ++a) replaced |= fid[a] == x || (moves_y && fid[a] == y);
+      if (replaced) continue; /* the face is one the collapse moves or removes */
+      for (uint r = qoff[qi]; r < qoff[qi + 1]; ++r) {
+        int id[3];
+        double3 pos[3];
+        tcc_sg_load_tri(tid, tpos, r, id, pos);
+        if (tcc_sg_boxes_apart(pos, fpos) || !tc_sg_tri_tri(id, pos, fid, fpos)) continue;
+        uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
+        qbad[qi] = code < 0x7ffffffeu ? code + 2u : 1u;
+        break;
+      }
+    })
   }
 }
 
@@ -276,31 +287,22 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
       return;
     }
   }
-  int i0 = tcc_sg_cell(lo.x, ox, h, gx), i1 = tcc_sg_cell(hi.x, ox, h, gx);
-  int j0 = tcc_sg_cell(lo.y, oy, h, gy), j1 = tcc_sg_cell(hi.y, oy, h, gy);
-  int k0 = tcc_sg_cell(lo.z, oz, h, gz), k1 = tcc_sg_cell(hi.z, oz, h, gz);
-  for (int k = k0; k <= k1; ++k)
-    for (int j = j0; j <= j1; ++j)
-      for (int i = i0; i <= i1; ++i) {
-        uint c = ((uint)k * (uint)gy + (uint)j) * (uint)gx + (uint)i;
-        for (uint m = cell_off[c]; m < cell_off[c + 1]; ++m) {
-          uint qb = cell_items[m];
-          if (qb == qa || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qb, i, j, k, org, h, gd)) continue;
-          for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
-            int ida[3];
-            double3 posa[3];
-            tcc_sg_load_tri(tid, tpos, na, ida, posa);
-            for (uint nb = qoff[qb]; nb < qoff[qb + 1]; ++nb) {
-              int idb[3];
-              double3 posb[3];
-              tcc_sg_load_tri(tid, tpos, nb, idb, posb);
-              if (tcc_sg_boxes_apart(posa, posb) || !tc_sg_tri_tri(ida, posa, idb, posb)) continue;
-              qbad[qa] = 0x80000000u | qb; /* names the other query for debugging */
-              return;
-            }
-          }
-        }
+  TCC_SG_FOR_CELL_QUERIES(lo, hi, qb, {
+    if (qb == qa || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qb, ci, cj, ck, org, h, gd)) continue;
+    for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
+      int ida[3];
+      double3 posa[3];
+      tcc_sg_load_tri(tid, tpos, na, ida, posa);
+      for (uint nb = qoff[qb]; nb < qoff[qb + 1]; ++nb) {
+        int idb[3];
+        double3 posb[3];
+        tcc_sg_load_tri(tid, tpos, nb, idb, posb);
+        if (tcc_sg_boxes_apart(posa, posb) || !tc_sg_tri_tri(ida, posa, idb, posb)) continue;
+        qbad[qa] = 0x80000000u | qb; /* names the other query for debugging */
+        return;
       }
+    }
+  })
 }
 
 /* Refusal reason of the guard, kept as the edge's verdict (collapse_verdicts.cl) so that the
