@@ -193,21 +193,6 @@ inline void tcc_claim(volatile __global int* slot, int e, __global const double*
   }
 }
 
-/* The claim of list entry i in a pass-1 round (pass1_claim): OUT when an end point is taken by
- * an IN edge, else a claim of both end points. */
-inline void tcc_pass1_claim(uint i, int first, __global const uint* list, __global const uint* cand,
-                            __global const int* edges, __global const double* cost, __global const int* vaff,
-                            volatile __global int* slot, __global uchar* state) {
-  int e = (int)cand[first ? i : list[i]];
-  int a = edges[2 * e], b = edges[2 * e + 1];
-  if (vaff[a] >= 0 || vaff[b] >= 0) {
-    state[e] = TCC_OUT;
-    return;
-  }
-  tcc_claim(slot + a, e, cost);
-  tcc_claim(slot + b, e, cost);
-}
-
 /* Whether the candidate of list entry i decides this round: -1 when it was dropped by
  * pass1_claim, 0 when it waits (appended to next, its next-round slots cleared), 1 when it is
  * first at both end points. *edge receives the edge. */

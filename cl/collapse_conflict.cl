@@ -42,7 +42,14 @@ __kernel void pass1_claim(uint n, int first, __global const uint* list, __global
                           volatile __global int* slot, __global uchar* state) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  tcc_pass1_claim(i, first, list, cand, edges, cost, vaff, slot, state);
+  int e = (int)cand[first ? i : list[i]];
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  if (vaff[a] >= 0 || vaff[b] >= 0) {
+    state[e] = TCC_OUT;
+    return;
+  }
+  tcc_claim(slot + a, e, cost);
+  tcc_claim(slot + b, e, cost);
 }
 
 /* Pass 1 over admissible edges (every edge tested beforehand): a turn means IN. */

@@ -121,8 +121,8 @@ TC_FN double tc_max_dihedral(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3) {
 }
 
 /* Mean-ratio style quality 6*sqrt(2)*V / l_rms^3: 1 for a regular tet, -> 0 for slivers,
- * negative when inverted (the "qmin" of ../shared/meshes/SOURCES.md). */
-/* The same with the tet's volume tc_tet_volume(p0, p1, p2, p3) already at hand (same bits). */
+ * negative when inverted (the "qmin" of ../shared/meshes/SOURCES.md). tc_tet_quality_v takes
+ * the volume tc_tet_volume(p0, p1, p2, p3) already at hand (the same bits). */
 TC_FN double tc_tet_quality_v(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3, double volume) {
   double s = dot(p1 - p0, p1 - p0) + dot(p2 - p0, p2 - p0) + dot(p3 - p0, p3 - p0) +
              dot(p2 - p1, p2 - p1) + dot(p3 - p1, p3 - p1) + dot(p3 - p2, p3 - p2);

@@ -2,10 +2,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 
 #include "collapse/guard_surface.hpp"
-#include "collapse/spatial_order.hpp"
 #include "collapse/stages.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/error.hpp"
@@ -122,15 +122,10 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   DeviceMesh dm, next;
   // origin: input vertex -> current vertex
   std::vector<int32_t> origin0;
-  if (options.spatial_order) {
-    check_collapse_input(mesh);
-    SpatialOrder order = spatial_order(mesh);
-    upload_mesh(ctx, mesh, options, dm, &order);
-    origin0 = std::move(order.vertex_new);
-  } else {
-    upload_mesh(ctx, mesh, options, dm);
+  upload_mesh(ctx, mesh, options, dm, options.spatial_order ? &origin0 : nullptr);
+  if (!options.spatial_order) {
     origin0.resize(dm.nv);
-    for (uint32_t i = 0; i < dm.nv; ++i) origin0[i] = int32_t(i);
+    std::iota(origin0.begin(), origin0.end(), 0);
   }
   const uint32_t n_origin = dm.nv;
   DeviceBuffer<int32_t> origin(ctx, origin0);

@@ -146,9 +146,9 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
     n_stets = dev::compact_indices(ctx, c.owns_s, stets, dm.nt);
     stets_generation = c.generation;
   }
-  launch(ctx, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), c.edges.buffer(), s.dir.buffer(), dm.points.buffer(),
-         dm.tets.buffer(), c.tet_nbr.buffer(), labels, use_labels, qedge.buffer(), qbox.buffer(), qoff.buffer(),
-         tid.buffer(), tpos.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(h),
+  launch(ctx, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), c.edges.buffer(), s.dir.buffer(),
+         dm.points.buffer(), dm.tets.buffer(), c.tet_nbr.buffer(), labels, use_labels, qedge.buffer(), qbox.buffer(),
+         qoff.buffer(), tid.buffer(), tpos.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(h),
          cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());
   launch(ctx, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
          cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(h), cl_int(g[0]), cl_int(g[1]),

@@ -16,8 +16,8 @@ struct SurfaceGuard {
   DeviceBuffer<double> qbox, tpos;           // per query: box; per new triangle: positions
   DeviceBuffer<uint32_t> qntri, qoff, qcount, qbad, cell_off, cell_items;
   uint32_t last_queries = 0;  // collapses tested by the last run (that change S)
-  DeviceBuffer<uint32_t> stets;  // the tets owning an S face, for the connectivity of generation:
-  uint64_t stets_generation = 0;
+  DeviceBuffer<uint32_t> stets;  // the tets owning an S face (n_stets), listed for the connectivity
+  uint64_t stets_generation = 0;  // of this Connectivity::generation
   uint32_t n_stets = 0;
 
   // Tests the `chosen` collapses of s.fin / s.dir; returns how many were refused (their edges

@@ -429,10 +429,7 @@ uint8_t SeqMesh::link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir) {
   return link_ok(a, b, fe) ? kOk : kRefusedLink;
 }
 
-bool SeqMesh::admissible(int32_t a, int32_t b, uint8_t fe, int dir) {
-  // the volume test first: it is cheaper and refuses more edges than the link condition
-  return volume_and_quality(a, b, dir) == kOk && link_ok(a, b, fe);
-}
+bool SeqMesh::admissible(int32_t a, int32_t b, uint8_t fe, int dir) { return link_and_volume(a, b, fe, dir) == kOk; }
 
 // The link condition of tcc_link_and_volume (a < b): true when it holds.
 bool SeqMesh::link_ok(int32_t a, int32_t b, uint8_t fe) {

@@ -100,9 +100,16 @@ void check_collapse_input(const Mesh& mesh) {
                                      " values for " + std::to_string(nt) + " tets");
 }
 
-void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm, const SpatialOrder* order) {
+void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm,
+                 std::vector<int32_t>* vertex_new) {
   check_collapse_input(mesh);
   const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
+  SpatialOrder spatial;
+  const SpatialOrder* order = nullptr;
+  if (vertex_new) {  // the indices are checked: the order may use them
+    spatial = spatial_order(mesh);
+    order = &spatial;
+  }
   // entity i of the device mesh is entity old(i) of `mesh` (the identity without an order)
   auto vold = [&](int64_t i) { return order ? int64_t(order->vertex_old[size_t(i)]) : i; };
   auto told = [&](int64_t i) { return order ? int64_t(order->tet_old[size_t(i)]) : i; };
@@ -155,6 +162,7 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
     throw std::invalid_argument("vertex_mask has " + std::to_string(o.vertex_mask.size()) + " entries for " +
                                 std::to_string(nv) + " vertices");
   dm.vmask = DeviceBuffer<uint8_t>(ctx, order && dm.has_mask ? gather(o.vertex_mask, nv, 1, vold) : o.vertex_mask);
+  if (vertex_new) *vertex_new = std::move(spatial.vertex_new);
 }
 
 uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p) {
@@ -392,12 +400,13 @@ uint32_t prepare_candidates(Context& ctx, EdgeState& s, const DeviceBuffer<uint3
 // The worklist loop of the conflict rounds: round(n, first, cur) enqueues one round over the n
 // entries of s.work[cur] (all candidates when first), which appends those still undecided to
 // s.work[1 - cur] via s.work_n; repeats until none is left. Every round decides at least the
-// undecided candidate of smallest (cost, index), so this terminates. When `tail` is given, the rounds left once at most tail_size entries remain go to
-// tail(n, first, cur), which runs them all in one launch.
+// undecided candidate of smallest (cost, index), so this terminates. When `tail` is given,
+// the rounds left once at most tail_size entries remain go to tail(n, first, cur), which runs
+// them all in one launch.
 template <class Round, class Tail = void (*)(uint32_t, cl_int, int)>
 void rounds(Context& ctx, EdgeState& s, uint32_t n, const char* what, const Round& round, const Tail* tail = nullptr,
             uint32_t tail_size = 0) {
-  ensure(s.work_n, ctx, 4);  // 4: lazy_p1_rounds
+  ensure(s.work_n, ctx, 1);
   ensure(s.work[0], ctx, n);
   ensure(s.work[1], ctx, n);
   int cur = 0;
@@ -500,7 +509,8 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, uint32_t 
     if (one_group) {
       s.resume.fill(0);
       set_args(loop, "lazy_p1_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(s.dlist),
-               B(s.queued), B(c.edges), B(s.cost), B(s.slot[0]), B(s.state), B(s.vaff), cl_uint(p.loop_exit_tests), B(s.resume));
+               B(s.queued), B(c.edges), B(s.cost), B(s.slot[0]), B(s.state), B(s.vaff), cl_uint(p.loop_exit_tests),
+               B(s.resume));
       ctx.launch(loop, ctx.group_size_for(loop), "lazy_p1_loop");
       uint32_t r[3];
       s.resume.download(r, 3);

@@ -131,10 +131,10 @@ struct StageParams {
 };
 StageParams params_from(const CollapseOptions& o);
 
-struct SpatialOrder;  // spatial_order.hpp
-// With an order, device vertex i is input vertex order->vertex_old[i] (tets likewise).
+// With vertex_new, the device mesh is renumbered in spatial order (spatial_order.hpp) and
+// *vertex_new receives the map input vertex -> device vertex; else it keeps the input's order.
 void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm,
-                 const SpatialOrder* order = nullptr);
+                 std::vector<int32_t>* vertex_new = nullptr);
 
 // With carry (an EdgeState after note_compaction), the data (N(v), tet_nbr, vclass,
 // eflags) of the vertices whose rings did not change is copied from the previous iteration
