@@ -473,29 +473,28 @@ void pass1_rounds(Context& ctx, cl::Kernel& decide, EdgeState& s, const Connecti
 }  // namespace
 
 namespace {
-// Pass 1 of the lazy filter over the n candidates of s.cand_edges (cl/collapse_admissible.cl,
-// lazy_p1_*): rounds over the turn list until it is empty. `decide` and `loop` have the
+// Pass 1 of the lazy filter over the candidates (s.cand[e] != 0 for e < ne; lazy_init made them
+// and their first claims in s.slot[0]; cl/collapse_admissible.cl, lazy_p1_*): rounds over the
+// turn list until it is empty. `decide` and `loop` have the
 // test's arguments set. s.vaff must be -1 everywhere. The rounds run in one work-group
 // (lazy_p1_loop) while the turn list holds at most p.loop_tests edges to test (the others take
 // the verdict carried from the previous iteration, cheap) and at most p.loop_turns in all; the
 // loop hands back to the per-round kernels when a list has more than p.loop_exit_tests to test.
-void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, uint32_t nv, uint32_t n, cl::Kernel& decide,
-                    cl::Kernel& loop, const StageParams& p) {
+void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kernel& decide, cl::Kernel& loop,
+                    const StageParams& p) {
   const std::string A = "collapse_admissible.cl";
-  ensure(s.slot[0], ctx, nv);
+  const uint32_t n = c.ne;  // bounds the candidates
   ensure(s.queued, ctx, c.ne);
   ensure(s.work[0], ctx, n);
   ensure(s.work[1], ctx, n);
   ensure(s.dlist, ctx, 2 * size_t(n) + 1);  // an edge is listed at most twice per pass
   ensure(s.work_n, ctx, 4);
   ensure(s.resume, ctx, 3);
-  s.slot[0].fill(-1);
   s.queued.fill(0xffffffffu);
   s.work_n.fill(0);
   if (n == 0) return;
-  run(ctx, A, "lazy_p1_claim_all", n, "", U(n), B(s.cand_edges), B(c.edges), B(s.cost), B(s.slot[0]));
-  run(ctx, A, "lazy_p1_first_turns", n, "", U(n), B(s.cand_edges), B(c.edges), B(s.slot[0]), B(s.work[0]),
-      B(s.work_n), B(s.verdict));
+  run(ctx, A, "lazy_p1_first_turns", n, "", U(n), B(s.cand), B(c.edges), B(s.slot[0]), B(s.work[0]), B(s.work_n),
+      B(s.verdict));
   uint32_t cnt[4];
   s.work_n.download(cnt, 4);
   uint32_t nt = cnt[0], nu = cnt[3];
@@ -578,11 +577,11 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   s.verdict_ready = false;
   const bool restrict_clean = s.restrict_clean;
   s.restrict_clean = false;
+  ensure(s.slot[0], ctx, dm.nv);
+  s.slot[0].fill(-1);
   run(ctx, A, "lazy_init", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(c.vflags), B(c.vclass), B(c.eflags), mode,
       paper_rule, B(s.state), B(s.dir), B(s.reason), B(s.cand), B(s.counters), cl_int(restrict_clean ? 1 : 0),
-      restrict_clean ? B(s.vdirty) : B(c.vflags));
-  ensure(s.cand_edges, ctx, c.ne);
-  const uint32_t n = dev::compact_indices(ctx, s.cand, s.cand_edges, c.ne);
+      restrict_clean ? B(s.vdirty) : B(c.vflags), B(s.verdict), B(s.cost), B(s.slot[0]));
   // the test's arguments, the same for the per-round kernel and the one-work-group loop
   cl::Kernel decide = ctx.kernel(A, "lazy_p1_decide"), loop = ctx.kernel(A, "lazy_p1_loop");
   const cl::Buffer& quality = tet_qualities(ctx, dm, c, s, p);
@@ -591,7 +590,7 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
                   B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass), B(c.eflags),
                   mode, paper_rule, p.eps_v, p.min_quality, quality, B(s.dir), B(s.reason), B(s.counters),
                   B(s.verdict));
-  lazy_p1_rounds(ctx, s, c, dm.nv, n, decide, loop, p);
+  lazy_p1_rounds(ctx, s, c, decide, loop, p);
   run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1),
       B(s.vaff), B(s.counters));
   uint32_t cnt[6];
