@@ -73,7 +73,7 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
         int4 q = vload4(t, tets);
         qs[m] = q;
         ts[m] = t;
-        m += (q.x != y && q.y != y && q.z != y && q.w != y) ? 1u : 0u; /* else removed by the collapse */
+        m += any(q == (int4)(y)) ? 0u : 1u; /* else removed by the collapse; no branch */
       }
       for (uint j = 0; j < m; ++j) {
         int4 q = qs[j];
