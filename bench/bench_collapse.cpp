@@ -2,7 +2,7 @@
 // eps_c = 0 and eps_c = 700 (paper Sec. 4.4, Fig. 9, Table 2). File I/O is excluded.
 //
 //   bench_collapse [MESH] [--runs N] [--json FILE] [--wg N] [--max-iterations N]
-//                  [--eps-c N[,N...]] [--min-quality Q[,Q...]] [--rounds N]
+//                  [--eps-c N[,N...]] [--min-quality Q[,Q...]] [--rounds N] [--host-tail F]
 // Defaults: eps_c 0 and 700, min_quality 0 (the paper: no quality guard) and 0.1 (the library's
 // default); every combination is run.
 // Prints a table (median of N runs of collapse(), iterations, collapses per iteration, time per
@@ -51,6 +51,7 @@ int main(int argc, char** argv) {
   size_t wg = 0;
   int max_iterations = 1000;
   int rounds = CollapseOptions{}.selection_rounds;
+  double host_tail = CollapseOptions{}.host_tail;
   std::vector<double> eps_cs = {0, 700}, qualities = {0, CollapseOptions{}.min_quality};
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
@@ -58,6 +59,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--wg") && i + 1 < argc) wg = size_t(std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--max-iterations") && i + 1 < argc) max_iterations = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--rounds") && i + 1 < argc) rounds = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--host-tail") && i + 1 < argc) host_tail = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--eps-c") && i + 1 < argc) eps_cs = parse_list(argv[++i]);
     else if (!std::strcmp(argv[i], "--min-quality") && i + 1 < argc) qualities = parse_list(argv[++i]);
     else path = argv[i];
@@ -97,6 +99,7 @@ int main(int argc, char** argv) {
       o.eps_c = eps_c;
       o.min_quality = q;
       o.selection_rounds = rounds;
+      o.host_tail = host_tail;
       o.max_iterations = max_iterations;
       auto t = std::chrono::steady_clock::now();
       CollapseReport rep = collapse(m, o, ctx);

@@ -147,6 +147,7 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, double sec
         .field("seconds_pass2", it.seconds_pass2)
         .field("seconds_collapse", it.seconds_collapse)
         .field("seconds_total", it.seconds_total)
+        .field("on_host", it.on_host)
         .end_object();
   }
   w.end_array().end_object();
@@ -218,6 +219,12 @@ void register_collapse(CLI::App& app, int& exit_code) {
                "Parallel method: keep the input's numbering on the device (default: vertices along a\n"
                "Morton curve, tets by their smallest vertex, for memory locality; the output then\n"
                "follows that order)");
+  app.add_option("--host-tail", c->opt.host_tail,
+                 "Parallel method with --eps-c 0 or 1: once an iteration collapses fewer than F x its\n"
+                 "tets, finish on the host with the sequential method's checks, greedily (the last\n"
+                 "iterations collapse a few edges each at the price of passes over the whole mesh).\n"
+                 "Default: 0.002 on CPU devices, 0 (all on the device) on GPUs")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--device", c->device, "OpenCL device: index or name substring (see 'tetcollapse devices');\n"
                                         "default: $TETCOLLAPSE_DEVICE, else the first GPU, else the first CPU");
   app.add_option("--stats", c->stats, "Write the run's statistics as JSON to this file ('-' for stdout)");
@@ -280,9 +287,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
       opt.progress = [](const IterationStats& it) {
         std::fprintf(stderr,
                      "iteration %3d: marked %9lld  admissible %9lld  pass1 %8lld  pass2 %8lld  collapsed %8lld  "
-                     "tets %9lld  %.3f s\n",
+                     "tets %9lld  %.3f s%s\n",
                      it.iteration + 1, (long long)it.marked, (long long)it.admissible, (long long)it.after_pass1,
-                     (long long)it.after_pass2, (long long)it.collapsed, (long long)it.tets_after, it.seconds_total);
+                     (long long)it.after_pass2, (long long)it.collapsed, (long long)it.tets_after, it.seconds_total,
+                     it.on_host ? "  (host tail)" : "");
       };
 
     CollapseReport r;

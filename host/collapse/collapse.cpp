@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "collapse/guard_surface.hpp"
+#include "collapse/sequential_run.hpp"
 #include "collapse/stages.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/error.hpp"
@@ -94,6 +95,55 @@ double volume_threshold(const Mesh& mesh, const CollapseOptions& options) {
   return options.eps_v * d2 * std::sqrt(d2);
 }
 
+namespace {
+
+// CollapseOptions::host_tail on this device (negative: automatic).
+double host_tail_fraction(const CollapseOptions& o, const DeviceInfo& device) {
+  if (o.host_tail >= 0) return o.host_tail;
+  return device.type == "CPU" ? CollapseOptions::kHostTailCpu : 0.0;
+}
+
+// After iteration s, does the rest run on the host?
+bool host_tail_due(const CollapseOptions& o, double fraction, const IterationStats& s) {
+  return fraction > 0 && o.eps_c <= 1 && o.cost_cl_source.empty() && s.iteration + 1 < o.max_iterations &&
+         double(s.collapsed) < fraction * double(s.tets);
+}
+
+// The host tail: the sequential method, greedy, on the downloaded mesh (current numbering; its
+// triangles and edges already remapped), with the run's target and volume threshold and the
+// current mask. Its iterations continue the report's.
+void finish_on_host(Mesh& mesh, const CollapseOptions& options, const collapse_detail::StageParams& p,
+                    std::vector<uint8_t> mask, CollapseReport& report) {
+  const int done = int(report.iterations.size());
+  CollapseOptions o = options;
+  o.method = CollapseOptions::Sequential;
+  o.target_length = p.target;
+  o.eps_v = p.eps_v;
+  o.eps_v_relative = false;
+  o.vertex_mask = std::move(mask);
+  o.max_iterations = options.max_iterations - done;
+  o.progress = [&](const IterationStats& s) {
+    if (!options.progress) return;
+    IterationStats t = s;
+    t.iteration += done;
+    t.on_host = true;
+    options.progress(t);
+  };
+  sequential_detail::SequentialRun run(mesh, o);
+  run.set_greedy(true);
+  while (run.step()) {
+  }
+  const CollapseReport r = run.finish();
+  for (IterationStats t : r.iterations) {
+    t.iteration += done;
+    t.on_host = true;
+    report.iterations.push_back(t);
+  }
+  report.seconds_total += r.seconds_total;
+}
+
+}  // namespace
+
 CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
   if (options.method == CollapseOptions::Sequential) return collapse_sequential(mesh, options);
   if (options.max_iterations < 0) throw std::invalid_argument("max_iterations must be >= 0");
@@ -135,6 +185,8 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   Connectivity conn;
   EdgeState st;
   SurfaceGuard guard;
+  bool host_tail = false;
+  const double tail_fraction = host_tail_fraction(options, ctx.info());
   p.target = options.target_length;
   const double t_loop = now();
   for (int it = 0; it < options.max_iterations && dm.nt > 0; ++it) {
@@ -208,6 +260,10 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     report.iterations.push_back(s);
     if (options.progress) options.progress(s);
     if (s.collapsed < std::max<int64_t>(options.eps_c, 1)) break;
+    if (host_tail_due(options, tail_fraction, s)) {
+      host_tail = true;
+      break;
+    }
   }
   report.target_length = p.target;
   const double t_down = now();
@@ -219,7 +275,10 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     remap_elements(mesh.tris, mesh.tri_tags, 3, org);
     remap_elements(mesh.edges, mesh.edge_tags, 2, org);
   }
+  std::vector<uint8_t> mask;
+  if (host_tail && dm.has_mask) mask = dm.vmask.download_range(0, dm.nv);
   report.seconds_download = now() - t_down;
+  if (host_tail) finish_on_host(mesh, options, p, std::move(mask), report);
   report.vertices_out = mesh.num_vertices();
   report.tets_out = mesh.num_tets();
   return report;

@@ -63,6 +63,8 @@ void remap_elements(std::vector<int32_t>& elems, std::vector<int32_t>& tags, int
 }
 
 // Queue order: (cost, a, b) ascending, i.e. (cost, edge index); a heap comparator is "after".
+uint64_t key(int32_t a, int32_t b) { return uint64_t(uint32_t(a)) << 32 | uint32_t(b); }
+
 bool after(double ca, int32_t aa, int32_t ab, double cb, int32_t ba, int32_t bb) {
   if (ca != cb) return ca > cb;
   return aa != ba ? aa > ba : ab > bb;
@@ -156,6 +158,7 @@ bool SequentialRun::step() {
     ++s.tested;
     if (!sm_.admissible(e.a, e.b, fe, dir)) continue;
     heap_.push_back({e.cost, e.a, e.b, uint8_t(dir)});
+    if (greedy_) queued_.insert(key(e.a, e.b));
   }
   s.admissible = int64_t(heap_.size());
   auto later = [](const QueueEntry& x, const QueueEntry& y) { return after(x.cost, x.a, x.b, y.cost, y.a, y.b); };
@@ -168,6 +171,7 @@ bool SequentialRun::step() {
     std::pop_heap(heap_.begin(), heap_.end(), later);
     const QueueEntry e = heap_.back();
     heap_.pop_back();
+    if (greedy_) queued_.erase(key(e.a, e.b));
     if (!sm_.alive(e.a) || !sm_.alive(e.b)) continue;
     uint8_t dir = e.dir;
     const bool invalidated = touched_[e.a] == cur || touched_[e.b] == cur;
@@ -177,6 +181,7 @@ bool SequentialRun::step() {
       const double cost = sm_.length(e.a, e.b);
       if (!marked(e.a, e.b, cost)) continue;
       if (cost != e.cost) {  // an end point moved: back into the queue at its new place
+        if (greedy_) queued_.insert(key(e.a, e.b));
         heap_.push_back({cost, e.a, e.b, 0});
         std::push_heap(heap_.begin(), heap_.end(), later);
         continue;
@@ -195,6 +200,28 @@ bool SequentialRun::step() {
     sm_.collapse(e.a, e.b, dir);
     ++s.collapsed;
     for (int32_t u : sm_.touched()) touched_[u] = cur;
+    if (greedy_) {
+      // the marked edges whose star changed, into the queue now (tested when popped: their end
+      // points are touched) instead of waiting for the next iteration
+      greedy_touched_.assign(sm_.touched().begin(), sm_.touched().end());
+      ++greedy_stamp_;
+      if (greedy_mark_.size() < size_t(sm_.num_vertices())) greedy_mark_.resize(size_t(sm_.num_vertices()), 0);
+      for (int32_t u : greedy_touched_) greedy_mark_[u] = greedy_stamp_;
+      for (int32_t u : greedy_touched_) {
+        if (!sm_.alive(u)) continue;
+        sm_.neighbours(u, nb_);
+        for (int32_t w : nb_) {
+          // each edge once per collapse: from its lower end point when both are touched
+          if (w < u && greedy_mark_[w] == greedy_stamp_) continue;
+          const int32_t a = std::min(u, w), b = std::max(u, w);
+          const double cost = sm_.length(a, b);
+          if (!marked(a, b, cost)) continue;
+          if (!queued_.insert(key(a, b)).second) continue;  // already queued (popped: tested again)
+          heap_.push_back({cost, a, b, 0});
+          std::push_heap(heap_.begin(), heap_.end(), later);
+        }
+      }
+    }
   }
   s.after_pass1 = s.after_pass2 = s.collapsed;  // no conflict passes: every collapse is applied
 

@@ -36,6 +36,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <unordered_set>
 #include <vector>
 
 #include "collapse/sequential_mesh.hpp"
@@ -58,6 +59,9 @@ class SequentialRun {
   CollapseReport finish();
 
   SeqMesh& seq() { return sm_; }
+  // Greedy: after each collapse the marked edges around it go into the queue at once, so that
+  // one iteration collapses until nothing is admissible (the next one finds nothing).
+  void set_greedy(bool on) { greedy_ = on; }
   const CollapseReport& report() const { return report_; }
   double target() const { return target_; }
 
@@ -81,7 +85,11 @@ class SequentialRun {
   std::vector<int32_t> origin_;    // input vertex -> current vertex (only with tris or edges)
   std::vector<uint32_t> touched_;  // per vertex: 1 + the last iteration that touched its star (0: none)
   std::vector<QueueEntry> edges_, heap_;
-  std::vector<int32_t> nb_, vmap_, kept_;
+  std::vector<int32_t> nb_, vmap_, kept_, greedy_touched_;
+  bool greedy_ = false;
+  std::unordered_set<uint64_t> queued_;  // greedy: the edges (a << 32 | b) in the queue
+  std::vector<uint32_t> greedy_mark_;
+  uint32_t greedy_stamp_ = 0;
 };
 
 }  // namespace tc::sequential_detail

@@ -62,6 +62,9 @@ struct IterationStats {
   // holds the lazy filter together with conflict pass 1; seconds_pass1 is then 0.
   double seconds_connectivity = 0, seconds_cost = 0, seconds_admissible = 0, seconds_pass1 = 0,
          seconds_pass2 = 0, seconds_collapse = 0, seconds_total = 0;
+  // An iteration of the host tail (CollapseOptions::host_tail): the sequential method's, greedy;
+  // its stats are those of the sequential method (no conflict passes).
+  bool on_host = false;
 };
 
 struct CollapseReport {
@@ -128,6 +131,17 @@ struct CollapseOptions {
   // before the run (memory locality of the stages: W1 about 20% faster with TetGen's numbering).
   // The output's vertices and tets follow that order instead of the input's.
   bool spatial_order = true;
+  // Host tail. Parallel method run until nothing collapses (eps_c <= 1) with the built-in cost:
+  // once an iteration collapses fewer than host_tail x (its tets) edges, the rest runs on the
+  // host with the sequential method's checks, greedily (after each collapse the marked edges
+  // around it are queued at once; one more iteration confirms that nothing is left). The last
+  // iterations of the parallel method collapse a few edges each (a cascade: a collapse makes a
+  // neighbour admissible) at the price of passes over the whole mesh, which on a CPU device
+  // cost more than collapsing them one by one: W1 (bench/README.md) saves ~0.2 s of ~3 s. On a
+  // GPU those passes are cheap. Negative (default): kHostTailCpu on CPU devices, 0 on others;
+  // 0: every iteration on the device. Decided by counts only: the output stays deterministic.
+  static constexpr double kHostTailCpu = 0.002;
+  double host_tail = -1;
 
   // Adaptive marking: with a non-empty mask (one byte per input vertex, non-zero = selected),
   // only edges whose both end points are selected are marked, or either end point with

@@ -146,6 +146,24 @@ TEST(Cli, CoarsenWritesAValidMeshAndStats) {
             0)
       << out;
   EXPECT_NE(tc::test::read_text(stats).find("\"spatial_order\":false"), std::string::npos);
+  // the host tail: its iterations marked in the progress lines and the statistics
+  ASSERT_EQ(run_command(cli() + " " + q(tc::test::project_mesh("bracket.msh")) + " " + q(result) +
+                            " --target-factor 2 --host-tail 0.05 --check --stats " + q(stats),
+                        &out),
+            0)
+      << out;
+  EXPECT_NE(out.find("(host tail)"), std::string::npos) << out;
+  EXPECT_NE(tc::test::read_text(stats).find("\"on_host\":true"), std::string::npos);
+  EXPECT_NE(tc::test::read_text(stats).find("\"on_host\":false"), std::string::npos);
+  ASSERT_EQ(run_command(cli() + " " + q(tc::test::project_mesh("bracket.msh")) + " " + q(result) +
+                            " --target-factor 2 --host-tail 0 -q --stats " + q(stats),
+                        &out),
+            0)
+      << out;
+  EXPECT_EQ(tc::test::read_text(stats).find("\"on_host\":true"), std::string::npos);
+  EXPECT_NE(run_command(cli() + " " + q(tc::test::project_mesh("bracket.msh")) + " " + q(result) + " --host-tail 2",
+                        &out),
+            0);
   // Quiet mode prints nothing on success.
   ASSERT_EQ(run_command(cli() + " -q " + q(tc::test::project_mesh("tet.mesh")) + " " + q(dir.file("t.mesh")), &out), 0);
   EXPECT_TRUE(out.empty()) << out;

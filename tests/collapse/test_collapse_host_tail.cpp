@@ -1,0 +1,192 @@
+// The host tail (CollapseOptions::host_tail): once an iteration of the parallel method collapses
+// few edges, the rest runs on the host with the sequential method's checks, greedily.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <set>
+
+#include "tetcollapse/check.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/io.hpp"
+#include "tetcollapse/topology.hpp"
+#include "test_support.hpp"
+
+using namespace tc;
+
+namespace {
+
+// The bracket (curved faces, ridges, corners, Gmsh's boundary triangles) with two materials
+// (split at the centre of its box) and a vertex field (x).
+Mesh bracket_with_attributes() {
+  Mesh m = read_mesh(test::project_mesh("bracket.msh"));
+  double lo = m.points[0], hi = m.points[0];
+  for (size_t v = 0; v < m.points.size(); v += 3) {
+    lo = std::min(lo, m.points[v]);
+    hi = std::max(hi, m.points[v]);
+  }
+  Labels l;
+  l.name = "material";
+  for (int64_t t = 0; t < m.num_tets(); ++t) {
+    double cx = 0;
+    for (int k = 0; k < 4; ++k) cx += m.points[3 * size_t(m.tets[4 * t + k])] / 4;
+    l.values.push_back(cx < 0.5 * (lo + hi) ? 1 : 2);
+  }
+  m.tet_labels.insert(m.tet_labels.begin(), l);
+  Field f;
+  f.name = "x";
+  f.components = 1;
+  for (size_t v = 0; v < m.points.size(); v += 3) f.values.push_back(m.points[v]);
+  m.vertex_fields.push_back(f);
+  return m;
+}
+
+CollapseOptions tail_early() {
+  CollapseOptions o;
+  o.target_factor = 2;
+  o.host_tail = 0.05;  // from the first iteration collapsing fewer than 5% of its tets
+  return o;
+}
+
+int count_on_host(const CollapseReport& r) {
+  return int(std::count_if(r.iterations.begin(), r.iterations.end(), [](const IterationStats& s) { return s.on_host; }));
+}
+
+}  // namespace
+
+TEST(CollapseHostTail, FinishesOnTheHostWithNothingLeft) {
+  Context ctx;
+  const Mesh in = bracket_with_attributes();
+  Mesh m = in;
+  const CollapseReport r = collapse(m, tail_early(), ctx);
+  ASSERT_GE(count_on_host(r), 2) << "the tail did not run (a greedy iteration and the one that finds nothing)";
+  // greedy: the sequential method's own iterations would need many more (a cascade each)
+  EXPECT_LE(count_on_host(r), 3);
+  // device iterations first, then the host's, numbered on; each starts where the last ended
+  int64_t collapsed = 0;
+  for (size_t i = 0; i < r.iterations.size(); ++i) {
+    const IterationStats& s = r.iterations[i];
+    EXPECT_EQ(s.iteration, int(i));
+    if (i > 0) {
+      EXPECT_FALSE(r.iterations[i - 1].on_host && !s.on_host) << "a device iteration after the host tail";
+      EXPECT_EQ(s.tets, r.iterations[i - 1].tets_after);
+      EXPECT_EQ(s.vertices, r.iterations[i - 1].vertices_after);
+    }
+    collapsed += s.collapsed;
+  }
+  EXPECT_GT(r.iterations[r.iterations.size() - count_on_host(r)].collapsed, 0);
+  EXPECT_EQ(r.iterations.back().collapsed, 0);
+  EXPECT_EQ(r.vertices_in - r.vertices_out, collapsed);
+  EXPECT_EQ(r.tets_out, m.num_tets());
+
+  CheckOptions co;
+  co.quality = false;
+  co.hausdorff = false;
+  const CheckReport c = check_mesh(m, co, &in);
+  EXPECT_TRUE(c.valid) << check_report_text(c);
+  EXPECT_FALSE(c.reference.topology_changed);
+  ASSERT_EQ(m.tet_labels.size(), in.tet_labels.size());
+  EXPECT_EQ(m.tet_labels[0].values.size(), size_t(m.num_tets()));
+  ASSERT_EQ(m.vertex_fields.size(), 1u);
+  ASSERT_EQ(m.vertex_fields[0].values.size(), size_t(m.num_vertices()));
+  // the field stays with the survivors (midpoint placement averages it): within the input's range
+  const auto [flo, fhi] = std::minmax_element(in.vertex_fields[0].values.begin(), in.vertex_fields[0].values.end());
+  for (double x : m.vertex_fields[0].values) {
+    EXPECT_GE(x, *flo);
+    EXPECT_LE(x, *fhi);
+  }
+
+  // Nothing is left to collapse: a fresh device iteration with the same target finds nothing.
+  Mesh again = m;
+  CollapseOptions o2 = tail_early();
+  o2.target_length = r.target_length;
+  o2.host_tail = 0;
+  o2.max_iterations = 1;
+  const CollapseReport r2 = collapse(again, o2, ctx);
+  ASSERT_EQ(r2.iterations.size(), 1u);
+  EXPECT_GT(r2.iterations[0].marked, 0);
+  EXPECT_EQ(r2.iterations[0].collapsed, 0);
+}
+
+TEST(CollapseHostTail, DeterministicAndBoundedByMaxIterations) {
+  Context ctx;
+  const Mesh in = bracket_with_attributes();
+  Mesh a = in, b = in;
+  const CollapseReport ra = collapse(a, tail_early(), ctx);
+  collapse(b, tail_early(), ctx);
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_EQ(a.tets, b.tets);
+  EXPECT_EQ(a.tet_labels[0].values, b.tet_labels[0].values);
+  EXPECT_EQ(a.vertex_fields[0].values, b.vertex_fields[0].values);
+  // max_iterations counts the host's iterations too
+  const int device_its = int(ra.iterations.size()) - count_on_host(ra);
+  CollapseOptions o = tail_early();
+  o.max_iterations = device_its + 1;
+  Mesh c = in;
+  const CollapseReport rc = collapse(c, o, ctx);
+  EXPECT_EQ(int(rc.iterations.size()), device_its + 1);
+  EXPECT_EQ(count_on_host(rc), 1);
+  EXPECT_TRUE(rc.iterations.back().on_host);
+}
+
+TEST(CollapseHostTail, OnlyWhenRunningUntilNothingCollapses) {
+  Context ctx;
+  const Mesh in = bracket_with_attributes();
+  CollapseOptions off = tail_early();
+  off.host_tail = 0;
+  CollapseOptions eps = tail_early();
+  eps.eps_c = 50;  // stops by itself: no tail
+  CollapseOptions user = tail_early();
+  user.target_length = 2 * median_edge_length(in);
+  user.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return length(p1 - p0); }";
+  for (const CollapseOptions* o : {&off, &eps, &user}) {
+    Mesh m = in;
+    const CollapseReport r = collapse(m, *o, ctx);
+    EXPECT_GT(r.vertices_in, r.vertices_out);
+    EXPECT_EQ(count_on_host(r), 0);
+  }
+  // the default: on CPU devices from 0.2% on, elsewhere never (the device decides, not the run)
+  Mesh m = in;
+  CollapseOptions d;
+  d.target_factor = 2;
+  d.max_iterations = 1;
+  EXPECT_LT(d.host_tail, 0);
+  const CollapseReport r = collapse(m, d, ctx);
+  EXPECT_EQ(count_on_host(r), 0);  // one iteration: no room for a tail
+}
+
+// The mask and the boundary triangles travel into the host tail: unselected vertices stay, the
+// triangles are remapped onto faces of the result.
+TEST(CollapseHostTail, MaskAndTrianglesCarried) {
+  Context ctx;
+  const Mesh in = bracket_with_attributes();
+  ASSERT_GT(in.tris.size(), 0u);
+  double lo = in.points[0], hi = in.points[0];
+  for (size_t v = 0; v < in.points.size(); v += 3) {
+    lo = std::min(lo, in.points[v]);
+    hi = std::max(hi, in.points[v]);
+  }
+  CollapseOptions o = tail_early();
+  std::set<test::Point3> outside;
+  o.vertex_mask = test::mask_x_below(in, lo + 0.6 * (hi - lo), &outside);
+  Mesh m = in;
+  const CollapseReport r = collapse(m, o, ctx);
+  ASSERT_GE(count_on_host(r), 1);
+  EXPECT_LT(r.tets_out, r.tets_in);
+  const std::set<test::Point3> out = test::vertex_positions(m);
+  for (const auto& p : outside) EXPECT_TRUE(out.count(p)) << "an unselected vertex moved or went away";
+  ASSERT_EQ(m.tris.size(), 3 * m.tri_tags.size());
+  EXPECT_GT(m.tri_tags.size(), 0u);
+  const Topology t = build_topology(m);
+  std::set<std::array<int32_t, 3>> faces;
+  for (int32_t f = 0; f < t.num_sfaces(); ++f) {
+    std::array<int32_t, 3> k{t.sfaces[3 * f], t.sfaces[3 * f + 1], t.sfaces[3 * f + 2]};
+    std::sort(k.begin(), k.end());
+    faces.insert(k);
+  }
+  for (size_t i = 0; i < m.tri_tags.size(); ++i) {
+    std::array<int32_t, 3> k{m.tris[3 * i], m.tris[3 * i + 1], m.tris[3 * i + 2]};
+    std::sort(k.begin(), k.end());
+    EXPECT_TRUE(faces.count(k)) << "triangle " << i << " is not a boundary face of the result";
+  }
+}
