@@ -105,7 +105,8 @@ double host_tail_fraction(const CollapseOptions& o, const DeviceInfo& device) {
 
 // After iteration s, does the rest run on the host?
 bool host_tail_due(const CollapseOptions& o, double fraction, const IterationStats& s) {
-  return fraction > 0 && o.eps_c <= 1 && o.cost_cl_source.empty() && s.iteration + 1 < o.max_iterations &&
+  return fraction > 0 && o.conflicts == CollapseOptions::TwoPass && o.eps_c <= 1 && o.cost_cl_source.empty() &&
+         s.iteration + 1 < o.max_iterations &&
          double(s.collapsed) < fraction * double(s.tets);
 }
 

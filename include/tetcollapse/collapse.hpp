@@ -131,7 +131,8 @@ struct CollapseOptions {
   // before the run (memory locality of the stages: W1 about 20% faster with TetGen's numbering).
   // The output's vertices and tets follow that order instead of the input's.
   bool spatial_order = true;
-  // Host tail. Parallel method run until nothing collapses (eps_c <= 1) with the built-in cost:
+  // Host tail. Parallel method with the two-pass conflict detection, run until nothing
+  // collapses (eps_c <= 1), with the built-in cost:
   // once an iteration collapses fewer than host_tail x (its tets) edges, the rest runs on the
   // host with the sequential method's checks, greedily (after each collapse the marked edges
   // around it are queued at once; one more iteration confirms that nothing is left). The last
