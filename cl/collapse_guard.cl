@@ -179,33 +179,35 @@ inline int tcc_sg_boxes_apart(const double3* a, const double3* b) {
   return alo.x > bhi.x || alo.y > bhi.y || alo.z > bhi.z || blo.x > ahi.x || blo.y > ahi.y || blo.z > ahi.z;
 }
 
-/* The uniform grid of the query boxes (built by the host): cell (i, j, k) of size h from org,
- * dims gd; the queries of cell c are cell_items[cell_off[c] .. cell_off[c + 1]). */
-inline int tcc_sg_cell(double v, double org, double h, int n) {
-  double c = floor((v - org) / h);
+/* The uniform grid of the query boxes (built by the host): cell (i, j, k) of size 1 / ih from
+ * org, dims gd; the queries of cell c are cell_items[cell_off[c] .. cell_off[c + 1]). A product
+ * by the inverse instead of a division (the host's cell_of does the same arithmetic, which
+ * keeps every pair's owner cell among the cells both were entered in). */
+inline int tcc_sg_cell(double v, double org, double ih, int n) {
+  double c = floor((v - org) * ih);
   return c < 0.0 ? 0 : c >= (double)n ? n - 1 : (int)c;
 }
 
 /* Is (i, j, k) the cell holding the low corner of the overlap of boxes A and B (so each pair
  * is tested once)? Also tests the overlap. */
 inline int tcc_sg_owner_cell(double3 alo, double3 ahi, __global const double* b, int i, int j, int k, double3 org,
-                             double h, int4 gd) {
+                             double ih, int4 gd) {
   double3 blo = (double3)(b[0], b[1], b[2]), bhi = (double3)(b[3], b[4], b[5]);
   if (alo.x > bhi.x || alo.y > bhi.y || alo.z > bhi.z || blo.x > ahi.x || blo.y > ahi.y || blo.z > ahi.z) return 0;
   double3 c = fmax(alo, blo);
-  return tcc_sg_cell(c.x, org.x, h, gd.x) == i && tcc_sg_cell(c.y, org.y, h, gd.y) == j &&
-         tcc_sg_cell(c.z, org.z, h, gd.z) == k;
+  return tcc_sg_cell(c.x, org.x, ih, gd.x) == i && tcc_sg_cell(c.y, org.y, ih, gd.y) == j &&
+         tcc_sg_cell(c.z, org.z, ih, gd.z) == k;
 }
 
 /* Loop over the queries entered in the grid cells that the box [LO, HI] overlaps: the body
  * (the variadic rest, so that it may hold commas) sees the cell (ci, cj, ck) and the query QI
- * (`continue` goes to the next query). Needs ox, oy, oz, h, gx, gy, gz, cell_off and
+ * (`continue` goes to the next query). Needs ox, oy, oz, ih, gx, gy, gz, cell_off and
  * cell_items in scope. */
 #define TCC_SG_FOR_CELL_QUERIES(LO, HI, QI, ...)                                                              \
   {                                                                                                          \
-    const int i0_ = tcc_sg_cell((LO).x, ox, h, gx), i1_ = tcc_sg_cell((HI).x, ox, h, gx);                    \
-    const int j0_ = tcc_sg_cell((LO).y, oy, h, gy), j1_ = tcc_sg_cell((HI).y, oy, h, gy);                    \
-    const int k0_ = tcc_sg_cell((LO).z, oz, h, gz), k1_ = tcc_sg_cell((HI).z, oz, h, gz);                    \
+    const int i0_ = tcc_sg_cell((LO).x, ox, ih, gx), i1_ = tcc_sg_cell((HI).x, ox, ih, gx);                  \
+    const int j0_ = tcc_sg_cell((LO).y, oy, ih, gy), j1_ = tcc_sg_cell((HI).y, oy, ih, gy);                  \
+    const int k0_ = tcc_sg_cell((LO).z, oz, ih, gz), k1_ = tcc_sg_cell((HI).z, oz, ih, gz);                  \
     for (int ck = k0_; ck <= k1_; ++ck)                                                                      \
       for (int cj = j0_; cj <= j1_; ++cj)                                                                    \
         for (int ci = i0_; ci <= i1_; ++ci) {                                                                \
@@ -223,7 +225,7 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
                              __global const int* tets, __global const int* tet_nbr, __global const int* labels,
                              int use_labels, __global const int* qedge, __global const double* qbox,
                              __global const uint* qoff, __global const int* tid, __global const double* tpos,
-                             double ox, double oy, double oz, double h, int gx, int gy, int gz,
+                             double ox, double oy, double oz, double ih, int gx, int gy, int gz,
                              __global const uint* cell_off, __global const uint* cell_items, __global uint* qbad) {
   const uint g = get_global_id(0);
   if (g >= n) return;
@@ -242,7 +244,7 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
     }
     double3 lo = fmin(fmin(fpos[0], fpos[1]), fpos[2]), hi = fmax(fmax(fpos[0], fpos[1]), fpos[2]);
     TCC_SG_FOR_CELL_QUERIES(lo, hi, qi, {
-      if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qi, ci, cj, ck, org, h, gd)) continue;
+      if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qi, ci, cj, ck, org, ih, gd)) continue;
       int x, y;
       double3 p;
       int moves_y = tcc_sg_collapse(qedge[qi], edges, dir, pts, &x, &y, &p);
@@ -264,7 +266,7 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
 
 /* The new triangles of two queries against each other. */
 __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const uint* qoff, __global const int* tid,
-                           __global const double* tpos, double ox, double oy, double oz, double h, int gx, int gy,
+                           __global const double* tpos, double ox, double oy, double oz, double ih, int gx, int gy,
                            int gz, __global const uint* cell_off, __global const uint* cell_items,
                            __global uint* qbad) {
   uint qa = get_global_id(0);
@@ -288,7 +290,7 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
     }
   }
   TCC_SG_FOR_CELL_QUERIES(lo, hi, qb, {
-    if (qb == qa || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qb, ci, cj, ck, org, h, gd)) continue;
+    if (qb == qa || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qb, ci, cj, ck, org, ih, gd)) continue;
     for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
       int ida[3];
       double3 posa[3];

@@ -46,9 +46,10 @@ void launch(Context& ctx, const char* name, size_t n, const A&... args) {
   }
 }
 
-// The cell of coordinate v on one axis; the same arithmetic as tcc_sg_cell in the kernels.
-int cell_of(double v, double org, double h, int n) {
-  double c = std::floor((v - org) / h);
+// The cell of coordinate v on one axis (ih = 1 / the cell size); the same arithmetic as
+// tcc_sg_cell in the kernels.
+int cell_of(double v, double org, double ih, int n) {
+  double c = std::floor((v - org) * ih);
   return c < 0.0 ? 0 : c >= double(n) ? n - 1 : int(c);
 }
 
@@ -111,6 +112,7 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   double ext = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
   double h = std::max(2 * extent[nq / 2], ext / kMaxCellsPerAxis);
   if (!(h > 0) || !std::isfinite(h)) h = 1;  // all boxes one point
+  const double ih = 1.0 / h;
   int g[3];
   for (int a = 0; a < 3; ++a) g[a] = std::min(kMaxCellsPerAxis + 1, int(std::floor((hi[a] - lo[a]) / h)) + 1);
   const size_t ncells = size_t(g[0]) * g[1] * g[2];
@@ -119,8 +121,8 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   auto for_cells = [&](uint32_t q, auto&& fn) {
     int r0[3], r1[3];
     for (int a = 0; a < 3; ++a) {
-      r0[a] = cell_of(box[6 * q + a], lo[a], h, g[a]);
-      r1[a] = cell_of(box[6 * q + 3 + a], lo[a], h, g[a]);
+      r0[a] = cell_of(box[6 * q + a], lo[a], ih, g[a]);
+      r1[a] = cell_of(box[6 * q + 3 + a], lo[a], ih, g[a]);
     }
     for (int k = r0[2]; k <= r1[2]; ++k)
       for (int j = r0[1]; j <= r1[1]; ++j)
@@ -148,10 +150,10 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   }
   launch(ctx, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), c.edges.buffer(), s.dir.buffer(),
          dm.points.buffer(), dm.tets.buffer(), c.tet_nbr.buffer(), labels, use_labels, qedge.buffer(), qbox.buffer(),
-         qoff.buffer(), tid.buffer(), tpos.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(h),
+         qoff.buffer(), tid.buffer(), tpos.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
          cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());
   launch(ctx, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
-         cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(h), cl_int(g[0]), cl_int(g[1]),
+         cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
          cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());
   qcount.fill(0u);
   const bool has_verdict = s.verdict.size() >= c.ne && s.verdict.buffer()();

@@ -8,6 +8,8 @@
 #include <sstream>
 #include <sys/wait.h>
 
+#include "tetcollapse/topology.hpp"
+
 namespace tc::test {
 
 std::string shared_meshes_dir() {
@@ -97,6 +99,28 @@ std::set<Point3> vertex_positions(const Mesh& m) {
   std::set<Point3> s;
   for (int64_t v = 0; v < m.num_vertices(); ++v) s.insert({m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]});
   return s;
+}
+
+std::set<std::array<int32_t, 3>> sface_keys(const Mesh& m) {
+  const Topology t = build_topology(m);
+  std::set<std::array<int32_t, 3>> faces;
+  for (int32_t f = 0; f < t.num_sfaces(); ++f) {
+    std::array<int32_t, 3> k{t.sfaces[3 * f], t.sfaces[3 * f + 1], t.sfaces[3 * f + 2]};
+    std::sort(k.begin(), k.end());
+    faces.insert(k);
+  }
+  return faces;
+}
+
+std::vector<size_t> triangles_off_surface(const Mesh& m) {
+  const std::set<std::array<int32_t, 3>> faces = sface_keys(m);
+  std::vector<size_t> off;
+  for (size_t i = 0; 3 * i + 2 < m.tris.size(); ++i) {
+    std::array<int32_t, 3> k{m.tris[3 * i], m.tris[3 * i + 1], m.tris[3 * i + 2]};
+    std::sort(k.begin(), k.end());
+    if (!faces.count(k)) off.push_back(i);
+  }
+  return off;
 }
 
 }  // namespace tc::test

@@ -1,6 +1,7 @@
 // Helpers shared by the test executables.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <set>
@@ -46,6 +47,10 @@ using Point3 = std::tuple<double, double, double>;
 std::vector<uint8_t> mask_x_below(const Mesh& m, double x_max, std::set<Point3>* unselected);
 // The vertex positions of a mesh.
 std::set<Point3> vertex_positions(const Mesh& m);
+// The faces of the feature surface S (tc::build_topology) as sorted vertex triples, and the
+// indices of the triangles of m.tris that are not among them.
+std::set<std::array<int32_t, 3>> sface_keys(const Mesh& m);
+std::vector<size_t> triangles_off_surface(const Mesh& m);
 
 // Runs a shell command, returns its exit code; its stdout+stderr go into *output.
 int run_command(const std::string& cmd, std::string* output);
