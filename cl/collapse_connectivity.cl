@@ -117,6 +117,42 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
       return;
     }
   }
+  if (carry && rename && prev_vaff[vold[v]] >= 0) {
+    /* v survives the collapse of u onto it: N(v) = N(u) U N(v) without u and v (the same link
+     * condition argument), renumbered. No other vertex of the two lists is an end point of a
+     * collapse (no tet holds end points of two final edges), so both renumber in order (the
+     * compaction keeps the order of the kept vertices) and a merge of the two keeps N(v)
+     * sorted. Otherwise (not expected) the general gather below. */
+    const int o = vold[v];
+    const uint ab = prev_nb_off[o], ae = prev_nb_off[o + 1];
+    int u = -1, other = 0;
+    for (uint i = ab; i < ae; ++i) {
+      int w = prev_nb[i];
+      if (prev_vaff[w] < 0) continue;
+      if (vmap[w] == (int)v && u < 0) u = w;
+      else other = 1;
+    }
+    if (u >= 0 && !other) {
+      const uint bb = prev_nb_off[u], be = prev_nb_off[u + 1];
+      for (uint j = bb; j < be && !other; ++j) other = prev_nb[j] != o && prev_vaff[prev_nb[j]] >= 0;
+      if (!other) {
+        /* u in N(v) and v in N(u) renumber to v, out of order: skipped before comparing */
+        uint i = ab, j = bb, m = 0;
+        for (;;) {
+          if (i < ae && prev_nb[i] == u) ++i;
+          if (j < be && prev_nb[j] == o) ++j;
+          if (i >= ae && j >= be) break;
+          int x = i < ae ? vmap[prev_nb[i]] : INT_MAX, y = j < be ? vmap[prev_nb[j]] : INT_MAX;
+          int z = x < y ? x : y;
+          if (x == z) ++i;
+          if (y == z) ++j;
+          s[m++] = z;
+        }
+        tcc_count_neighbours(s, m, v, nb_count, up_count);
+        return;
+      }
+    }
+  }
   /* N(v) is built by insertion into a sorted private list (short: ~15 entries), spilling to the
    * global scratch area only when it outgrows TCC_MAX_NB */
   int loc[TCC_MAX_NB];
