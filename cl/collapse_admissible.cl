@@ -22,6 +22,14 @@
 #endif
 #define TCC_VOL_CHUNK 32
 
+/* Software prefetch (lazy_p1_decide) where the host asks for it (CPU devices) and the compiler
+ * has the builtin (clang, as in PoCL). */
+#if defined(TCC_PREFETCH) && defined(__has_builtin)
+#if __has_builtin(__builtin_prefetch)
+#define TCC_PREFETCH_OK 1
+#endif
+#endif
+
 inline int tcc_in(const int* list, int n, int x) {
   for (int i = 0; i < n; ++i)
     if (list[i] == x) return 1;
@@ -427,6 +435,23 @@ __kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const 
                              TCC_TEST_PARAMS) {
   uint i = get_global_id(0);
   if (i >= n) return;
+#ifdef TCC_PREFETCH_OK
+  /* CPU devices (the host sets TCC_PREFETCH) run a work-group's items one after another: start
+   * the memory traffic of the next items' tests, whose first loop otherwise waits for each of
+   * its tets in turn (W1: the test's share of the CPU samples 23% -> 21%): three items ahead
+   * the rings' lists, two ahead the rings' tets. */
+  if (i + 3 < n) {
+    int e3 = (int)tlist[i + 3];
+    for (int s = 0; s < 2; ++s) __builtin_prefetch(vt + vt_off[edges[2 * e3 + s]]);
+  }
+  if (i + 2 < n) {
+    int e2 = (int)tlist[i + 2];
+    for (int s = 0; s < 2; ++s) {
+      int x = edges[2 * e2 + s];
+      for (uint k = vt_off[x]; k < vt_off[x + 1]; ++k) __builtin_prefetch(tets + 4 * vt[k]);
+    }
+  }
+#endif
   tcc_p1_decide((int)tlist[i], edges, state, vaff, slot, dlist, cnt + 2, TCC_TEST_ARGS);
 }
 

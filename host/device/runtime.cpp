@@ -370,6 +370,9 @@ cl::Program& Context::build(const std::string& file, const std::string& text, co
   std::set<std::string> seen{file};
   expand_text(text, source, seen, 0);
   std::string opts = "-cl-std=CL1.2";
+  // CPU devices run a work-group's items one after another, so a kernel may prefetch for its
+  // next items (cl/collapse_admissible.cl, lazy_p1_decide)
+  if (info_.type == "CPU") opts += " -DTCC_PREFETCH";
   if (!options.empty()) opts += " " + options;
   if (const char* extra = std::getenv("TETCOLLAPSE_CL_OPTIONS"); extra && *extra) opts += std::string(" ") + extra;
 
