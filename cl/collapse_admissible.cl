@@ -460,6 +460,14 @@ __kernel void lazy_p1_recompute(uint n, __global const uint* dlist, __global con
                                 __global int* slot) {
   uint i = get_global_id(0);
   if (i >= n) return;
+#ifdef TCC_PREFETCH_OK
+  /* as in lazy_p1_decide: the next items' edge lists, then their costs */
+  if (i + 2 < n) __builtin_prefetch(nb_edge + nb_off[dlist[i + 2]]);
+  if (i + 1 < n) {
+    int v1 = (int)dlist[i + 1];
+    for (uint j = nb_off[v1]; j < nb_off[v1 + 1]; ++j) __builtin_prefetch(cost + nb_edge[j]);
+  }
+#endif
   tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, cost, slot);
 }
 
