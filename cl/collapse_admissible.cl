@@ -22,13 +22,6 @@
 #endif
 #define TCC_VOL_CHUNK 32
 
-/* Software prefetch (lazy_p1_decide) where the host asks for it (CPU devices) and the compiler
- * has the builtin (clang, as in PoCL). */
-#if defined(TCC_PREFETCH) && defined(__has_builtin)
-#if __has_builtin(__builtin_prefetch)
-#define TCC_PREFETCH_OK 1
-#endif
-#endif
 
 inline int tcc_in(const int* list, int n, int x) {
   for (int i = 0; i < n; ++i)

@@ -19,6 +19,15 @@
  * predicate Q: cl/collapse_predicate.h, shared with the sequential method. */
 #include "collapse_predicate.h"
 
+/* Software prefetch for the next work items of a kernel, where the host asks for it (CPU
+ * devices, which run a work-group's items one after another: TCC_PREFETCH) and the compiler
+ * has the builtin (clang, as in PoCL). */
+#if defined(TCC_PREFETCH) && defined(__has_builtin)
+#if __has_builtin(__builtin_prefetch)
+#define TCC_PREFETCH_OK 1
+#endif
+#endif
+
 /* Refusal reasons written by the admissible filter (tc::collapse::Reason). */
 #define TCC_OK 0
 #define TCC_NOT_MARKED 1
