@@ -167,6 +167,7 @@ bool SequentialRun::step() {
 
   // 2. pop, check again where an earlier collapse changed the star, collapse
   const uint32_t cur = uint32_t(it_) + 1;
+  int64_t guard_refusals = 0;
   while (!heap_.empty()) {
     std::pop_heap(heap_.begin(), heap_.end(), later);
     const QueueEntry e = heap_.back();
@@ -195,6 +196,7 @@ bool SequentialRun::step() {
       // refused by the surface guard, which looks beyond the star: its end points count as
       // touched, so the edge is tested again next iteration (S nearby may have moved away)
       touched_[e.a] = touched_[e.b] = cur;
+      ++guard_refusals;
       continue;
     }
     sm_.collapse(e.a, e.b, dir);
@@ -249,6 +251,10 @@ bool SequentialRun::step() {
   if (o_.progress) o_.progress(s);
   ++it_;
   if (s.collapsed < std::max<int64_t>(o_.eps_c, 1)) done_ = true;
+  // Greedy: every marked edge was tested after the last change of its star, so nothing is
+  // admissible now, unless the surface guard, which looks beyond the star, refused one (S
+  // nearby may have moved since): only then another iteration.
+  if (greedy_ && guard_refusals == 0) done_ = true;
   return !done_;
 }
 

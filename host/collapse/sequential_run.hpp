@@ -60,7 +60,8 @@ class SequentialRun {
 
   SeqMesh& seq() { return sm_; }
   // Greedy: after each collapse the marked edges around it go into the queue at once, so that
-  // one iteration collapses until nothing is admissible (the next one finds nothing).
+  // one iteration collapses until nothing is admissible; the run then stops, unless the surface
+  // guard refused an edge (it looks beyond the star), which another iteration tests again.
   void set_greedy(bool on) { greedy_ = on; }
   const CollapseReport& report() const { return report_; }
   double target() const { return target_; }

@@ -57,9 +57,10 @@ TEST(CollapseHostTail, FinishesOnTheHostWithNothingLeft) {
   const Mesh in = bracket_with_attributes();
   Mesh m = in;
   const CollapseReport r = collapse(m, tail_early(), ctx);
-  ASSERT_GE(count_on_host(r), 2) << "the tail did not run (a greedy iteration and the one that finds nothing)";
-  // greedy: the sequential method's own iterations would need many more (a cascade each)
-  EXPECT_LE(count_on_host(r), 3);
+  ASSERT_GE(count_on_host(r), 1) << "the tail did not run";
+  // greedy: one iteration (another only after a refusal by the surface guard); the sequential
+  // method's own iterations would need many more (a cascade each)
+  EXPECT_LE(count_on_host(r), 2);
   // device iterations first, then the host's, numbered on; each starts where the last ended
   int64_t collapsed = 0;
   for (size_t i = 0; i < r.iterations.size(); ++i) {
@@ -73,7 +74,6 @@ TEST(CollapseHostTail, FinishesOnTheHostWithNothingLeft) {
     collapsed += s.collapsed;
   }
   EXPECT_GT(r.iterations[r.iterations.size() - count_on_host(r)].collapsed, 0);
-  EXPECT_EQ(r.iterations.back().collapsed, 0);
   EXPECT_EQ(r.vertices_in - r.vertices_out, collapsed);
   EXPECT_EQ(r.tets_out, m.num_tets());
 
