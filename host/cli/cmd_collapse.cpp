@@ -221,8 +221,9 @@ void register_collapse(CLI::App& app, int& exit_code) {
                "follows that order)");
   app.add_option("--host-tail", c->opt.host_tail,
                  "Parallel method with --eps-c 0 or 1: once an iteration collapses fewer than F x its\n"
-                 "tets, finish on the host with the sequential method's checks, greedily (the last\n"
-                 "iterations collapse a few edges each at the price of passes over the whole mesh).\n"
+                 "tets (and the counts shrink slowly: a long tail), finish on the host with the\n"
+                 "sequential method's checks, greedily (the last iterations collapse a few edges each\n"
+                 "at the price of passes over the whole mesh).\n"
                  "Default: 0.002 on CPU devices, 0 (all on the device) on GPUs")
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--device", c->device, "OpenCL device: index or name substring (see 'tetcollapse devices');\n"

@@ -103,11 +103,20 @@ double host_tail_fraction(const CollapseOptions& o, const DeviceInfo& device) {
   return device.type == "CPU" ? CollapseOptions::kHostTailCpu : 0.0;
 }
 
-// After iteration s, does the rest run on the host?
-bool host_tail_due(const CollapseOptions& o, double fraction, const IterationStats& s) {
-  return fraction > 0 && o.conflicts == CollapseOptions::TwoPass && o.eps_c <= 1 && o.cost_cl_source.empty() &&
-         s.iteration + 1 < o.max_iterations &&
-         double(s.collapsed) < fraction * double(s.tets);
+// After the last iteration of `its`, does the rest run on the host? When it collapsed fewer
+// than fraction x its tets, and the collapses shrink slowly: at the ratio r of the last two
+// iterations' counts (at most 0.95), c r^n < 1 takes n = ln c / ln(1 / r) >=
+// host_tail_min_iterations more iterations (a tail that dies out fast, r ~0.6, is cheaper on
+// the device than the host's fixed cost). Counts only: the choice is deterministic.
+bool host_tail_due(const CollapseOptions& o, double fraction, const std::vector<IterationStats>& its) {
+  if (!(fraction > 0) || o.conflicts != CollapseOptions::TwoPass || o.eps_c > 1 || !o.cost_cl_source.empty() ||
+      its.size() < 2)
+    return false;
+  const IterationStats& s = its.back();
+  if (s.iteration + 1 >= o.max_iterations || !(double(s.collapsed) < fraction * double(s.tets))) return false;
+  const double c = double(s.collapsed);
+  const double r = std::min(0.95, c / double(std::max<int64_t>(its[its.size() - 2].collapsed, 1)));
+  return std::log(c) >= o.host_tail_min_iterations * std::log(1 / r);
 }
 
 // The host tail: the sequential method, greedy, on the downloaded mesh (current numbering; its
@@ -261,7 +270,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     report.iterations.push_back(s);
     if (options.progress) options.progress(s);
     if (s.collapsed < std::max<int64_t>(options.eps_c, 1)) break;
-    if (host_tail_due(options, tail_fraction, s)) {
+    if (host_tail_due(options, tail_fraction, report.iterations)) {
       host_tail = true;
       break;
     }

@@ -132,8 +132,10 @@ struct CollapseOptions {
   // The output's vertices and tets follow that order instead of the input's.
   bool spatial_order = true;
   // Host tail. Parallel method with the two-pass conflict detection, run until nothing
-  // collapses (eps_c <= 1), with the built-in cost:
-  // once an iteration collapses fewer than host_tail x (its tets) edges, the rest runs on the
+  // collapses (eps_c <= 1), with the built-in cost: once an iteration collapses fewer than
+  // host_tail x (its tets) edges and the counts shrink slowly enough to promise many more
+  // iterations (at the ratio of the last two, at least host_tail_min_iterations until none), the
+  // rest runs on the
   // host with the sequential method's checks, greedily (after each collapse the marked edges
   // around it are queued at once, so one iteration leaves nothing admissible; another runs only
   // when the surface guard refused an edge, since it looks beyond the star). The last
@@ -144,6 +146,10 @@ struct CollapseOptions {
   // 0: every iteration on the device. Decided by counts only: the output stays deterministic.
   static constexpr double kHostTailCpu = 0.002;
   double host_tail = -1;
+  // The host's fixed cost (its dynamic mesh, the first tests of every marked edge, the final
+  // compaction) is worth about this many device iterations of the same mesh on a CPU device: a
+  // tail that dies out faster stays on the device (e.g. the shared Block 250k in strict mode).
+  double host_tail_min_iterations = 24;
 
   // Adaptive marking: with a non-empty mask (one byte per input vertex, non-zero = selected),
   // only edges whose both end points are selected are marked, or either end point with

@@ -43,6 +43,7 @@ CollapseOptions tail_early() {
   CollapseOptions o;
   o.target_factor = 2;
   o.host_tail = 0.05;  // from the first iteration collapsing fewer than 5% of its tets
+  o.host_tail_min_iterations = 0;  // however fast the counts shrink
   return o;
 }
 
@@ -142,6 +143,13 @@ TEST(CollapseHostTail, OnlyWhenRunningUntilNothingCollapses) {
     const CollapseReport r = collapse(m, *o, ctx);
     EXPECT_GT(r.vertices_in, r.vertices_out);
     EXPECT_EQ(count_on_host(r), 0);
+  }
+  // a tail that would die out within host_tail_min_iterations stays on the device
+  CollapseOptions slow = tail_early();
+  slow.host_tail_min_iterations = 1e9;
+  {
+    Mesh m = in;
+    EXPECT_EQ(count_on_host(collapse(m, slow, ctx)), 0);
   }
   // the default: on CPU devices from 0.2% on, elsewhere never (the device decides, not the run)
   Mesh m = in;
