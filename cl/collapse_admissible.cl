@@ -20,7 +20,13 @@
 #ifndef TCC_MAX_LINK
 #define TCC_MAX_LINK 96
 #endif
+/* Tets per chunk of the volume loop: on CPU devices (TCC_PREFETCH) many, so that the gathers
+ * overlap; elsewhere few (private arrays indexed at run time cost GPUs scratch memory). */
+#ifdef TCC_PREFETCH
 #define TCC_VOL_CHUNK 32
+#else
+#define TCC_VOL_CHUNK 4
+#endif
 
 
 inline int tcc_in(const int* list, int n, int x) {

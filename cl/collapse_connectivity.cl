@@ -136,20 +136,26 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
       const uint bb = prev_nb_off[u], be = prev_nb_off[u + 1];
       for (uint j = bb; j < be && !other; ++j) other = prev_nb[j] != o && prev_vaff[prev_nb[j]] >= 0;
       if (!other) {
-        /* u in N(v) and v in N(u) renumber to v, out of order: skipped before comparing */
+        /* u in N(v) and v in N(u) renumber to v, out of order: skipped before comparing. At
+         * most 3 |ring(v)| entries fit in v's scratch (each tet gives 3 neighbours); more
+         * would contradict the argument above: then the general gather. */
+        const uint cap = 3 * n;
         uint i = ab, j = bb, m = 0;
         for (;;) {
           if (i < ae && prev_nb[i] == u) ++i;
           if (j < be && prev_nb[j] == o) ++j;
           if (i >= ae && j >= be) break;
+          if (m == cap) break;
           int x = i < ae ? vmap[prev_nb[i]] : INT_MAX, y = j < be ? vmap[prev_nb[j]] : INT_MAX;
           int z = x < y ? x : y;
           if (x == z) ++i;
           if (y == z) ++j;
           s[m++] = z;
         }
-        tcc_count_neighbours(s, m, v, nb_count, up_count);
-        return;
+        if (i >= ae && j >= be) {
+          tcc_count_neighbours(s, m, v, nb_count, up_count);
+          return;
+        }
       }
     }
   }

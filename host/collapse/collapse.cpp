@@ -127,6 +127,7 @@ void finish_on_host(Mesh& mesh, const CollapseOptions& options, const collapse_d
   const int done = int(report.iterations.size());
   CollapseOptions o = options;
   o.method = CollapseOptions::Sequential;
+  o.sequential_skip_invalidated = false;  // greedy: every queued edge has a touched end point
   o.target_length = p.target;
   o.eps_v = p.eps_v;
   o.eps_v_relative = false;

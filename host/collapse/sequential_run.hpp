@@ -17,7 +17,9 @@
 //   3. the dead vertices and tets are dropped from the arrays (order kept).
 // Iterations repeat until one collapses fewer than max(eps_c, 1) edges, or max_iterations.
 // Edges created by a collapse (the removed vertex's edges, now at the survivor) wait for the
-// next iteration, as in the paper. The options of the parallel method's conflict detection
+// next iteration, as in the paper. Greedy mode (set_greedy; the parallel method's host tail):
+// after each collapse the marked edges of every touched vertex go into the queue at once (each
+// edge once), and the run stops after an iteration in which the surface guard refused nothing. The options of the parallel method's conflict detection
 // (conflicts, selection_rounds) do not apply; a user cost (cost_cl_source) is refused.
 //
 // IterationStats of an iteration: marked (all marked edges), passed_q (of those, passing Q at

@@ -109,7 +109,8 @@ void check_collapse_input(const Mesh& mesh);
 
 enum Reason : uint8_t {
   kOk = 0, kNotMarked = 1, kRefusedQ = 2, kRefusedLink = 3, kRefusedVolume = 4, kRefusedQuality = 6,
-  kUntested = 5,  // lazy filter: passed Q, never tested because a cheaper rival won
+  kUntested = 5,  // lazy filter: passed Q, never tested because a cheaper rival won (an edge
+                  // with a refusal carried from the previous iteration keeps that reason)
   kRefusedSurface = 7  // the surface guard (guard_surface.hpp)
 };
 

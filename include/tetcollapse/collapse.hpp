@@ -63,7 +63,9 @@ struct IterationStats {
   double seconds_connectivity = 0, seconds_cost = 0, seconds_admissible = 0, seconds_pass1 = 0,
          seconds_pass2 = 0, seconds_collapse = 0, seconds_total = 0;
   // An iteration of the host tail (CollapseOptions::host_tail): the sequential method's, greedy;
-  // its stats are those of the sequential method (no conflict passes).
+  // its stats are those of the sequential method (no conflict passes), whose marked, tested
+  // and admissible count its first tests only: the edges queued again after each collapse
+  // are not counted, so collapsed may exceed admissible.
   bool on_host = false;
 };
 
