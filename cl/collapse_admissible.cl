@@ -28,7 +28,6 @@
 #define TCC_VOL_CHUNK 4
 #endif
 
-
 inline int tcc_in(const int* list, int n, int x) {
   for (int i = 0; i < n; ++i)
     if (list[i] == x) return 1;

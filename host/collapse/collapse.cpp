@@ -133,23 +133,20 @@ void finish_on_host(Mesh& mesh, const CollapseOptions& options, const collapse_d
   o.eps_v_relative = false;
   o.vertex_mask = std::move(mask);
   o.max_iterations = options.max_iterations - done;
-  o.progress = [&](const IterationStats& s) {
-    if (!options.progress) return;
-    IterationStats t = s;
+  auto continued = [done](IterationStats t) {  // numbered on from the device's iterations
     t.iteration += done;
     t.on_host = true;
-    options.progress(t);
+    return t;
+  };
+  o.progress = [&](const IterationStats& s) {
+    if (options.progress) options.progress(continued(s));
   };
   sequential_detail::SequentialRun run(mesh, o);
   run.set_greedy(true);
   while (run.step()) {
   }
   const CollapseReport r = run.finish();
-  for (IterationStats t : r.iterations) {
-    t.iteration += done;
-    t.on_host = true;
-    report.iterations.push_back(t);
-  }
+  for (const IterationStats& t : r.iterations) report.iterations.push_back(continued(t));
   report.seconds_total += r.seconds_total;
 }
 

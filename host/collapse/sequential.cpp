@@ -62,9 +62,10 @@ void remap_elements(std::vector<int32_t>& elems, std::vector<int32_t>& tags, int
   tags.resize(kt);
 }
 
-// Queue order: (cost, a, b) ascending, i.e. (cost, edge index); a heap comparator is "after".
+// The greedy mode's set of queued edges is keyed by a << 32 | b.
 uint64_t key(int32_t a, int32_t b) { return uint64_t(uint32_t(a)) << 32 | uint32_t(b); }
 
+// Queue order: (cost, a, b) ascending, i.e. (cost, edge index); a heap comparator is "after".
 bool after(double ca, int32_t aa, int32_t ab, double cb, int32_t ba, int32_t bb) {
   if (ca != cb) return ca > cb;
   return aa != ba ? aa > ba : ab > bb;
@@ -205,11 +206,10 @@ bool SequentialRun::step() {
     if (greedy_) {
       // the marked edges whose star changed, into the queue now (tested when popped: their end
       // points are touched) instead of waiting for the next iteration
-      greedy_touched_.assign(sm_.touched().begin(), sm_.touched().end());
       ++greedy_stamp_;
       if (greedy_mark_.size() < size_t(sm_.num_vertices())) greedy_mark_.resize(size_t(sm_.num_vertices()), 0);
-      for (int32_t u : greedy_touched_) greedy_mark_[u] = greedy_stamp_;
-      for (int32_t u : greedy_touched_) {
+      for (int32_t u : sm_.touched()) greedy_mark_[u] = greedy_stamp_;
+      for (int32_t u : sm_.touched()) {  // neighbours() and length() leave touched() as it is
         if (!sm_.alive(u)) continue;
         sm_.neighbours(u, nb_);
         for (int32_t w : nb_) {

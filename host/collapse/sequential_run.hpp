@@ -19,8 +19,9 @@
 // Edges created by a collapse (the removed vertex's edges, now at the survivor) wait for the
 // next iteration, as in the paper. Greedy mode (set_greedy; the parallel method's host tail):
 // after each collapse the marked edges of every touched vertex go into the queue at once (each
-// edge once), and the run stops after an iteration in which the surface guard refused nothing. The options of the parallel method's conflict detection
-// (conflicts, selection_rounds) do not apply; a user cost (cost_cl_source) is refused.
+// edge once), and the run stops after an iteration in which the surface guard refused nothing.
+// The options of the parallel method's conflict detection (conflicts, selection_rounds) do not
+// apply; a user cost (cost_cl_source) is refused.
 //
 // IterationStats of an iteration: marked (all marked edges), passed_q (of those, passing Q at
 // the start), tested (link and volume tests at the start), admissible (pushed into the queue),
@@ -88,7 +89,7 @@ class SequentialRun {
   std::vector<int32_t> origin_;    // input vertex -> current vertex (only with tris or edges)
   std::vector<uint32_t> touched_;  // per vertex: 1 + the last iteration that touched its star (0: none)
   std::vector<QueueEntry> edges_, heap_;
-  std::vector<int32_t> nb_, vmap_, kept_, greedy_touched_;
+  std::vector<int32_t> nb_, vmap_, kept_;
   bool greedy_ = false;
   std::unordered_set<uint64_t> queued_;  // greedy: the edges (a << 32 | b) in the queue
   std::vector<uint32_t> greedy_mark_;

@@ -475,11 +475,11 @@ void pass1_rounds(Context& ctx, cl::Kernel& decide, EdgeState& s, const Connecti
 namespace {
 // Pass 1 of the lazy filter over the candidates (s.cand[e] != 0 for e < ne; lazy_init made them
 // and their first claims in s.slot[0]; cl/collapse_admissible.cl, lazy_p1_*): rounds over the
-// turn list until it is empty. `decide` and `loop` have the
-// test's arguments set. s.vaff must be -1 everywhere. The rounds run in one work-group
-// (lazy_p1_loop) while the turn list holds at most p.loop_tests edges to test (the others take
-// the verdict carried from the previous iteration, cheap) and at most p.loop_turns in all; the
-// loop hands back to the per-round kernels when a list has more than p.loop_exit_tests to test.
+// turn list until it is empty. `decide` and `loop` have the test's arguments set. s.vaff must
+// be -1 everywhere. The rounds run in one work-group (lazy_p1_loop) while the turn list holds
+// at most p.loop_tests edges to test (the others take the verdict carried from the previous
+// iteration, cheap) and at most p.loop_turns in all; the loop hands back to the per-round
+// kernels when a list has more than p.loop_exit_tests to test.
 void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kernel& decide, cl::Kernel& loop,
                     const StageParams& p) {
   const std::string A = "collapse_admissible.cl";

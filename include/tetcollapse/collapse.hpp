@@ -137,10 +137,10 @@ struct CollapseOptions {
   // collapses (eps_c <= 1), with the built-in cost: once an iteration collapses fewer than
   // host_tail x (its tets) edges and the counts shrink slowly enough to promise many more
   // iterations (at the ratio of the last two, at least host_tail_min_iterations until none), the
-  // rest runs on the
-  // host with the sequential method's checks, greedily (after each collapse the marked edges
-  // around it are queued at once, so one iteration leaves nothing admissible; another runs only
-  // when the surface guard refused an edge, since it looks beyond the star). The last
+  // rest runs on the host with the sequential method's checks, greedily (after each collapse
+  // the marked edges around it are queued at once, so one iteration leaves nothing admissible;
+  // another runs only when the surface guard refused an edge, since it looks beyond the
+  // star). The last
   // iterations of the parallel method collapse a few edges each (a cascade: a collapse makes a
   // neighbour admissible) at the price of passes over the whole mesh, which on a CPU device
   // cost more than collapsing them one by one: W1 (bench/README.md) saves ~0.2 s of ~3 s. On a
