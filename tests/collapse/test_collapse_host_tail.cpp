@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <set>
+#include <utility>
 
 #include "tetcollapse/check.hpp"
 #include "tetcollapse/collapse.hpp"
@@ -14,15 +15,21 @@ using namespace tc;
 
 namespace {
 
-// The bracket (curved faces, ridges, corners, Gmsh's boundary triangles) with two materials
-// (split at the centre of its box) and a vertex field (x).
-Mesh bracket_with_attributes() {
-  Mesh m = read_mesh(test::project_mesh("bracket.msh"));
+// The smallest and largest x of the mesh's points.
+std::pair<double, double> x_range(const Mesh& m) {
   double lo = m.points[0], hi = m.points[0];
   for (size_t v = 0; v < m.points.size(); v += 3) {
     lo = std::min(lo, m.points[v]);
     hi = std::max(hi, m.points[v]);
   }
+  return {lo, hi};
+}
+
+// The bracket (curved faces, ridges, corners, Gmsh's boundary triangles) with two materials
+// (split at the centre of its box) and a vertex field (x).
+Mesh bracket_with_attributes() {
+  Mesh m = read_mesh(test::project_mesh("bracket.msh"));
+  const auto [lo, hi] = x_range(m);
   Labels l;
   l.name = "material";
   for (int64_t t = 0; t < m.num_tets(); ++t) {
@@ -185,11 +192,7 @@ TEST(CollapseHostTail, MaskAndTrianglesCarried) {
   Context ctx;
   const Mesh in = bracket_with_attributes();
   ASSERT_GT(in.tris.size(), 0u);
-  double lo = in.points[0], hi = in.points[0];
-  for (size_t v = 0; v < in.points.size(); v += 3) {
-    lo = std::min(lo, in.points[v]);
-    hi = std::max(hi, in.points[v]);
-  }
+  const auto [lo, hi] = x_range(in);
   CollapseOptions o = tail_early();
   std::set<test::Point3> outside;
   o.vertex_mask = test::mask_x_below(in, lo + 0.6 * (hi - lo), &outside);
