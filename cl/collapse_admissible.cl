@@ -274,32 +274,31 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
  * refused edge ends OUT whatever its rivals do, and the others only wait for it to be decided.
  * In the late iterations nearly every candidate is such an edge, and the rounds then see only
  * the few that can still collapse. */
-__kernel void lazy_init(uint ne, __global const int* edges, __global const uint* marked, __global const uchar* vflags,
-                        __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
-                        __global uchar* state, __global uchar* edge_dir, __global uchar* reason, __global uint* cand,
-                        __global uint* counters, int restrict_clean, __global const uchar* vdirty,
-                        __global const uchar* verdict, __global const double* cost, volatile __global int* slot) {
-  uint e = get_global_id(0);
-  if (e >= ne) return;
+/* lazy_init for edge e; returns whether it passes Q (counted in counters[5]). */
+inline uint tcc_lazy_init_edge(uint e, __global const int* edges, __global const uint* marked,
+                               __global const uchar* vflags, __global const uchar* vclass, __global const uchar* eflags,
+                               int mode, int paper_rule, __global uchar* state, __global uchar* edge_dir,
+                               __global uchar* reason, __global uint* cand, int restrict_clean,
+                               __global const uchar* vdirty, __global const uchar* verdict, __global const double* cost,
+                               volatile __global int* slot) {
   edge_dir[e] = 0;
   cand[e] = 0u;
   state[e] = TCC_OUT;
   if (!marked[e]) {
     reason[e] = TCC_NOT_MARKED;
-    return;
+    return 0u;
   }
   int a = edges[2 * e], b = edges[2 * e + 1];
   /* a later selection round: only edges away from the collapses chosen so far */
-  if (restrict_clean && (vdirty[a] || vdirty[b])) return;
+  if (restrict_clean && (vdirty[a] || vdirty[b])) return 0u;
   if (tcc_predicate_q(a, b, vflags[a], vflags[b], eflags[e], vclass[a], vclass[b], mode, paper_rule) < 0) {
     reason[e] = TCC_REFUSED_Q;
-    return;
+    return 0u;
   }
-  atomic_inc(&counters[5]);
   uchar r = verdict[e];
   if (r != TCC_VERDICT_UNKNOWN && r != TCC_OK) {
     reason[e] = r;
-    return;
+    return 1u;
   }
   reason[e] = TCC_UNTESTED;
   state[e] = TCC_UNDECIDED;
@@ -307,6 +306,20 @@ __kernel void lazy_init(uint ne, __global const int* edges, __global const uint*
   /* pass 1's first claims (lazy_p1_first_turns reads them): slot[] is -1 on entry */
   tcc_claim(slot + a, (int)e, cost);
   tcc_claim(slot + b, (int)e, cost);
+  return 1u;
+}
+
+__kernel void lazy_init(uint ne, __global const int* edges, __global const uint* marked, __global const uchar* vflags,
+                        __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
+                        __global uchar* state, __global uchar* edge_dir, __global uchar* reason, __global uint* cand,
+                        __global uint* counters, int restrict_clean, __global const uchar* vdirty,
+                        __global const uchar* verdict, __global const double* cost, volatile __global int* slot) {
+  __local uint group_passed_q;
+  uint e = get_global_id(0);
+  uint q = e < ne ? tcc_lazy_init_edge(e, edges, marked, vflags, vclass, eflags, mode, paper_rule, state, edge_dir,
+                                       reason, cand, restrict_clean, vdirty, verdict, cost, slot)
+                  : 0u;
+  tcc_group_count(q, &group_passed_q, &counters[5]);
 }
 
 /* The arguments of the lazy filter's test (tcc_lazy_decide), passed down unchanged by the

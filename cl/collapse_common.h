@@ -28,6 +28,18 @@
 #endif
 #endif
 
+/* Adds flag (0 or 1) of every work item of the group to *counter, with one global atomic per
+ * work-group instead of one per item: on a CPU device a global counter incremented by every
+ * item bounces its cache line between the cores (W1: ~5 million marked edges over a run).
+ * Every work item of the group must call it (barriers); lc is a __local uint of the kernel. */
+inline void tcc_group_count(uint flag, volatile __local uint* lc, __global uint* counter) {
+  if (get_local_id(0) == 0) *lc = 0u;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (flag) atomic_inc(lc);
+  barrier(CLK_LOCAL_MEM_FENCE);
+  if (get_local_id(0) == 0 && *lc) atomic_add(counter, *lc);
+}
+
 /* Refusal reasons written by the admissible filter (tc::collapse::Reason). */
 #define TCC_OK 0
 #define TCC_NOT_MARKED 1

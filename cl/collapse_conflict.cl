@@ -69,15 +69,15 @@ __kernel void conflict_pass1_decide(uint n, int first, __global const uint* list
 /* After pass 1: p1 flags, vaff (vertAffectedByEdge) of both end points of IN edges, counters[2]. */
 __kernel void conflict_pass1_finish(uint ne, __global const int* edges, __global const uchar* state,
                                     __global uint* p1, __global int* vaff, __global uint* counters) {
+  __local uint group_in;
   uint e = get_global_id(0);
-  if (e >= ne) return;
-  uint in = state[e] == TCC_IN;
-  p1[e] = in;
+  uint in = e < ne && state[e] == TCC_IN;
+  if (e < ne) p1[e] = in;
   if (in) {
     vaff[edges[2 * e]] = (int)e;
     vaff[edges[2 * e + 1]] = (int)e;
-    atomic_inc(&counters[2]);
   }
+  tcc_group_count(in, &group_in, &counters[2]);
 }
 
 /* Pass 2 initial states: pass-1 edges undecided, others out. */
@@ -141,13 +141,16 @@ __kernel void conflict_pass2_loop(uint n, int first, int cur, __global uint* l0,
 __kernel void conflict_finalize(uint ne, __global const int* edges, __global const uint* p1,
                                 __global const uchar* state, __global uint* fin, __global int* vaff,
                                 __global uint* counters) {
+  __local uint group_fin;
   uint e = get_global_id(0);
-  if (e >= ne) return;
-  uint f = p1[e] && state[e] == TCC_IN;
-  fin[e] = f;
-  if (p1[e] && !f) {
-    vaff[edges[2 * e]] = -1;
-    vaff[edges[2 * e + 1]] = -1;
+  uint f = 0u;
+  if (e < ne) {
+    f = p1[e] && state[e] == TCC_IN;
+    fin[e] = f;
+    if (p1[e] && !f) {
+      vaff[edges[2 * e]] = -1;
+      vaff[edges[2 * e + 1]] = -1;
+    }
   }
-  if (f) atomic_inc(&counters[3]);
+  tcc_group_count(f, &group_fin, &counters[3]);
 }

@@ -12,22 +12,25 @@ __kernel void cost_and_mark(uint ne, __global const int* edges, __global const d
                             __global const double* vfield, uint vfield_stride, int has_vfield,
                             __global const uchar* vmask, int mask_mode, double target, __global double* cost,
                             __global uint* marked, __global uint* counters) {
+  __local uint group_marked;
   uint e = get_global_id(0);
-  if (e >= ne) return;
-  int a = edges[2 * e], b = edges[2 * e + 1];
-  double3 pa = tc_point(pts, a), pb = tc_point(pts, b);
+  uint m = 0u;
+  if (e < ne) {
+    int a = edges[2 * e], b = edges[2 * e + 1];
+    double3 pa = tc_point(pts, a), pb = tc_point(pts, b);
 #ifdef TCC_USER_COST
-  double fa = has_vfield ? vfield[(size_t)a * vfield_stride] : 0.0;
-  double fb = has_vfield ? vfield[(size_t)b * vfield_stride] : 0.0;
-  double c = tc_user_cost(pa, pb, fa, fb);
+    double fa = has_vfield ? vfield[(size_t)a * vfield_stride] : 0.0;
+    double fb = has_vfield ? vfield[(size_t)b * vfield_stride] : 0.0;
+    double c = tc_user_cost(pa, pb, fa, fb);
 #else
-  double3 d = pb - pa;
-  double c = sqrt(tcc_dot(d, d));
+    double3 d = pb - pa;
+    double c = sqrt(tcc_dot(d, d));
 #endif
-  cost[e] = c;
-  /* mask_mode 0: no mask; 1: both end points in the mask; 2: either */
-  int allowed = mask_mode == 0 ? 1 : mask_mode == 1 ? (vmask[a] && vmask[b]) : (vmask[a] || vmask[b]);
-  uint m = (allowed && c < target) ? 1u : 0u;
-  marked[e] = m;
-  if (m) atomic_inc(&counters[0]);
+    cost[e] = c;
+    /* mask_mode 0: no mask; 1: both end points in the mask; 2: either */
+    int allowed = mask_mode == 0 ? 1 : mask_mode == 1 ? (vmask[a] && vmask[b]) : (vmask[a] || vmask[b]);
+    m = (allowed && c < target) ? 1u : 0u;
+    marked[e] = m;
+  }
+  tcc_group_count(m, &group_marked, &counters[0]);
 }

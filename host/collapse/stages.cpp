@@ -343,7 +343,13 @@ uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   const cl_int mask_mode = dm.has_mask ? p.mask_mode : 0;
   set_args(k, "cost_and_mark", U(c.ne), B(c.edges), B(dm.points), B(dm.vfields), U(dm.vfield_comps),
            I(dm.vfield_comps > 0 ? 1 : 0), B(dm.vmask), mask_mode, p.target, B(s.cost), B(s.marked), B(s.counters));
+  auto t0 = std::chrono::steady_clock::now();
   ctx.launch(k, c.ne, "cost_and_mark");
+  if (kProfile) {
+    ctx.finish();
+    std::fprintf(stderr, "  %-28s n=%-9u %8.4f s\n", "cost_and_mark", c.ne,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
   return counter(s, 0);
 }
 
