@@ -14,6 +14,9 @@
  *   sguard_queries    a collapse that changes S (removed vertex x on S, or a survivor y on S
  *                     that moves to the midpoint) is a query: the bounding box of its new
  *                     S triangles (below); the host grids the boxes;
+ *   sguard_tris       the new S triangles of each query with their boxes (the filter read
+ *                     before a triangle pair is tested), and the vertices whose faces the
+ *                     query replaces (x, and y when it moves);
  *   sguard_surface    every S face of the current mesh that is not replaced by the query is
  *                     tested against the query's new triangles (over tets, through the grid);
  *   sguard_pairs      the new triangles of two queries are tested against each other (two
@@ -146,12 +149,15 @@ __kernel void sguard_queries(uint ne, __global const int* edges, __global const 
 __kernel void sguard_tris(uint nq, __global const int* qedge, __global const uint* qoff, __global const int* edges,
                           __global const uchar* dir, __global const double* pts, __global const int* tets,
                           __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
-                          __global const int* labels, int use_labels, __global int* tid, __global double* tpos) {
+                          __global const int* labels, int use_labels, __global int* tid, __global double* tpos,
+                          __global double* tbox, __global int* qrep) {
   uint qi = get_global_id(0);
   if (qi >= nq) return;
   int x, y;
   double3 p;
   int moves_y = tcc_sg_collapse(qedge[qi], edges, dir, pts, &x, &y, &p);
+  qrep[2 * qi] = x;
+  qrep[2 * qi + 1] = moves_y ? y : -1;
   uint n = qoff[qi];
   int id[3];
   double3 pos[3];
@@ -162,6 +168,11 @@ __kernel void sguard_tris(uint nq, __global const int* qedge, __global const uin
       tpos[9 * n + 3 * k + 1] = pos[k].y;
       tpos[9 * n + 3 * k + 2] = pos[k].z;
     }
+    /* its box (no comma at this level: the body is a macro argument) */
+    double3 lo = fmin(fmin(pos[0], pos[1]), pos[2]);
+    double3 hi = fmax(fmax(pos[0], pos[1]), pos[2]);
+    vstore3(lo, 2 * n, tbox);
+    vstore3(hi, 2 * n + 1, tbox);
     ++n;
   })
 }
@@ -173,10 +184,11 @@ inline void tcc_sg_load_tri(__global const int* tid, __global const double* tpos
   }
 }
 
-inline int tcc_sg_boxes_apart(const double3* a, const double3* b) {
-  double3 alo = fmin(fmin(a[0], a[1]), a[2]), ahi = fmax(fmax(a[0], a[1]), a[2]);
-  double3 blo = fmin(fmin(b[0], b[1]), b[2]), bhi = fmax(fmax(b[0], b[1]), b[2]);
-  return alo.x > bhi.x || alo.y > bhi.y || alo.z > bhi.z || blo.x > ahi.x || blo.y > ahi.y || blo.z > ahi.z;
+/* Are the box [lo, hi] and the box of new triangle n (tbox, written by sguard_tris) apart? The
+ * filter before a triangle pair's test, read before the triangle itself. */
+inline int tcc_sg_tri_box_apart(double3 lo, double3 hi, __global const double* tbox, uint n) {
+  __global const double* b = tbox + 6 * n;
+  return lo.x > b[3] || lo.y > b[4] || lo.z > b[5] || b[0] > hi.x || b[1] > hi.y || b[2] > hi.z;
 }
 
 /* The uniform grid of the query boxes (built by the host): cell (i, j, k) of size 1 / ih from
@@ -220,12 +232,11 @@ inline int tcc_sg_owner_cell(double3 alo, double3 ahi, __global const double* b,
   }
 
 /* Every current S face against the queries whose box it overlaps. */
-__kernel void sguard_surface(uint n, __global const uint* stets, __global const int* edges, __global const uchar* dir,
-                             __global const double* pts,
+__kernel void sguard_surface(uint n, __global const uint* stets, __global const double* pts,
                              __global const int* tets, __global const int* tet_nbr, __global const int* labels,
-                             int use_labels, __global const int* qedge, __global const double* qbox,
+                             int use_labels, __global const int* qrep, __global const double* qbox,
                              __global const uint* qoff, __global const int* tid, __global const double* tpos,
-                             double ox, double oy, double oz, double ih, int gx, int gy, int gz,
+                             __global const double* tbox, double ox, double oy, double oz, double ih, int gx, int gy, int gz,
                              __global const uint* cell_off, __global const uint* cell_items, __global uint* qbad) {
   const uint g = get_global_id(0);
   if (g >= n) return;
@@ -245,17 +256,15 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
     double3 lo = fmin(fmin(fpos[0], fpos[1]), fpos[2]), hi = fmax(fmax(fpos[0], fpos[1]), fpos[2]);
     TCC_SG_FOR_CELL_QUERIES(lo, hi, qi, {
       if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qi, ci, cj, ck, org, ih, gd)) continue;
-      int x, y;
-      double3 p;
-      int moves_y = tcc_sg_collapse(qedge[qi], edges, dir, pts, &x, &y, &p);
-      int replaced = 0;
-      for (int a = 0; a < 3; ++a) replaced |= fid[a] == x || (moves_y && fid[a] == y);
-      if (replaced) continue; /* the face is one the collapse moves or removes */
+      /* the face is one the collapse moves or removes: it has x, or y when y moves (-1 else) */
+      const int rx = qrep[2 * qi], ry = qrep[2 * qi + 1];
+      if (fid[0] == rx || fid[1] == rx || fid[2] == rx || fid[0] == ry || fid[1] == ry || fid[2] == ry) continue;
       for (uint r = qoff[qi]; r < qoff[qi + 1]; ++r) {
+        if (tcc_sg_tri_box_apart(lo, hi, tbox, r)) continue;
         int id[3];
         double3 pos[3];
         tcc_sg_load_tri(tid, tpos, r, id, pos);
-        if (tcc_sg_boxes_apart(pos, fpos) || !tc_sg_tri_tri(id, pos, fid, fpos)) continue;
+        if (!tc_sg_tri_tri(id, pos, fid, fpos)) continue;
         uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
         qbad[qi] = code < 0x7ffffffeu ? code + 2u : 1u;
         break;
@@ -266,7 +275,7 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
 
 /* The new triangles of two queries against each other. */
 __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const uint* qoff, __global const int* tid,
-                           __global const double* tpos, double ox, double oy, double oz, double ih, int gx, int gy,
+                           __global const double* tpos, __global const double* tbox, double ox, double oy, double oz, double ih, int gx, int gy,
                            int gz, __global const uint* cell_off, __global const uint* cell_items,
                            __global uint* qbad) {
   uint qa = get_global_id(0);
@@ -280,11 +289,14 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
     int ida[3];
     double3 posa[3];
     tcc_sg_load_tri(tid, tpos, na, ida, posa);
+    __global const double* ba_ = tbox + 6 * na;
+    const double3 alo = (double3)(ba_[0], ba_[1], ba_[2]), ahi = (double3)(ba_[3], ba_[4], ba_[5]);
     for (uint nb = na + 1; nb < qoff[qa + 1]; ++nb) {
+      if (tcc_sg_tri_box_apart(alo, ahi, tbox, nb)) continue;
       int idb[3];
       double3 posb[3];
       tcc_sg_load_tri(tid, tpos, nb, idb, posb);
-      if (tcc_sg_boxes_apart(posa, posb) || !tc_sg_tri_tri(ida, posa, idb, posb)) continue;
+      if (!tc_sg_tri_tri(ida, posa, idb, posb)) continue;
       qbad[qa] = 0x80000000u | qa;
       return;
     }
@@ -292,14 +304,21 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
   TCC_SG_FOR_CELL_QUERIES(lo, hi, qb, {
     if (qb == qa || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qb, ci, cj, ck, org, ih, gd)) continue;
     for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
+      __global const double* ba_ = tbox + 6 * na;
+      const double3 alo = (double3)(ba_[0], ba_[1], ba_[2]), ahi = (double3)(ba_[3], ba_[4], ba_[5]);
       int ida[3];
       double3 posa[3];
-      tcc_sg_load_tri(tid, tpos, na, ida, posa);
+      int loaded = 0;
       for (uint nb = qoff[qb]; nb < qoff[qb + 1]; ++nb) {
+        if (tcc_sg_tri_box_apart(alo, ahi, tbox, nb)) continue;
+        if (!loaded) {
+          tcc_sg_load_tri(tid, tpos, na, ida, posa);
+          loaded = 1;
+        }
         int idb[3];
         double3 posb[3];
         tcc_sg_load_tri(tid, tpos, nb, idb, posb);
-        if (tcc_sg_boxes_apart(posa, posb) || !tc_sg_tri_tri(ida, posa, idb, posb)) continue;
+        if (!tc_sg_tri_tri(ida, posa, idb, posb)) continue;
         qbad[qa] = 0x80000000u | qb; /* names the other query for debugging */
         return;
       }

@@ -87,9 +87,11 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   qoff.upload(off_tri);
   ensure_nonempty(tid, ctx, size_t(ntri) * 3);
   ensure_nonempty(tpos, ctx, size_t(ntri) * 9);
+  ensure_nonempty(tbox, ctx, size_t(ntri) * 6);
+  ensure_nonempty(qrep, ctx, size_t(nq) * 2);
   launch(ctx, "sguard_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(), s.dir.buffer(),
          dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
-         tid.buffer(), tpos.buffer());
+         tid.buffer(), tpos.buffer(), tbox.buffer(), qrep.buffer());
 
   // The grid: cells twice the median query box (most boxes span <= 2 cells per axis, the large
   // ones are entered in every cell they span), at most kMaxCellsPerAxis per axis.
@@ -148,11 +150,11 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
     n_stets = dev::compact_indices(ctx, c.owns_s, stets, dm.nt);
     stets_generation = c.generation;
   }
-  launch(ctx, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), c.edges.buffer(), s.dir.buffer(),
-         dm.points.buffer(), dm.tets.buffer(), c.tet_nbr.buffer(), labels, use_labels, qedge.buffer(), qbox.buffer(),
-         qoff.buffer(), tid.buffer(), tpos.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
+  launch(ctx, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), dm.points.buffer(), dm.tets.buffer(),
+         c.tet_nbr.buffer(), labels, use_labels, qrep.buffer(), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
+         tbox.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
          cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());
-  launch(ctx, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
+  launch(ctx, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),
          cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
          cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());
   qcount.fill(0u);
