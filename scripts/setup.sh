@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Installs every Debian package tetcollapse needs to build, test and benchmark.
 # Idempotent: when everything is there it installs nothing and does not touch apt.
-#   scripts/setup.sh              build + test dependencies
-#   scripts/setup.sh --with-tools also the mesh tools used by scripts/ and bench/ (gmsh + its Python
-#                                 module, tetgen, matplotlib, clang for fuzzing; MMG3D, which Debian
-#                                 does not package, from PyPI's mmgpy wheel for the peers benchmark)
+#   scripts/setup.sh              build + test dependencies (with the gmsh and tetgen programs,
+#                                 which some I/O tests run)
+#   scripts/setup.sh --with-tools also what scripts/ and bench/ use (gmsh's Python module,
+#                                 matplotlib, clang for fuzzing; MMG3D, which Debian does not
+#                                 package, from PyPI's mmgpy wheel for the peers benchmark)
 set -euo pipefail
 
 packages=(
@@ -13,9 +14,10 @@ packages=(
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev zlib1g-dev libcli11-dev
   googletest libgtest-dev libbenchmark-dev
   python3 python3-meshio          # independent reader used by the cross-read tests
+  gmsh tetgen                     # the tests that read files these programs write, and vice versa
 )
 if [[ "${1:-}" == "--with-tools" ]]; then
-  packages+=(gmsh python3-gmsh tetgen python3-matplotlib python3-numpy clang libclang-rt-14-dev llvm-14)
+  packages+=(python3-gmsh python3-matplotlib python3-numpy clang libclang-rt-14-dev llvm-14)
 fi
 
 missing=()
