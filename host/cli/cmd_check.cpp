@@ -51,6 +51,7 @@ void register_check(CLI::App& app, int& exit_code) {
   cmd->add_flag("-q,--quiet", o->quiet, "Print only the verdict line");
   add_input_options(*cmd, o->input);
   cmd->callback([o, &exit_code] {
+    check_output_path(o->json, nullptr);
     Mesh m = read_input(o->path, o->input, o->quiet);
     Mesh ref;
     if (!o->reference.empty()) ref = read_input(o->reference, o->input, o->quiet);

@@ -238,6 +238,8 @@ void register_collapse(CLI::App& app, int& exit_code) {
     if (!app.get_subcommands().empty()) return;
     if (c->in.empty() || c->out.empty())
       throw CLI::RequiredError("IN and OUT (or a subcommand; see --help)");
+    check_output_path(c->out, &c->output);
+    check_output_path(c->stats, nullptr);
     auto t0 = std::chrono::steady_clock::now();
     Mesh mesh = read_input(c->in, c->input, c->quiet);
     double seconds_read = seconds_since(t0);

@@ -19,6 +19,7 @@ void register_convert(CLI::App& app, int& exit_code) {
   add_output_options(*cmd, o->output);
   cmd->add_flag("-q,--quiet", o->quiet, "Print nothing but errors");
   cmd->callback([o, &exit_code] {
+    check_output_path(o->out, &o->output);
     Mesh m = read_input(o->in, o->input, o->quiet);
     write_mesh(o->out, m, write_options(o->output));
     if (!o->quiet)

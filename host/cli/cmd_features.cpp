@@ -27,6 +27,7 @@ void register_features(CLI::App& app, int& exit_code) {
   add_input_options(*cmd, o->input);
   add_output_options(*cmd, o->output);
   cmd->callback([o, &exit_code] {
+    check_output_path(o->out, &o->output);
     Mesh m = read_input(o->in, o->input, false);
     TopologyOptions to{o->eps_f, o->eps_r, !o->no_labels};
     Topology topo = build_topology(m, to);

@@ -1,5 +1,6 @@
 #include "cli/common.hpp"
 
+#include <filesystem>
 #include <iostream>
 
 namespace tc::cli {
@@ -43,6 +44,25 @@ WriteOptions write_options(const OutputOptions& o) {
   else if (o.vtu_encoding == "base64") w.vtu_encoding = WriteOptions::VtuEncoding::Base64;
   else w.vtu_encoding = WriteOptions::VtuEncoding::Appended;
   return w;
+}
+
+void check_output_path(const std::string& path, const OutputOptions* o) {
+  if (path.empty() || path == "-") return;
+  if (o) {
+    WriteOptions w = write_options(*o);  // an unknown --out-format: InputError naming it
+    if (w.format == Format::Auto) {
+      try {
+        format_from_name(path);
+      } catch (const InputError& e) {
+        throw OutputError(e.what());  // as write_mesh reports it
+      }
+    }
+  }
+  const std::filesystem::path p(path);
+  const std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec))
+    throw OutputError(path + ": folder '" + dir.string() + "' does not exist");  // as io::AtomicFile
 }
 
 }  // namespace tc::cli

@@ -89,6 +89,43 @@ TEST(Cli, ConvertRoundTripsAndNeverLeavesHalfFiles) {
   EXPECT_EQ(files, 1);  // tet.vtu only
 }
 
+// An output that cannot be written is refused before the input is read (a long run must not end
+// in it): with an input that does not exist either, the error names the output, exit 4 (or 2
+// for an unknown --out-format), and nothing is written.
+TEST(Cli, UnwritableOutputIsRefusedBeforeTheWork) {
+  tc::test::TempDir dir;
+  const std::string missing = q(dir.file("missing.mesh")), tet = q(tc::test::project_mesh("tet.mesh"));
+  const std::string nowhere = dir.file("no/such/folder/out.vtu");
+  struct Case {
+    std::string args, expect;
+    int code;
+  };
+  const Case cases[] = {
+      {missing + " " + q(nowhere), "no/such/folder' does not exist", 4},
+      {missing + " " + q(dir.file("out.xyz")), "unknown file extension '.xyz'", 4},
+      {missing + " " + q(dir.file("out.vtu")) + " --stats " + q(dir.file("no/s.json")), "no' does not exist", 4},
+      {missing + " " + q(dir.file("out.vtu")) + " --out-format foo", "unknown mesh format", 2},
+      {"convert " + missing + " " + q(nowhere), "no/such/folder' does not exist", 4},
+      {"features " + missing + " " + q(nowhere), "no/such/folder' does not exist", 4},
+      {"check " + missing + " --json " + q(dir.file("no/r.json")), "no' does not exist", 4},
+  };
+  for (const Case& c : cases) {
+    std::string out;
+    EXPECT_EQ(run_command(cli() + " " + c.args, &out), c.code) << c.args << "\n" << out;
+    EXPECT_NE(out.find(c.expect), std::string::npos) << c.args << "\n" << out;
+    EXPECT_EQ(out.find("missing.mesh"), std::string::npos) << "the input was read first: " << out;
+  }
+  // the same output with a real input: still refused, nothing written
+  std::string out;
+  EXPECT_EQ(run_command(cli() + " " + tet + " " + q(dir.file("out.xyz")), &out), 4) << out;
+  int files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path())) {
+    (void)e;
+    ++files;
+  }
+  EXPECT_EQ(files, 0);
+}
+
 TEST(Cli, DefaultMeshInfo) {
   std::string out;
   ASSERT_EQ(run_command(cli() + " info --json " + q(tc::test::project_mesh("bracket.msh")), &out), 0) << out;
