@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Regenerates the project's own meshes in meshes/ (the committed files are its output).
-# Needs gmsh from Debian (scripts/setup.sh --with-tools installs it).
+# Needs gmsh from Debian (scripts/setup.sh installs it).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 out="$here/../meshes"

@@ -47,7 +47,7 @@ WriteOptions write_options(const OutputOptions& o) {
 }
 
 void check_output_path(const std::string& path, const OutputOptions* o) {
-  if (path.empty() || path == "-") return;
+  if (path.empty() || (!o && path == "-")) return;  // a report may go to stdout, a mesh may not
   if (o) {
     WriteOptions w = write_options(*o);  // an unknown --out-format: InputError naming it
     if (w.format == Format::Auto) {

@@ -37,7 +37,7 @@ void add_output_options(CLI::App& cmd, OutputOptions& o);
 WriteOptions write_options(const OutputOptions& o);
 // Before any work: the errors that writing `path` at the end would give (an unknown output
 // format or extension, a folder that does not exist), so that a long run does not end in
-// them. `o` null: a report file (JSON), whose format is not a mesh format. "-" is stdout.
+// them. `o` null: a report file (JSON), whose format is not a mesh format, and "-" is stdout.
 void check_output_path(const std::string& path, const OutputOptions* o);
 
 // Registration of each subcommand: adds it to `app` and returns a flag set when it ran.

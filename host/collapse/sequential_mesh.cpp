@@ -31,7 +31,8 @@ tc_d3 face_normal(const std::vector<double>& pts, const int32_t* q, int f) {
   return geo::normalize(geo::cross(p1 - p0, p2 - p0));
 }
 
-// Bounding box of a triangle, and whether two are apart (tcc_sg_boxes_apart of the guard).
+// Bounding box of a triangle, and whether two are apart (the guard kernels' box test,
+// tcc_sg_tri_box_apart, on the boxes sguard_tris stores).
 // (std::min / max rather than fmin / fmax: they differ only for NaN coordinates)
 void box_of(const tc_d3* p, tc_d3& lo, tc_d3& hi) {
   lo = hi = p[0];

@@ -115,9 +115,12 @@ TEST(Cli, UnwritableOutputIsRefusedBeforeTheWork) {
     EXPECT_NE(out.find(c.expect), std::string::npos) << c.args << "\n" << out;
     EXPECT_EQ(out.find("missing.mesh"), std::string::npos) << "the input was read first: " << out;
   }
-  // the same output with a real input: still refused, nothing written
+  // the same output with a real input: refused before the collapse (no device line, no
+  // iteration), nothing written
   std::string out;
   EXPECT_EQ(run_command(cli() + " " + tet + " " + q(dir.file("out.xyz")), &out), 4) << out;
+  EXPECT_EQ(out.find("device:"), std::string::npos) << out;
+  EXPECT_EQ(out.find("iteration"), std::string::npos) << out;
   int files = 0;
   for (const auto& e : std::filesystem::directory_iterator(dir.path())) {
     (void)e;
