@@ -34,6 +34,13 @@ inline int tcc_in(const int* list, int n, int x) {
   return 0;
 }
 
+/* x in v[0..8) (pads of -1 never match a vertex): eight compares, no branch. The link test's
+ * small sets are kept so when they fit: a lookup by loop exits at a data-dependent place, and
+ * those mispredicted exits were about a third of a passing test on W1 (bench_admissible). */
+#define TCC_ANY8(v, x)                                                                                     \
+  (((x) == (v)[0]) | ((x) == (v)[1]) | ((x) == (v)[2]) | ((x) == (v)[3]) | ((x) == (v)[4]) | ((x) == (v)[5]) | \
+   ((x) == (v)[6]) | ((x) == (v)[7]))
+
 /* Does some tet of ring(x) contain y and z (and w when w >= 0)? */
 inline int tcc_ring_has(__global const int* tets, __global const uint* vt_off, __global const int* vt, int x, int y,
                         int z, int w) {
@@ -102,20 +109,23 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
   if (q_min > 0.0 && q_new < (q_old < q_min ? q_old : q_min)) return TCC_REFUSED_QUALITY;
 
   /* --- link condition --- */
-  int cn[TCC_MAX_LINK], pc[TCC_MAX_LINK], pd[TCC_MAX_LINK];
+  /* cn: the common neighbours of a and b, with the edges (a, cn[k]) and (b, cn[k]); (pc, pd):
+   * the edges of lk(ab), one per tet of the edge */
+  int cn[TCC_MAX_LINK], cea[TCC_MAX_LINK], ceb[TCC_MAX_LINK], pc[TCC_MAX_LINK], pd[TCC_MAX_LINK];
   int ncn = 0, np = 0;
   {
+    /* a merge of the sorted N(a) and N(b) without branches on their values */
     uint i = nb_off[a], ie = nb_off[a + 1], j = nb_off[b], je = nb_off[b + 1];
     while (i < ie && j < je) {
-      int x = nb[i], y = nb[j];
-      if (x < y) ++i;
-      else if (y < x) ++j;
-      else {
-        if (ncn == TCC_MAX_LINK) return TCC_REFUSED_LINK;
-        cn[ncn++] = x;
-        ++i;
-        ++j;
-      }
+      const int x = nb[i], y = nb[j];
+      if (x == y && ncn == TCC_MAX_LINK) return TCC_REFUSED_LINK;
+      const int at = ncn < TCC_MAX_LINK ? ncn : TCC_MAX_LINK - 1;
+      cn[at] = x;
+      cea[at] = nb_edge[i]; /* the edges (a, x) and (b, x) when x == y */
+      ceb[at] = nb_edge[j];
+      ncn += x == y;
+      i += x <= y;
+      j += y <= x;
     }
   }
   for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
@@ -130,6 +140,15 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
     pd[np] = o[1];
     ++np;
   }
+  /* cn, pc and pd padded to 8 when they fit (the usual case), for TCC_ANY8 */
+  const int small = ncn <= 8 && np <= 8;
+  int c8[8], p8[8], d8[8];
+  for (int k = 0; k < 8; ++k) {
+    c8[k] = k < ncn ? cn[k] : -1;
+    p8[k] = k < np ? pc[k] : -1;
+    d8[k] = k < np ? pd[k] : -1;
+  }
+#define TCC_IN_CN(x) (small ? TCC_ANY8(c8, x) : tcc_in(cn, ncn, (x)))
   int ok = 1;
   const uint smask = TCC_BOUNDARY | TCC_INTERFACE;
   /* (iii) with w, inside the tets (a,b,c,d) of the edge: no S-faces (a,c,d) and (b,c,d) (the
@@ -146,28 +165,34 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
       if (acd && bcd) ok = 0;
     }
   /* (i) vertices, and w */
-  for (int k = 0; k < ncn && ok; ++k)
-    if (!tcc_in(pc, np, cn[k]) && !tcc_in(pd, np, cn[k])) ok = 0;
-  if (ok && (fa & smask) && (fb & smask) && !(fe & smask)) ok = 0;
-  /* (ii) with w: S-edges (a,c) and (b,c) need the S-face (a,b,c) */
-  for (int k = 0; k < ncn && ok; ++k) {
-    int c = cn[k];
-    if (!(vflags[c] & smask)) continue;
-    int eac = tcc_edge_id(nb_off, nb, nb_edge, a, c), ebc = tcc_edge_id(nb_off, nb, nb_edge, b, c);
-    if (eac < 0 || ebc < 0) continue;
-    if ((eflags[eac] & smask) && (eflags[ebc] & smask) &&
-        !tcc_triangle_kind(tets, vt_off, vt, labels, use_labels, a, b, c))
-      ok = 0;
+  if (small) {
+    for (int k = 0; k < 8; ++k) ok &= (c8[k] < 0) | TCC_ANY8(p8, c8[k]) | TCC_ANY8(d8, c8[k]);
+  } else {
+    for (int k = 0; k < ncn && ok; ++k)
+      if (!tcc_in(pc, np, cn[k]) && !tcc_in(pd, np, cn[k])) ok = 0;
   }
+  if (ok && (fa & smask) && (fb & smask) && !(fe & smask)) ok = 0;
+  /* (ii) with w: S-edges (a,c) and (b,c) need the S-face (a,b,c); an S-edge has both end
+   * points on S, so only when a and b are */
+  if ((fa & smask) && (fb & smask))
+    for (int k = 0; k < ncn && ok; ++k) {
+      int c = cn[k];
+      if (!(vflags[c] & smask)) continue;
+      if ((eflags[cea[k]] & smask) && (eflags[ceb[k]] & smask) &&
+          !tcc_triangle_kind(tets, vt_off, vt, labels, use_labels, a, b, c))
+        ok = 0;
+    }
   /* (ii) triangles and (iii) tets and S-faces, from the tets of ring(a) without b */
   for (uint i = vt_off[a]; i < vt_off[a + 1] && ok; ++i) {
     int t = vt[i];
-    if (tcc_has(tets, t, b)) continue;
+    const int4 q4 = vload4(t, tets);
+    if ((q4.x == b) | (q4.y == b) | (q4.z == b) | (q4.w == b)) continue;
     __global const int* q = tets + 4 * t;
-    int o[3], no = 0;
-    for (int k = 0; k < 4; ++k)
-      if (q[k] != a) o[no++] = q[k];
-    int in0 = tcc_in(cn, ncn, o[0]), in1 = tcc_in(cn, ncn, o[1]), in2 = tcc_in(cn, ncn, o[2]);
+    /* the three vertices other than a, in the tet's order, without branches */
+    const int la = q4.x == a ? 0 : q4.y == a ? 1 : q4.z == a ? 2 : 3;
+    const int o[3] = {la == 0 ? q4.y : q4.x, la <= 1 ? q4.z : q4.y, la <= 2 ? q4.w : q4.z};
+    const int in0 = TCC_IN_CN(o[0]), in1 = TCC_IN_CN(o[1]), in2 = TCC_IN_CN(o[2]);
+    if (in0 + in1 + in2 < 2) continue; /* most tets: nothing below applies (no pair in cn) */
     if (in0 && in1 && in2 && tcc_ring_has(tets, vt_off, vt, b, o[0], o[1], o[2])) {
       ok = 0; /* tets (a,c,d,e) and (b,c,d,e) */
       break;
@@ -178,8 +203,11 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
       if (!inside[pairs[k][0]] || !inside[pairs[k][1]]) continue;
       int c = o[pairs[k][0]], d = o[pairs[k][1]];
       int in_lk = 0;
-      for (int m = 0; m < np; ++m)
-        if ((pc[m] == c && pd[m] == d) || (pc[m] == d && pd[m] == c)) in_lk = 1;
+      if (small)
+        for (int m = 0; m < 8; ++m) in_lk |= (p8[m] == c & d8[m] == d) | (p8[m] == d & d8[m] == c);
+      else
+        for (int m = 0; m < np; ++m)
+          if ((pc[m] == c && pd[m] == d) || (pc[m] == d && pd[m] == c)) in_lk = 1;
       if (!in_lk) {
         /* (ii) triangles (a,c,d) and (b,c,d) need the tet (a,b,c,d) */
         if (tcc_ring_has(tets, vt_off, vt, b, c, d, -1)) ok = 0;
@@ -196,8 +224,8 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
       if (acd_on_s && tcc_triangle_kind(tets, vt_off, vt, labels, use_labels, b, c, d)) ok = 0;
     }
   }
+#undef TCC_IN_CN
   return ok ? TCC_OK : TCC_REFUSED_LINK;
-
 }
 
 /* tet_quality[t] = tc_tet_quality of tet t (the quality guard's "before", once per iteration

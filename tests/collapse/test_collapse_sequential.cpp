@@ -237,6 +237,35 @@ TEST(SequentialVerdicts, SameAsDeviceOnBracketAndSharedMeshes) {
   }
 }
 
+// With the volume test out of the way (eps_v = -infinity: no tet is too small), every marked
+// edge that passes Q reaches the link condition, whose refusals the volume test otherwise hides
+// (it runs first): the device's link test (cl/collapse_admissible.cl) and the host's
+// (SeqMesh::link_ok), written apart, must refuse the same edges, and refuse many.
+TEST(SequentialVerdicts, LinkConditionAloneAgreesWithTheDevice) {
+  Context ctx;
+  std::vector<std::pair<std::string, Mesh>> meshes;
+  meshes.push_back({"cube", test::cube_tets(4)});
+  meshes.push_back({"two-material cube", two_material_cube(4)});
+  meshes.push_back({"bracket", read_mesh(test::project_mesh("bracket.msh"))});
+  for (auto& [name, in] : meshes) {
+    int64_t link = 0, ok = 0;
+    for (auto mode : {CollapseOptions::Features, CollapseOptions::Free}) {
+      CollapseOptions o;
+      o.boundary = mode;  // features: boundary edges too, with S; free: every edge
+      o.min_quality = 0;
+      o.eps_v = -INFINITY;
+      const std::string what = name + " mode " + std::to_string(int(mode)) + " without the volume test";
+      const DeviceVerdicts d = device_verdicts(ctx, in, o, 2.0 * median_edge_length(in));
+      link += std::count(d.reason.begin(), d.reason.end(), uint8_t(kRefusedLink));
+      ok += std::count(d.reason.begin(), d.reason.end(), uint8_t(kOk));
+      EXPECT_EQ(std::count(d.reason.begin(), d.reason.end(), uint8_t(kRefusedVolume)), 0) << what;
+      EXPECT_GT(expect_same_verdicts_fresh(ctx, in, o, 2.0, what), 100) << what;
+    }
+    EXPECT_GT(link, 10) << name;  // the link condition is what refuses here
+    EXPECT_GT(ok, 10) << name;
+  }
+}
+
 TEST(SequentialVerdicts, IncrementalStateAgreesWithTheDeviceInLaterIterations) {
   // After each sequential iteration the classes and rings of the dynamic mesh were updated
   // collapse by collapse; the device builds them from scratch on the same mesh.
