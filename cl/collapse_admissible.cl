@@ -109,9 +109,10 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
   if (q_min > 0.0 && q_new < (q_old < q_min ? q_old : q_min)) return TCC_REFUSED_QUALITY;
 
   /* --- link condition --- */
-  /* cn: the common neighbours of a and b, with the edges (a, cn[k]) and (b, cn[k]); (pc, pd):
-   * the edges of lk(ab), one per tet of the edge */
-  int cn[TCC_MAX_LINK], cea[TCC_MAX_LINK], ceb[TCC_MAX_LINK], pc[TCC_MAX_LINK], pd[TCC_MAX_LINK];
+  /* cn: the common neighbours of a and b, with the edges (a, cn[k]) and (b, cn[k]) (one more
+   * slot: the merge writes at ncn before it knows whether it keeps the entry); (pc, pd): the
+   * edges of lk(ab), one per tet of the edge */
+  int cn[TCC_MAX_LINK + 1], cea[TCC_MAX_LINK + 1], ceb[TCC_MAX_LINK + 1], pc[TCC_MAX_LINK], pd[TCC_MAX_LINK];
   int ncn = 0, np = 0;
   {
     /* a merge of the sorted N(a) and N(b) without branches on their values */
@@ -119,10 +120,9 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
     while (i < ie && j < je) {
       const int x = nb[i], y = nb[j];
       if (x == y && ncn == TCC_MAX_LINK) return TCC_REFUSED_LINK;
-      const int at = ncn < TCC_MAX_LINK ? ncn : TCC_MAX_LINK - 1;
-      cn[at] = x;
-      cea[at] = nb_edge[i]; /* the edges (a, x) and (b, x) when x == y */
-      ceb[at] = nb_edge[j];
+      cn[ncn] = x; /* ncn <= TCC_MAX_LINK here */
+      cea[ncn] = nb_edge[i]; /* the edges (a, x) and (b, x) when x == y */
+      ceb[ncn] = nb_edge[j];
       ncn += x == y;
       i += x <= y;
       j += y <= x;

@@ -266,6 +266,59 @@ TEST(SequentialVerdicts, LinkConditionAloneAgreesWithTheDevice) {
   }
 }
 
+// The link test's lists have a cap (TCC_MAX_LINK, 96 by default): an edge with more common
+// neighbours or more tets around it is refused, conservatively. Built with a cap of 6, which many
+// of the bracket's edges reach exactly, the device must agree with the host on every edge within
+// the cap (the lists are filled up to it, then stop) and may only refuse the others.
+TEST(SequentialVerdicts, LinkListCapOnlyRefusesLargerLists) {
+  constexpr size_t kCap = 6;
+  test::EnvVar cap("TETCOLLAPSE_CL_OPTIONS", "-DTCC_MAX_LINK=" + std::to_string(kCap));
+  Context ctx;  // builds its programs with the cap
+  const Mesh bracket = read_mesh(test::project_mesh("bracket.msh"));
+  CollapseOptions o;
+  o.boundary = CollapseOptions::Free;  // every edge goes through the link test
+  o.min_quality = 0;
+  o.eps_v = -INFINITY;
+  const DeviceVerdicts d = device_verdicts(ctx, bracket, o, 2.0 * median_edge_length(bracket));
+  std::map<std::pair<int32_t, int32_t>, size_t> tets_of_edge;
+  for (size_t t = 0; t < bracket.tets.size(); t += 4)
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        int32_t x = bracket.tets[t + i], y = bracket.tets[t + j];
+        ++tets_of_edge[{std::min(x, y), std::max(x, y)}];
+      }
+  Mesh m = bracket;
+  SeqMesh sm(m, seq_params_from(o));
+  int64_t within = 0, at_cap = 0, beyond = 0, bad = 0;
+  std::vector<int32_t> na, nb, common;
+  for (size_t e = 0; e < d.marked.size(); ++e) {
+    if (!d.marked[e]) continue;
+    const int32_t a = d.edges[2 * e], b = d.edges[2 * e + 1];
+    sm.neighbours(a, na);
+    sm.neighbours(b, nb);
+    std::sort(na.begin(), na.end());
+    std::sort(nb.begin(), nb.end());
+    common.clear();
+    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
+    const size_t ncn = common.size(), np = tets_of_edge[{std::min(a, b), std::max(a, b)}];
+    const uint8_t host = sm.check(a, b).reason;
+    if (ncn <= kCap && np <= kCap) {
+      ++within;
+      at_cap += ncn == kCap || np == kCap;
+      if (d.reason[e] != host && bad++ < 5)
+        ADD_FAILURE() << "edge (" << a << ", " << b << "), " << ncn << " common neighbours, " << np
+                      << " tets: host reason " << int(host) << ", device " << int(d.reason[e]);
+    } else {
+      ++beyond;
+      EXPECT_EQ(d.reason[e], uint8_t(kRefusedLink)) << "edge beyond the cap not refused: " << a << " " << b;
+    }
+  }
+  EXPECT_EQ(bad, 0);
+  EXPECT_GT(at_cap, 100) << "the cap is not reached often enough to test it";
+  EXPECT_GT(within, 1000);
+  EXPECT_GT(beyond, 100);
+}
+
 TEST(SequentialVerdicts, IncrementalStateAgreesWithTheDeviceInLaterIterations) {
   // After each sequential iteration the classes and rings of the dynamic mesh were updated
   // collapse by collapse; the device builds them from scratch on the same mesh.

@@ -21,24 +21,7 @@ std::string lower(std::string s) {
   return s;
 }
 
-// Sets an environment variable for the lifetime of the object.
-class EnvVar {
- public:
-  EnvVar(const char* name, const std::string& value) : name_(name) {
-    if (const char* old = std::getenv(name)) old_ = std::make_unique<std::string>(old);
-    ::setenv(name, value.c_str(), 1);
-  }
-  ~EnvVar() {
-    if (old_)
-      ::setenv(name_, old_->c_str(), 1);
-    else
-      ::unsetenv(name_);
-  }
-
- private:
-  const char* name_;
-  std::unique_ptr<std::string> old_;
-};
+using tc::test::EnvVar;
 
 std::string message_of(const std::function<void()>& f) {
   try {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -41,6 +42,21 @@ std::vector<std::string> shared_volume_meshes() {
 }
 
 std::string project_mesh(const std::string& name) { return (std::filesystem::path(TC_PROJECT_MESHES) / name).string(); }
+
+EnvVar::EnvVar(const char* name, const std::string& value) : name_(name) {
+  if (const char* old = std::getenv(name)) {
+    had_old_ = true;
+    old_ = old;
+  }
+  ::setenv(name, value.c_str(), 1);
+}
+
+EnvVar::~EnvVar() {
+  if (had_old_)
+    ::setenv(name_, old_.c_str(), 1);
+  else
+    ::unsetenv(name_);
+}
 
 TempDir::TempDir() {
   std::random_device rd;

@@ -34,6 +34,18 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+// Sets an environment variable for the lifetime of the object (the previous value comes back).
+class EnvVar {
+ public:
+  EnvVar(const char* name, const std::string& value);
+  ~EnvVar();
+
+ private:
+  const char* name_;
+  bool had_old_ = false;
+  std::string old_;
+};
+
 void write_text(const std::string& path, const std::string& text);
 std::string read_text(const std::string& path);
 
