@@ -184,6 +184,12 @@ inline void tcc_sg_load_tri(__global const int* tid, __global const double* tpos
   }
 }
 
+/* The box of new triangle n, as sguard_tris stored it. */
+inline void tcc_sg_load_box(__global const double* tbox, uint n, double3* lo, double3* hi) {
+  *lo = vload3(2 * n, tbox);
+  *hi = vload3(2 * n + 1, tbox);
+}
+
 /* Are the box [lo, hi] and the box of new triangle n (tbox, written by sguard_tris) apart? The
  * filter before a triangle pair's test, read before the triangle itself. */
 inline int tcc_sg_tri_box_apart(double3 lo, double3 hi, __global const double* tbox, uint n) {
@@ -289,8 +295,8 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
     int ida[3];
     double3 posa[3];
     tcc_sg_load_tri(tid, tpos, na, ida, posa);
-    __global const double* ba_ = tbox + 6 * na;
-    const double3 alo = (double3)(ba_[0], ba_[1], ba_[2]), ahi = (double3)(ba_[3], ba_[4], ba_[5]);
+    double3 alo, ahi;
+    tcc_sg_load_box(tbox, na, &alo, &ahi);
     for (uint nb = na + 1; nb < qoff[qa + 1]; ++nb) {
       if (tcc_sg_tri_box_apart(alo, ahi, tbox, nb)) continue;
       int idb[3];
@@ -304,8 +310,8 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
   TCC_SG_FOR_CELL_QUERIES(lo, hi, qb, {
     if (qb == qa || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qb, ci, cj, ck, org, ih, gd)) continue;
     for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
-      __global const double* ba_ = tbox + 6 * na;
-      const double3 alo = (double3)(ba_[0], ba_[1], ba_[2]), ahi = (double3)(ba_[3], ba_[4], ba_[5]);
+      double3 alo, ahi;
+      tcc_sg_load_box(tbox, na, &alo, &ahi);
       int ida[3];
       double3 posa[3];
       int loaded = 0;

@@ -1,7 +1,8 @@
 #include "cli/common.hpp"
 
-#include <filesystem>
 #include <iostream>
+
+#include "io/io_util.hpp"
 
 namespace tc::cli {
 
@@ -48,21 +49,9 @@ WriteOptions write_options(const OutputOptions& o) {
 
 void check_output_path(const std::string& path, const OutputOptions* o) {
   if (path.empty() || (!o && path == "-")) return;  // a report may go to stdout, a mesh may not
-  if (o) {
-    WriteOptions w = write_options(*o);  // an unknown --out-format: InputError naming it
-    if (w.format == Format::Auto) {
-      try {
-        format_from_name(path);
-      } catch (const InputError& e) {
-        throw OutputError(e.what());  // as write_mesh reports it
-      }
-    }
-  }
-  const std::filesystem::path p(path);
-  const std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
-  std::error_code ec;
-  if (!std::filesystem::is_directory(dir, ec))
-    throw OutputError(path + ": folder '" + dir.string() + "' does not exist");  // as io::AtomicFile
+  // the checks write_mesh and io::AtomicFile make (an unknown --out-format: InputError naming it)
+  if (o) io::output_format(path, write_options(*o).format);
+  io::require_output_folder(path);
 }
 
 }  // namespace tc::cli

@@ -77,16 +77,17 @@ Mesh read_mesh(const std::string& path, const ReadOptions& options, ReadNotes* n
   return mesh;
 }
 
-void write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions& options) {
-  Format f = options.format;
-  if (f == Format::Auto) {
-    try {
-      f = format_from_name(path);
-    } catch (const InputError& e) {
-      throw OutputError(e.what());
-    }
+Format io::output_format(const std::string& path, Format f) {
+  if (f != Format::Auto) return f;
+  try {
+    return format_from_name(path);
+  } catch (const InputError& e) {
+    throw OutputError(e.what());
   }
-  switch (f) {
+}
+
+void write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions& options) {
+  switch (io::output_format(path, options.format)) {
     case Format::Gmsh: write_gmsh(path, mesh, options); break;
     case Format::Medit: write_medit(path, mesh, options); break;
     case Format::Vtk: write_vtk(path, mesh, options); break;

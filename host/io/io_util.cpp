@@ -152,12 +152,18 @@ void TextCursor::set_pos(size_t p) {
 
 // ---------------------------------------------------------------- AtomicFile
 
-AtomicFile::AtomicFile(const std::string& path, bool binary) : path_(path) {
-  std::filesystem::path p(path);
-  std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+void require_output_folder(const std::string& path) {
+  const std::filesystem::path p(path);
+  const std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec))
     throw OutputError(path + ": folder '" + dir.string() + "' does not exist");
+}
+
+AtomicFile::AtomicFile(const std::string& path, bool binary) : path_(path) {
+  require_output_folder(path);
+  std::filesystem::path p(path);
+  std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
   std::random_device rd;
   tmp_ = (dir / ("." + p.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" +
                  std::to_string(rd() % 1000000)))

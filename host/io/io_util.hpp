@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "tetcollapse/error.hpp"
+#include "tetcollapse/io.hpp"
 
 namespace tc::io {
 
@@ -116,6 +117,14 @@ class BinaryCursor {
   size_t pos_ = 0;
   bool swap_ = false;
 };
+
+// The format write_mesh writes `path` in: f, or when Auto the one its extension names (an
+// unknown one: OutputError).
+Format output_format(const std::string& path, Format f);
+
+// Throws OutputError unless the folder `path` is to be written in exists (AtomicFile's first
+// check, also made before a long run by the CLI).
+void require_output_folder(const std::string& path);
 
 // A file written under a temporary name in the target's folder and renamed onto the
 // target by commit(). Destroyed without commit(), the temporary is removed, so a failed
