@@ -234,7 +234,7 @@ __kernel void conn_lower_edges(uint nv, __global const uint* nb_off, __global co
 
 /* tet_nbr (see collapse_common.h). Each face is matched by its smallest vertex v: the faces of
  * ring(v) whose other two vertices are both above v are paired in private memory (about 20 per
- * vertex), O(k^2) per vertex instead of a ring scan per face. A vertex with more such faces
+ * vertex) by sorting their keys, instead of a ring scan per face. A vertex with more such faces
  * than TCC_MAX_MIN_FACES falls back to the ring scan for its faces. */
 /* Carried tet_nbr for the faces owned by (whose smallest vertex is) a clean vertex v
  * (ndirty[v] == 0): ring(v) is unchanged since the previous iteration (collapse_verdicts.cl),
@@ -295,19 +295,36 @@ __kernel void conn_tet_neighbours(uint n, __global const int* tets, __global con
       ++k;
     }
   }
-  for (int i = 0; i < k; ++i) {
-    int n = 0, other = -1;
-    for (int j = 0; j < k; ++j)
-      if (j != i && key[j] == key[i]) {
-        if (n == 0) other = ft[j];
-        ++n;
-      }
-    if (overflow) { /* faces beyond the capacity may match this one too */
-      int o2;
-      n = tcc_face_others(tets, vt_off, vt, ft[i], ff[i], &o2);
-      other = o2;
+  if (overflow) { /* faces beyond the capacity may match these too: the ring scan for each */
+    for (int i = 0; i < k; ++i) {
+      int other;
+      int n = tcc_face_others(tets, vt_off, vt, ft[i], ff[i], &other);
+      tet_nbr[4 * ft[i] + ff[i]] = n == 0 ? -1 : n == 1 ? other : -2;
     }
-    tet_nbr[4 * ft[i] + ff[i]] = n == 0 ? -1 : n == 1 ? other : -2;
+    return;
+  }
+  /* Sorted by key (insertion sort: ~20 entries), each run of equal keys is one face: one entry
+   * is a boundary face, two are the two tets of an inner face, more an invalid input. */
+  for (int i = 1; i < k; ++i) {
+    ulong kk = key[i];
+    int tt = ft[i];
+    uchar fv = ff[i];
+    int j = i;
+    for (; j > 0 && key[j - 1] > kk; --j) {
+      key[j] = key[j - 1];
+      ft[j] = ft[j - 1];
+      ff[j] = ff[j - 1];
+    }
+    key[j] = kk;
+    ft[j] = tt;
+    ff[j] = fv;
+  }
+  for (int i = 0; i < k;) {
+    int j = i + 1;
+    while (j < k && key[j] == key[i]) ++j;
+    for (int m = i; m < j; ++m)
+      tet_nbr[4 * ft[m] + ff[m]] = j - i == 1 ? -1 : j - i == 2 ? ft[m == i ? i + 1 : i] : -2;
+    i = j;
   }
 }
 

@@ -2,7 +2,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 
 #include "collapse/stages.hpp"
 #include "tetcollapse/io.hpp"
@@ -25,6 +27,37 @@ Mesh two_materials(int n) {
   }
   m.tet_labels.push_back(l);
   return m;
+}
+
+// tet_nbr as collapse_common.h defines it, by a map of the faces' sorted vertex triples: the
+// tet across face f (opposite local vertex f), -1 when none, -2 when several.
+std::vector<int32_t> reference_tet_nbr(const Mesh& mesh) {
+  std::map<std::array<int32_t, 3>, std::vector<int32_t>> tets_of_face;
+  auto face = [&](int64_t t, int f) {
+    std::array<int32_t, 3> k;
+    for (int i = 0, n = 0; i < 4; ++i)
+      if (i != f) k[n++] = mesh.tets[4 * t + i];
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  for (int64_t t = 0; t < mesh.num_tets(); ++t)
+    for (int f = 0; f < 4; ++f) tets_of_face[face(t, f)].push_back(int32_t(t));
+  std::vector<int32_t> nbr;
+  for (int64_t t = 0; t < mesh.num_tets(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      const std::vector<int32_t>& all = tets_of_face[face(t, f)];
+      nbr.push_back(all.size() == 1 ? -1 : all.size() == 2 ? (all[0] == t ? all[1] : all[0]) : -2);
+    }
+  return nbr;
+}
+
+std::vector<int32_t> device_tet_nbr(Context& ctx, const Mesh& mesh) {
+  CollapseOptions o;
+  DeviceMesh dm;
+  upload_mesh(ctx, mesh, o, dm);
+  Connectivity c;
+  build_connectivity(ctx, dm, c, params_from(o));
+  return c.tet_nbr.download_range(0, 4 * size_t(dm.nt));
 }
 
 void compare_with_reference(Context& ctx, const Mesh& mesh) {
@@ -65,6 +98,7 @@ void compare_with_reference(Context& ctx, const Mesh& mesh) {
   }
   EXPECT_EQ(vflags, ref.vertex_boundary);
   EXPECT_EQ(vclass, ref.vertex_class);
+  EXPECT_EQ(c.tet_nbr.download_range(0, 4 * size_t(dm.nt)), reference_tet_nbr(mesh));
 }
 
 }  // namespace
@@ -101,6 +135,26 @@ TEST(CollapseConnectivity, IndependentOfWorkGroupSize) {
     if (first.empty()) first = all;
     EXPECT_EQ(all, first) << "work-group size " << wg;
   }
+}
+
+// The face matching of conn_tet_neighbours on an invalid input: a face in three tets is -2 on
+// each side. Also with the private face list capped at 4 (TCC_MAX_MIN_FACES), so that vertices
+// overflow it and take the ring scan for their faces.
+TEST(CollapseConnectivity, TetNeighboursOfAFaceInThreeTetsAndBeyondTheListCap) {
+  Mesh m;
+  m.points = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 1, 1, -1};
+  m.tets = {0, 1, 2, 3, 0, 2, 1, 4, 0, 1, 2, 5};  // face (0, 1, 2) in all three
+  const std::vector<int32_t> expected = reference_tet_nbr(m);
+  ASSERT_EQ(std::count(expected.begin(), expected.end(), -2), 3);
+  Mesh cube = test::cube_tets(3);
+  {
+    Context ctx;
+    EXPECT_EQ(device_tet_nbr(ctx, m), expected);
+  }
+  test::EnvVar cap("TETCOLLAPSE_CL_OPTIONS", "-DTCC_MAX_MIN_FACES=4");
+  Context ctx;  // builds its programs with the cap
+  EXPECT_EQ(device_tet_nbr(ctx, m), expected);
+  EXPECT_EQ(device_tet_nbr(ctx, cube), reference_tet_nbr(cube));
 }
 
 TEST(CollapseConnectivity, SharedMeshesMatchBuildTopology) {
