@@ -75,7 +75,21 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
   uint v = get_global_id(0);
   if (v >= nv) return;
   uint b = vt_off[v], n = vt_off[v + 1] - b;
-  if (sort) tcc_sort_segment(vt + b, n); /* else already sorted (collapse_update.cl) */
+  if (sort) { /* else already sorted (collapse_update.cl) */
+    if (n <= TCC_MAX_NB) {
+      /* each entry goes to its rank among the (distinct) tets: compares without branches,
+       * where an insertion sort mispredicts the end of every inner loop */
+      int r[TCC_MAX_NB];
+      for (uint i = 0; i < n; ++i) r[i] = vt[b + i];
+      for (uint i = 0; i < n; ++i) {
+        uint rank = 0;
+        for (uint j = 0; j < n; ++j) rank += r[j] < r[i] ? 1u : 0u;
+        vt[b + rank] = r[i];
+      }
+    } else {
+      tcc_sort_segment(vt + b, n);
+    }
+  }
   __global int* s = scratch + 3 * b;
   if (carry && !ndirty[v]) {
     /* ring(v) unchanged (collapse_verdicts.cl): N(v) is the previous one renumbered; none of
@@ -170,9 +184,14 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
       int u = q[k];
       if (u == (int)v) continue;
       if (!big) {
-        uint j = m;
-        while (j > 0 && loc[j - 1] > u) --j;
-        if (j > 0 && loc[j - 1] == u) continue;
+        /* u's place and whether it is there, without branches (see the ring sort above) */
+        uint j = 0;
+        int dup = 0;
+        for (uint i = 0; i < m; ++i) {
+          j += loc[i] < u ? 1u : 0u;
+          dup |= loc[i] == u;
+        }
+        if (dup) continue;
         if (m < TCC_MAX_NB) {
           for (uint k2 = m; k2 > j; --k2) loc[k2] = loc[k2 - 1];
           loc[j] = u;

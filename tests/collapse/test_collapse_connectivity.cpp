@@ -138,23 +138,35 @@ TEST(CollapseConnectivity, IndependentOfWorkGroupSize) {
 }
 
 // The face matching of conn_tet_neighbours on an invalid input: a face in three tets is -2 on
-// each side. Also with the private face list capped at 4 (TCC_MAX_MIN_FACES), so that vertices
-// overflow it and take the ring scan for their faces.
-TEST(CollapseConnectivity, TetNeighboursOfAFaceInThreeTetsAndBeyondTheListCap) {
+// each side, also when the vertex's private face list overflows (capped at 1, TCC_MAX_MIN_FACES)
+// and its faces take the ring scan.
+TEST(CollapseConnectivity, TetNeighboursOfAFaceInThreeTets) {
   Mesh m;
   m.points = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 1, 1, -1};
   m.tets = {0, 1, 2, 3, 0, 2, 1, 4, 0, 1, 2, 5};  // face (0, 1, 2) in all three
   const std::vector<int32_t> expected = reference_tet_nbr(m);
   ASSERT_EQ(std::count(expected.begin(), expected.end(), -2), 3);
-  Mesh cube = test::cube_tets(3);
   {
     Context ctx;
     EXPECT_EQ(device_tet_nbr(ctx, m), expected);
   }
-  test::EnvVar cap("TETCOLLAPSE_CL_OPTIONS", "-DTCC_MAX_MIN_FACES=4");
+  test::EnvVar cap("TETCOLLAPSE_CL_OPTIONS", "-DTCC_MAX_MIN_FACES=1");
   Context ctx;  // builds its programs with the cap
   EXPECT_EQ(device_tet_nbr(ctx, m), expected);
-  EXPECT_EQ(device_tet_nbr(ctx, cube), reference_tet_nbr(cube));
+}
+
+// The private lists of the connectivity kernels capped at 4 entries (a ring, N(v), the faces a
+// vertex matches), so that most vertices take the fallbacks: insertion sort and gather in the
+// global scratch (conn_ring_sort_and_gather), the ring scan per face (conn_tet_neighbours).
+TEST(CollapseConnectivity, SmallListCapsTakeTheFallbacks) {
+  test::EnvVar cap("TETCOLLAPSE_CL_OPTIONS", "-DTCC_MAX_NB=4 -DTCC_MAX_MIN_FACES=4");
+  Context ctx;
+  {
+    SCOPED_TRACE("cube");
+    compare_with_reference(ctx, test::cube_tets(3));
+  }
+  SCOPED_TRACE("two materials");
+  compare_with_reference(ctx, two_materials(3));
 }
 
 TEST(CollapseConnectivity, SharedMeshesMatchBuildTopology) {
