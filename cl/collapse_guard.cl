@@ -145,12 +145,27 @@ __kernel void sguard_queries(uint ne, __global const int* edges, __global const 
   b[0] = lo.x, b[1] = lo.y, b[2] = lo.z, b[3] = hi.x, b[4] = hi.y, b[5] = hi.z;
 }
 
-/* The new S triangles of each query, at qoff[q] .. qoff[q + 1] (ids, positions). */
+/* The plane data (tc_sg_plane) of new triangle n in tplane (5 doubles each). */
+inline void tcc_sg_store_plane(__global double* tplane, uint n, tc_sg_plane q) {
+  __global double* d = tplane + 5 * n;
+  d[0] = q.n.x, d[1] = q.n.y, d[2] = q.n.z, d[3] = q.ln, d[4] = q.e2;
+}
+inline tc_sg_plane tcc_sg_load_plane(__global const double* tplane, uint n) {
+  __global const double* d = tplane + 5 * n;
+  tc_sg_plane q;
+  q.n = (double3)(d[0], d[1], d[2]);
+  q.ln = d[3];
+  q.e2 = d[4];
+  return q;
+}
+
+/* The new S triangles of each query, at qoff[q] .. qoff[q + 1] (ids, positions, boxes and
+ * planes). */
 __kernel void sguard_tris(uint nq, __global const int* qedge, __global const uint* qoff, __global const int* edges,
                           __global const uchar* dir, __global const double* pts, __global const int* tets,
                           __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
                           __global const int* labels, int use_labels, __global int* tid, __global double* tpos,
-                          __global double* tbox, __global int* qrep) {
+                          __global double* tbox, __global double* tplane, __global int* qrep) {
   uint qi = get_global_id(0);
   if (qi >= nq) return;
   int x, y;
@@ -173,6 +188,7 @@ __kernel void sguard_tris(uint nq, __global const int* qedge, __global const uin
     double3 hi = fmax(fmax(pos[0], pos[1]), pos[2]);
     vstore3(lo, 2 * n, tbox);
     vstore3(hi, 2 * n + 1, tbox);
+    tcc_sg_store_plane(tplane, n, tc_sg_plane_of(pos));
     ++n;
   })
 }
@@ -242,8 +258,9 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
                              __global const int* tets, __global const int* tet_nbr, __global const int* labels,
                              int use_labels, __global const int* qrep, __global const double* qbox,
                              __global const uint* qoff, __global const int* tid, __global const double* tpos,
-                             __global const double* tbox, double ox, double oy, double oz, double ih, int gx, int gy, int gz,
-                             __global const uint* cell_off, __global const uint* cell_items, __global uint* qbad) {
+                             __global const double* tbox, __global const double* tplane, double ox, double oy, double oz,
+                             double ih, int gx, int gy, int gz, __global const uint* cell_off,
+                             __global const uint* cell_items, __global uint* qbad) {
   const uint g = get_global_id(0);
   if (g >= n) return;
   const uint t = stets[g];
@@ -260,6 +277,8 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
       fpos[k] = tc_point(pts, fid[k]);
     }
     double3 lo = fmin(fmin(fpos[0], fpos[1]), fpos[2]), hi = fmax(fmax(fpos[0], fpos[1]), fpos[2]);
+    int has_plane = 0; /* the face's plane, computed at its first triangle test */
+    tc_sg_plane fplane;
     TCC_SG_FOR_CELL_QUERIES(lo, hi, qi, {
       if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qi, ci, cj, ck, org, ih, gd)) continue;
       /* the face is one the collapse moves or removes: it has x, or y when y moves (-1 else) */
@@ -270,7 +289,11 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
         int id[3];
         double3 pos[3];
         tcc_sg_load_tri(tid, tpos, r, id, pos);
-        if (!tc_sg_tri_tri(id, pos, fid, fpos)) continue;
+        if (!has_plane) {
+          fplane = tc_sg_plane_of(fpos);
+          has_plane = 1;
+        }
+        if (!tc_sg_tri_tri_planes(id, pos, tcc_sg_load_plane(tplane, r), fid, fpos, fplane)) continue;
         uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
         qbad[qi] = code < 0x7ffffffeu ? code + 2u : 1u;
         break;
@@ -281,9 +304,9 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
 
 /* The new triangles of two queries against each other. */
 __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const uint* qoff, __global const int* tid,
-                           __global const double* tpos, __global const double* tbox, double ox, double oy, double oz, double ih, int gx, int gy,
-                           int gz, __global const uint* cell_off, __global const uint* cell_items,
-                           __global uint* qbad) {
+                           __global const double* tpos, __global const double* tbox, __global const double* tplane,
+                           double ox, double oy, double oz, double ih, int gx, int gy, int gz,
+                           __global const uint* cell_off, __global const uint* cell_items, __global uint* qbad) {
   uint qa = get_global_id(0);
   if (qa >= nq) return;
   const double3 org = (double3)(ox, oy, oz);
@@ -302,7 +325,8 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
       int idb[3];
       double3 posb[3];
       tcc_sg_load_tri(tid, tpos, nb, idb, posb);
-      if (!tc_sg_tri_tri(ida, posa, idb, posb)) continue;
+      if (!tc_sg_tri_tri_planes(ida, posa, tcc_sg_load_plane(tplane, na), idb, posb, tcc_sg_load_plane(tplane, nb)))
+        continue;
       qbad[qa] = 0x80000000u | qa;
       return;
     }
@@ -324,7 +348,8 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
         int idb[3];
         double3 posb[3];
         tcc_sg_load_tri(tid, tpos, nb, idb, posb);
-        if (!tc_sg_tri_tri(ida, posa, idb, posb)) continue;
+        if (!tc_sg_tri_tri_planes(ida, posa, tcc_sg_load_plane(tplane, na), idb, posb, tcc_sg_load_plane(tplane, nb)))
+          continue;
         qbad[qa] = 0x80000000u | qb; /* names the other query for debugging */
         return;
       }

@@ -96,24 +96,38 @@ TC_FN int tc_sg_seg_tri(tc_d3 p, tc_d3 q, tc_d3 a, tc_d3 b, tc_d3 c) {
   return tc_sg_in_tri2(tc_sg_proj(p + pq * t, drop), a2, b2, c2, tol);
 }
 
+/* What tc_sg_one_side needs of a triangle p: its normal cross(p1 - p0, p2 - p0), the normal's
+ * length and the longest squared edge. Computed once per triangle by the kernels that test one
+ * triangle against many (the same arithmetic as computing it per pair: the same decisions). */
+typedef struct {
+  tc_d3 n;
+  double ln, e2;
+} tc_sg_plane;
+
+TC_FN tc_sg_plane tc_sg_plane_of(const tc_d3* p) {
+  tc_sg_plane r;
+  r.n = cross(p[1] - p[0], p[2] - p[0]);
+  r.ln = sqrt(dot(r.n, r.n));
+  r.e2 = 0.0;
+  for (int k = 0; k < 3; ++k) {
+    tc_d3 e = p[(k + 1) % 3] - p[k];
+    double l = dot(e, e);
+    r.e2 = r.e2 > l ? r.e2 : l;
+  }
+  return r;
+}
+
 /* Are the vertices of B not shared with A all farther than 1e-9 times the two triangles' size
  * from A's plane, on one side? (Then B meets A at most in what they share; the tolerance is at
  * least that of tc_sg_seg_tri, so this never drops a pair that test would report.) */
-TC_FN int tc_sg_one_side(const int* ia, const tc_d3* pa, const int* ib, const tc_d3* pb) {
-  tc_d3 n = cross(pa[1] - pa[0], pa[2] - pa[0]);
-  double ln = sqrt(dot(n, n)), s2 = 0.0;
-  if (!(ln > 0.0)) return 0;
-  for (int k = 0; k < 3; ++k) {
-    tc_d3 ea = pa[(k + 1) % 3] - pa[k], eb = pb[(k + 1) % 3] - pb[k];
-    double la = dot(ea, ea), lb = dot(eb, eb);
-    s2 = s2 > la ? s2 : la;
-    s2 = s2 > lb ? s2 : lb;
-  }
-  double tol = 1e-9 * sqrt(s2);
+TC_FN int tc_sg_one_side(const int* ia, const tc_d3* pa, tc_sg_plane qa, const int* ib, const tc_d3* pb,
+                         tc_sg_plane qb) {
+  if (!(qa.ln > 0.0)) return 0;
+  double tol = 1e-9 * sqrt(qa.e2 > qb.e2 ? qa.e2 : qb.e2);
   int above = 0, below = 0, free = 0;
   for (int k = 0; k < 3; ++k) {
     if (ib[k] == ia[0] || ib[k] == ia[1] || ib[k] == ia[2]) continue;
-    double d = dot(n, pb[k] - pa[0]) / ln;
+    double d = dot(qa.n, pb[k] - pa[0]) / qa.ln;
     ++free;
     above += d > tol;
     below += d < -tol;
@@ -121,11 +135,12 @@ TC_FN int tc_sg_one_side(const int* ia, const tc_d3* pa, const int* ib, const tc
   return free > 0 && (above == free || below == free);
 }
 
-/* Do triangles A and B (vertex ids ia, ib; positions pa, pb) intersect other than in what they
- * share? Sharing an edge (or all three vertices): not tested. Sharing one vertex s: they meet
- * elsewhere iff the edge opposite s of one meets the other. Sharing none: iff an edge of one
- * meets the other. */
-TC_FN int tc_sg_tri_tri(const int* ia, const tc_d3* pa, const int* ib, const tc_d3* pb) {
+/* Do triangles A and B (vertex ids ia, ib; positions pa, pb; planes qa, qb of tc_sg_plane_of)
+ * intersect other than in what they share? Sharing an edge (or all three vertices): not
+ * tested. Sharing one vertex s: they meet elsewhere iff the edge opposite s of one meets the
+ * other. Sharing none: iff an edge of one meets the other. */
+TC_FN int tc_sg_tri_tri_planes(const int* ia, const tc_d3* pa, tc_sg_plane qa, const int* ib, const tc_d3* pb,
+                               tc_sg_plane qb) {
   int sa = -1, sb = -1, shared = 0;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
@@ -136,7 +151,7 @@ TC_FN int tc_sg_tri_tri(const int* ia, const tc_d3* pa, const int* ib, const tc_
       }
   if (shared >= 2) return 0;
   /* cheap and most frequent: one triangle on one side of the other's plane */
-  if (tc_sg_one_side(ia, pa, ib, pb) || tc_sg_one_side(ib, pb, ia, pa)) return 0;
+  if (tc_sg_one_side(ia, pa, qa, ib, pb, qb) || tc_sg_one_side(ib, pb, qb, ia, pa, qa)) return 0;
   if (shared == 1)
     return tc_sg_seg_tri(pa[(sa + 1) % 3], pa[(sa + 2) % 3], pb[0], pb[1], pb[2]) ||
            tc_sg_seg_tri(pb[(sb + 1) % 3], pb[(sb + 2) % 3], pa[0], pa[1], pa[2]);
@@ -145,6 +160,11 @@ TC_FN int tc_sg_tri_tri(const int* ia, const tc_d3* pa, const int* ib, const tc_
     if (tc_sg_seg_tri(pb[i], pb[(i + 1) % 3], pa[0], pa[1], pa[2])) return 1;
   }
   return 0;
+}
+
+/* The same, computing the planes. */
+TC_FN int tc_sg_tri_tri(const int* ia, const tc_d3* pa, const int* ib, const tc_d3* pb) {
+  return tc_sg_tri_tri_planes(ia, pa, tc_sg_plane_of(pa), ib, pb, tc_sg_plane_of(pb));
 }
 
 #ifndef __OPENCL_C_VERSION__

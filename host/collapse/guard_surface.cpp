@@ -88,10 +88,11 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   ensure_nonempty(tid, ctx, size_t(ntri) * 3);
   ensure_nonempty(tpos, ctx, size_t(ntri) * 9);
   ensure_nonempty(tbox, ctx, size_t(ntri) * 6);
+  ensure_nonempty(tplane, ctx, size_t(ntri) * 5);
   ensure_nonempty(qrep, ctx, size_t(nq) * 2);
   launch(ctx, "sguard_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(), s.dir.buffer(),
          dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
-         tid.buffer(), tpos.buffer(), tbox.buffer(), qrep.buffer());
+         tid.buffer(), tpos.buffer(), tbox.buffer(), tplane.buffer(), qrep.buffer());
 
   // The grid: cells twice the median query box (most boxes span <= 2 cells per axis, the large
   // ones are entered in every cell they span), at most kMaxCellsPerAxis per axis.
@@ -152,10 +153,10 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   }
   launch(ctx, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), dm.points.buffer(), dm.tets.buffer(),
          c.tet_nbr.buffer(), labels, use_labels, qrep.buffer(), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
-         tbox.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
+         tbox.buffer(), tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
          cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());
   launch(ctx, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),
-         cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
+         tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
          cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());
   qcount.fill(0u);
   const bool has_verdict = s.verdict.size() >= c.ne && s.verdict.buffer()();

@@ -14,7 +14,7 @@ namespace tc::collapse_detail {
 struct SurfaceGuard {
   DeviceBuffer<int32_t> qedge, tid;          // per query: its edge; per new triangle: ids
   DeviceBuffer<int32_t> qrep;                // per query: x, and y when it moves (else -1)
-  DeviceBuffer<double> qbox, tpos, tbox;     // per query: box; per new triangle: positions, box
+  DeviceBuffer<double> qbox, tpos, tbox, tplane;  // per query: box; per new triangle: positions, box, plane
   DeviceBuffer<uint32_t> qntri, qoff, qcount, qbad, cell_off, cell_items;
   uint32_t last_queries = 0;  // collapses tested by the last run (that change S)
   DeviceBuffer<uint32_t> stets;  // the tets owning an S face (n_stets), listed for the connectivity
