@@ -69,16 +69,13 @@ TC_FN int tc_sg_in_tri2(tc_sg_d2 p, tc_sg_d2 a, tc_sg_d2 b, tc_sg_d2 c, double t
 
 /* Does the closed segment (p, q) meet the closed triangle (a, b, c), up to 1e-9 times their
  * size? A segment within that distance of the triangle's plane is tested in the plane (in 2D,
- * the dominant axis of the normal dropped); otherwise the point where it crosses the plane. */
-TC_FN int tc_sg_seg_tri(tc_d3 p, tc_d3 q, tc_d3 a, tc_d3 b, tc_d3 c) {
-  tc_d3 ab = b - a, ac = c - a, bc = c - b, pq = q - p;
-  tc_d3 n = cross(ab, ac);
-  double ln = sqrt(dot(n, n));
+ * the dominant axis of the normal dropped); otherwise the point where it crosses the plane.
+ * n = cross(b - a, c - a), ln its length, e2 the triangle's longest squared edge (tc_sg_plane). */
+TC_FN int tc_sg_seg_tri_n(tc_d3 p, tc_d3 q, tc_d3 a, tc_d3 b, tc_d3 c, tc_d3 n, double ln, double e2) {
+  tc_d3 pq = q - p;
   if (!(ln > 0.0)) return 1; /* a degenerate triangle: cannot tell */
-  double s2 = dot(ab, ab), t2;
-  t2 = dot(ac, ac), s2 = s2 > t2 ? s2 : t2;
-  t2 = dot(bc, bc), s2 = s2 > t2 ? s2 : t2;
-  t2 = dot(pq, pq), s2 = s2 > t2 ? s2 : t2;
+  double s2 = dot(pq, pq);
+  s2 = e2 > s2 ? e2 : s2;
   double tol = 1e-9 * sqrt(s2);
   double dp = dot(n, p - a) / ln, dq = dot(n, q - a) / ln; /* signed distances to the plane */
   if ((dp > tol && dq > tol) || (dp < -tol && dq < -tol)) return 0;
@@ -153,11 +150,11 @@ TC_FN int tc_sg_tri_tri_planes(const int* ia, const tc_d3* pa, tc_sg_plane qa, c
   /* cheap and most frequent: one triangle on one side of the other's plane */
   if (tc_sg_one_side(ia, pa, qa, ib, pb, qb) || tc_sg_one_side(ib, pb, qb, ia, pa, qa)) return 0;
   if (shared == 1)
-    return tc_sg_seg_tri(pa[(sa + 1) % 3], pa[(sa + 2) % 3], pb[0], pb[1], pb[2]) ||
-           tc_sg_seg_tri(pb[(sb + 1) % 3], pb[(sb + 2) % 3], pa[0], pa[1], pa[2]);
+    return tc_sg_seg_tri_n(pa[(sa + 1) % 3], pa[(sa + 2) % 3], pb[0], pb[1], pb[2], qb.n, qb.ln, qb.e2) ||
+           tc_sg_seg_tri_n(pb[(sb + 1) % 3], pb[(sb + 2) % 3], pa[0], pa[1], pa[2], qa.n, qa.ln, qa.e2);
   for (int i = 0; i < 3; ++i) {
-    if (tc_sg_seg_tri(pa[i], pa[(i + 1) % 3], pb[0], pb[1], pb[2])) return 1;
-    if (tc_sg_seg_tri(pb[i], pb[(i + 1) % 3], pa[0], pa[1], pa[2])) return 1;
+    if (tc_sg_seg_tri_n(pa[i], pa[(i + 1) % 3], pb[0], pb[1], pb[2], qb.n, qb.ln, qb.e2)) return 1;
+    if (tc_sg_seg_tri_n(pb[i], pb[(i + 1) % 3], pa[0], pa[1], pa[2], qa.n, qa.ln, qa.e2)) return 1;
   }
   return 0;
 }
