@@ -43,27 +43,6 @@ struct Staged {
   }
 };
 
-// cube_tets(n) restricted to the bottom layer of cells: a slab one tet thick, every vertex on
-// the boundary.
-Mesh slab(int n) {
-  Mesh c = test::cube_tets(n), m;
-  std::vector<int32_t> map(c.num_vertices(), -1);
-  for (int64_t t = 0; t < c.num_tets(); ++t) {
-    bool low = true;
-    for (int k = 0; k < 4; ++k) low = low && c.points[3 * c.tets[4 * t + k] + 2] <= 1.0 / n + 1e-12;
-    if (!low) continue;
-    for (int k = 0; k < 4; ++k) {
-      int32_t& v = map[c.tets[4 * t + k]];
-      if (v < 0) {
-        v = int32_t(m.num_vertices());
-        for (int d = 0; d < 3; ++d) m.points.push_back(c.points[3 * c.tets[4 * t + k] + d]);
-      }
-      m.tets.push_back(v);
-    }
-  }
-  return m;
-}
-
 int32_t vertex_at(const Mesh& m, double x, double y, double z) {
   for (int64_t v = 0; v < m.num_vertices(); ++v)
     if (std::abs(m.points[3 * v] - x) < 1e-12 && std::abs(m.points[3 * v + 1] - y) < 1e-12 &&
@@ -138,7 +117,7 @@ TEST(CollapseAdmissible, LinkConditionRefusesCollapseAcrossThinSlab) {
   // edge would glue the sheets. Free mode has no Q, so the link condition (the virtual vertex)
   // must refuse it.
   Context ctx;
-  Mesh m = slab(3);
+  Mesh m = test::slab(3);
   CollapseOptions o;
   o.boundary = CollapseOptions::Free;
   Staged st(ctx, m, o, 10.0);
@@ -198,6 +177,43 @@ TEST(CollapseAdmissible, LinkConditionRefusesTunnelClosure) {
   }
   EXPECT_GT(refused, 0);
   EXPECT_GT(ok, 0);
+}
+
+TEST(CollapseAdmissible, LinkConditionRefusesACommonNeighbourOutsideTheLink) {
+  // The thin slab closed by a cone (test::cone_boundary): every vertex is interior now, so Q
+  // lets every edge through even in features mode, and the apex W is a real vertex where the
+  // virtual one was. An edge across the slab (from the bottom sheet to the top one; not an edge
+  // of the slab's boundary) has W as a common neighbour of its end points, but no tet (a, b, W,
+  // .) holds the edge: check (i) refuses it. Away from the slab's side walls no third vertex d
+  // gives triangles (a, W, d) and (b, W, d) (no boundary edge of the slab joins the two sheets
+  // there), so checks (ii) and (iii) do not refuse those: (i) alone decides. The volume test is
+  // off (eps_v = -infinity): the cone's tets overlap the slab.
+  Context ctx;
+  const Mesh s = test::slab(6);
+  const Mesh m = test::cone_boundary(s, 0.5, 0.5, 3.0);
+  CollapseOptions o;
+  o.eps_v = -INFINITY;
+  o.min_quality = 0;
+  Staged st(ctx, m, o, 10.0);  // every edge marked
+  Topology t = build_topology(s);
+  auto inside = [&](int32_t v) {  // off the side walls
+    for (int d = 0; d < 2; ++d)
+      if (!(s.points[3 * size_t(v) + d] > 1e-9 && s.points[3 * size_t(v) + d] < 1 - 1e-9)) return false;
+    return true;
+  };
+  int crossing = 0, away = 0, ok = 0;
+  for (int32_t e = 0; e < t.num_edges(); ++e) {
+    const int32_t a = t.edges[2 * e], b = t.edges[2 * e + 1], d = st.edge(a, b);
+    ASSERT_GE(d, 0);
+    ok += st.reason[d] == kOk;
+    if (t.edge_boundary[e]) continue;
+    EXPECT_EQ(st.reason[d], kRefusedLink) << "edge " << a << "-" << b;
+    ++crossing;
+    away += inside(a) && inside(b);
+  }
+  EXPECT_GT(crossing, 0);
+  EXPECT_GT(away, 0);
+  EXPECT_GT(ok, 0);  // the edges within a sheet: W is in their link
 }
 
 TEST(CollapseAdmissible, VolumeTestMatchesHostReference) {

@@ -5,10 +5,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 #include <sys/wait.h>
 
+#include "geometry.h"
 #include "tetcollapse/topology.hpp"
 
 namespace tc::test {
@@ -88,6 +90,61 @@ Mesh single_tet() {
 }
 
 Mesh cube_tets(int n) { return make_cube_mesh(n); }
+
+Mesh slab(int n) {
+  Mesh c = cube_tets(n), m;
+  std::vector<int32_t> map(size_t(c.num_vertices()), -1);
+  for (int64_t t = 0; t < c.num_tets(); ++t) {
+    bool low = true;
+    for (int k = 0; k < 4; ++k) low = low && c.points[3 * size_t(c.tets[4 * t + k]) + 2] <= 1.0 / n + 1e-12;
+    if (!low) continue;
+    for (int k = 0; k < 4; ++k) {
+      int32_t& v = map[size_t(c.tets[4 * t + k])];
+      if (v < 0) {
+        v = int32_t(m.num_vertices());
+        for (int d = 0; d < 3; ++d) m.points.push_back(c.points[3 * size_t(c.tets[4 * t + k]) + d]);
+      }
+      m.tets.push_back(v);
+    }
+  }
+  return m;
+}
+
+Mesh cone_boundary(const Mesh& m, double x, double y, double z) {
+  struct Seen {
+    int count = 0;
+    std::array<int32_t, 3> face;  // as its tet has it
+    int64_t tet = 0;
+  };
+  std::map<std::array<int32_t, 3>, Seen> faces;  // by sorted vertices
+  for (int64_t t = 0; t < m.num_tets(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      std::array<int32_t, 3> q;
+      for (int i = 0, n = 0; i < 4; ++i)
+        if (i != f) q[n++] = m.tets[4 * t + i];
+      std::array<int32_t, 3> k = q;
+      std::sort(k.begin(), k.end());
+      Seen& e = faces[k];
+      ++e.count;
+      e.face = q;
+      e.tet = t;
+    }
+  Mesh out;  // points, tets and labels (a cone tet has the label of the tet it closes)
+  out.points = m.points;
+  out.tets = m.tets;
+  out.tet_labels = m.tet_labels;
+  const int32_t apex = int32_t(m.num_vertices());
+  out.points.insert(out.points.end(), {x, y, z});
+  auto p = [&](int32_t v) { return geo::tc_point(out.points.data(), v); };
+  for (const auto& [key, e] : faces) {
+    if (e.count != 1) continue;
+    std::array<int32_t, 4> t{e.face[0], e.face[1], e.face[2], apex};
+    if (geo::tc_orient3d(p(t[0]), p(t[1]), p(t[2]), p(t[3])) < 0) std::swap(t[0], t[1]);
+    out.tets.insert(out.tets.end(), t.begin(), t.end());
+    for (Labels& l : out.tet_labels) l.values.push_back(l.values[size_t(e.tet)]);
+  }
+  return out;
+}
 
 int run_command(const std::string& cmd, std::string* output) {
   std::string full = cmd + " 2>&1";

@@ -52,6 +52,12 @@ std::string read_text(const std::string& path);
 // Small meshes built in code.
 Mesh single_tet();             // the unit right-corner tet, positively oriented
 Mesh cube_tets(int n);         // [0,1]^3 split into n^3 cubes of 6 tets each (Kuhn), labels none
+Mesh slab(int n);              // the bottom layer of cube_tets(n): one tet thick, every vertex on the boundary
+// m closed by a cone: a new last vertex at (x, y, z) joined by a tet to every boundary face (each
+// tet made positively oriented, whatever it overlaps; labelled as the tet it closes; m's fields,
+// triangles and edges are dropped). No boundary is left: the new vertex plays the virtual vertex
+// of the link condition as a real one.
+Mesh cone_boundary(const Mesh& m, double x, double y, double z);
 
 // Adaptive marking tests: a vertex mask selecting the vertices with x < x_max; the positions
 // of the others (which no collapse may move or remove) go to *unselected.
