@@ -223,14 +223,15 @@ inline int tcc_sg_cell(double v, double org, double ih, int n) {
 }
 
 /* Is (i, j, k) the cell holding the low corner of the overlap of boxes A and B (so each pair
- * is tested once)? Also tests the overlap. */
-inline int tcc_sg_owner_cell(double3 alo, double3 ahi, __global const double* b, int i, int j, int k, double3 org,
-                             double ih, int4 gd) {
+ * is tested once)? Also tests the overlap. The cell of the overlap's low corner is, per axis,
+ * the larger of the two boxes' low cells (the cell of a coordinate does not decrease with it):
+ * A's are (i0, j0, k0), B's qcell (the host's, the same arithmetic), so most pairs met in
+ * another of their common cells are passed over before B's box is read. */
+inline int tcc_sg_owner_cell(double3 alo, double3 ahi, int i0, int j0, int k0, __global const double* b,
+                             __global const int* qcell, int i, int j, int k) {
+  if (max(i0, qcell[0]) != i || max(j0, qcell[1]) != j || max(k0, qcell[2]) != k) return 0;
   double3 blo = (double3)(b[0], b[1], b[2]), bhi = (double3)(b[3], b[4], b[5]);
-  if (alo.x > bhi.x || alo.y > bhi.y || alo.z > bhi.z || blo.x > ahi.x || blo.y > ahi.y || blo.z > ahi.z) return 0;
-  double3 c = fmax(alo, blo);
-  return tcc_sg_cell(c.x, org.x, ih, gd.x) == i && tcc_sg_cell(c.y, org.y, ih, gd.y) == j &&
-         tcc_sg_cell(c.z, org.z, ih, gd.z) == k;
+  return !(alo.x > bhi.x || alo.y > bhi.y || alo.z > bhi.z || blo.x > ahi.x || blo.y > ahi.y || blo.z > ahi.z);
 }
 
 /* Loop over the queries entered in the grid cells that the box [LO, HI] overlaps: the body
@@ -260,12 +261,10 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
                              __global const uint* qoff, __global const int* tid, __global const double* tpos,
                              __global const double* tbox, __global const double* tplane, double ox, double oy, double oz,
                              double ih, int gx, int gy, int gz, __global const uint* cell_off,
-                             __global const uint* cell_items, __global uint* qbad) {
+                             __global const uint* cell_items, __global const int* qcell, __global uint* qbad) {
   const uint g = get_global_id(0);
   if (g >= n) return;
   const uint t = stets[g];
-  const double3 org = (double3)(ox, oy, oz);
-  const int4 gd = (int4)(gx, gy, gz, 0);
   __global const int* tq = tets + 4 * t;
   for (int f = 0; f < 4; ++f) {
     uint on_s;
@@ -280,7 +279,7 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
     int has_plane = 0; /* the face's plane, computed at its first triangle test */
     tc_sg_plane fplane;
     TCC_SG_FOR_CELL_QUERIES(lo, hi, qi, {
-      if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qi, ci, cj, ck, org, ih, gd)) continue;
+      if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, qbox + 6 * qi, qcell + 3 * qi, ci, cj, ck)) continue;
       /* the face is one the collapse moves or removes: it has x, or y when y moves (-1 else) */
       const int rx = qrep[2 * qi], ry = qrep[2 * qi + 1];
       if (fid[0] == rx || fid[1] == rx || fid[2] == rx || fid[0] == ry || fid[1] == ry || fid[2] == ry) continue;
@@ -306,11 +305,10 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
 __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const uint* qoff, __global const int* tid,
                            __global const double* tpos, __global const double* tbox, __global const double* tplane,
                            double ox, double oy, double oz, double ih, int gx, int gy, int gz,
-                           __global const uint* cell_off, __global const uint* cell_items, __global uint* qbad) {
+                           __global const uint* cell_off, __global const uint* cell_items, __global const int* qcell,
+                           __global uint* qbad) {
   uint qa = get_global_id(0);
   if (qa >= nq) return;
-  const double3 org = (double3)(ox, oy, oz);
-  const int4 gd = (int4)(gx, gy, gz, 0);
   __global const double* ba = qbox + 6 * qa;
   double3 lo = (double3)(ba[0], ba[1], ba[2]), hi = (double3)(ba[3], ba[4], ba[5]);
   /* the new triangles of the collapse among themselves (S folded over itself around y) */
@@ -332,7 +330,7 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
     }
   }
   TCC_SG_FOR_CELL_QUERIES(lo, hi, qb, {
-    if (qb == qa || !tcc_sg_owner_cell(lo, hi, qbox + 6 * qb, ci, cj, ck, org, ih, gd)) continue;
+    if (qb == qa || !tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, qbox + 6 * qb, qcell + 3 * qb, ci, cj, ck)) continue;
     for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
       double3 alo, ahi;
       tcc_sg_load_box(tbox, na, &alo, &ahi);

@@ -135,6 +135,10 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   for (size_t i = 0; i < ncells; ++i) off[i + 1] += off[i];
   std::vector<uint32_t> items(std::max<uint32_t>(off[ncells], 1)), cursor(off.begin(), off.end() - 1);
   for (uint32_t q = 0; q < nq; ++q) for_cells(q, [&](size_t cell) { items[cursor[cell]++] = q; });
+  // each query's low cell (tcc_sg_owner_cell)
+  std::vector<int32_t> low(size_t(nq) * 3);
+  for (uint32_t q = 0; q < nq; ++q)
+    for (int a = 0; a < 3; ++a) low[3 * size_t(q) + a] = cell_of(box[6 * q + a], lo[a], ih, g[a]);
   if (kProfile)
     std::fprintf(stderr, "  surface guard grid: h %g, %d x %d x %d cells, %u entries for %u queries\n", h, g[0], g[1],
                  g[2], off[ncells], nq);
@@ -142,6 +146,8 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   cell_off.upload(off);
   ensure_nonempty(cell_items, ctx, items.size());
   cell_items.upload(items);
+  ensure_nonempty(qcell, ctx, low.size());
+  qcell.upload(low);
 
   ensure_nonempty(qbad, ctx, nq);
   qbad.fill(0u);
@@ -154,10 +160,10 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   launch(ctx, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), dm.points.buffer(), dm.tets.buffer(),
          c.tet_nbr.buffer(), labels, use_labels, qrep.buffer(), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
          tbox.buffer(), tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
-         cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());
+         cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer());
   launch(ctx, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),
          tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
-         cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qbad.buffer());
+         cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer());
   qcount.fill(0u);
   const bool has_verdict = s.verdict.size() >= c.ne && s.verdict.buffer()();
   launch(ctx, "sguard_drop", nq, cl_uint(nq), qedge.buffer(), qbad.buffer(), s.marked.buffer(),
