@@ -274,22 +274,11 @@ TEST(SequentialVerdicts, LinkConditionAloneAgreesWithTheDevice) {
 // tunnels, tets joined at an edge or a vertex only (a non-manifold boundary); every kind of
 // link configuration, many of which no mesher would produce.
 Mesh cube_with_holes(uint32_t seed) {
-  Mesh c = test::cube_tets(3), m;
   uint32_t r = seed * 2654435761u;
-  std::vector<int32_t> map(size_t(c.num_vertices()), -1);
-  for (int64_t t = 0; t < c.num_tets(); ++t) {
+  return test::sub_mesh(test::cube_tets(3), [&](int64_t) {
     r = r * 1664525u + 1013904223u;
-    if ((r >> 24) < 77) continue;
-    for (int k = 0; k < 4; ++k) {
-      int32_t& v = map[size_t(c.tets[4 * t + k])];
-      if (v < 0) {
-        v = int32_t(m.num_vertices());
-        for (int d = 0; d < 3; ++d) m.points.push_back(c.points[3 * size_t(c.tets[4 * t + k]) + d]);
-      }
-      m.tets.push_back(v);
-    }
-  }
-  return m;
+    return (r >> 24) >= 77;
+  });
 }
 
 // The device's link test and the host's agree edge by edge on odd configurations too: cubes with

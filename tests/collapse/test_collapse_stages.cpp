@@ -143,25 +143,16 @@ TEST(CollapseAdmissible, LinkConditionRefusesTunnelClosure) {
   // ring from the top sheet to the bottom one) must be refused by the link condition, while
   // some boundary edges remain admissible.
   Context ctx;
-  Mesh c = test::cube_tets(3), m;
-  std::vector<int32_t> map(c.num_vertices(), -1);
-  for (int64_t t = 0; t < c.num_tets(); ++t) {
+  const Mesh c = test::cube_tets(3);
+  const Mesh m = test::sub_mesh(c, [&](int64_t t) {
     double x = 0, y = 0, z = 0;
     for (int k = 0; k < 4; ++k) {
       x += c.points[3 * c.tets[4 * t + k]] / 4;
       y += c.points[3 * c.tets[4 * t + k] + 1] / 4;
       z += c.points[3 * c.tets[4 * t + k] + 2] / 4;
     }
-    if (z > 1.0 / 3 || (x > 1.0 / 3 && x < 2.0 / 3 && y > 1.0 / 3 && y < 2.0 / 3)) continue;
-    for (int k = 0; k < 4; ++k) {
-      int32_t& v = map[c.tets[4 * t + k]];
-      if (v < 0) {
-        v = int32_t(m.num_vertices());
-        for (int d = 0; d < 3; ++d) m.points.push_back(c.points[3 * c.tets[4 * t + k] + d]);
-      }
-      m.tets.push_back(v);
-    }
-  }
+    return !(z > 1.0 / 3 || (x > 1.0 / 3 && x < 2.0 / 3 && y > 1.0 / 3 && y < 2.0 / 3));
+  });
   CollapseOptions o;
   o.boundary = CollapseOptions::Free;
   Staged st(ctx, m, o, 10.0);

@@ -91,23 +91,30 @@ Mesh single_tet() {
 
 Mesh cube_tets(int n) { return make_cube_mesh(n); }
 
-Mesh slab(int n) {
-  Mesh c = cube_tets(n), m;
-  std::vector<int32_t> map(size_t(c.num_vertices()), -1);
-  for (int64_t t = 0; t < c.num_tets(); ++t) {
-    bool low = true;
-    for (int k = 0; k < 4; ++k) low = low && c.points[3 * size_t(c.tets[4 * t + k]) + 2] <= 1.0 / n + 1e-12;
-    if (!low) continue;
+Mesh sub_mesh(const Mesh& m, const std::function<bool(int64_t)>& keep) {
+  Mesh out;
+  std::vector<int32_t> map(size_t(m.num_vertices()), -1);
+  for (int64_t t = 0; t < m.num_tets(); ++t) {
+    if (!keep(t)) continue;
     for (int k = 0; k < 4; ++k) {
-      int32_t& v = map[size_t(c.tets[4 * t + k])];
+      int32_t& v = map[size_t(m.tets[4 * t + k])];
       if (v < 0) {
-        v = int32_t(m.num_vertices());
-        for (int d = 0; d < 3; ++d) m.points.push_back(c.points[3 * size_t(c.tets[4 * t + k]) + d]);
+        v = int32_t(out.num_vertices());
+        for (int d = 0; d < 3; ++d) out.points.push_back(m.points[3 * size_t(m.tets[4 * t + k]) + d]);
       }
-      m.tets.push_back(v);
+      out.tets.push_back(v);
     }
   }
-  return m;
+  return out;
+}
+
+Mesh slab(int n) {
+  const Mesh c = cube_tets(n);
+  return sub_mesh(c, [&](int64_t t) {
+    bool low = true;
+    for (int k = 0; k < 4; ++k) low = low && c.points[3 * size_t(c.tets[4 * t + k]) + 2] <= 1.0 / n + 1e-12;
+    return low;
+  });
 }
 
 Mesh cone_boundary(const Mesh& m, double x, double y, double z) {
