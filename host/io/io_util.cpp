@@ -165,9 +165,11 @@ AtomicFile::AtomicFile(const std::string& path, bool binary) : path_(path) {
   std::filesystem::path p(path);
   std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
   std::random_device rd;
-  tmp_ = (dir / ("." + p.filename().string() + ".tmp" + std::to_string(::getpid()) + "_" +
-                 std::to_string(rd() % 1000000)))
-             .string();
+  // appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) on "." + std::string&&
+  std::string name = ".";
+  name += p.filename().string();
+  name += ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(rd() % 1000000);
+  tmp_ = (dir / name).string();
   out_.open(tmp_, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
   if (!out_) throw OutputError(path + ": cannot create a temporary file in '" + dir.string() + "': " + std::strerror(errno));
   out_.exceptions(std::ios::goodbit);
