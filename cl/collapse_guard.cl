@@ -225,7 +225,8 @@ inline int tcc_sg_cell(double v, double org, double ih, int n) {
 /* Is (i, j, k) the cell holding the low corner of the overlap of boxes A and B (so each pair
  * is tested once)? Also tests the overlap. The cell of the overlap's low corner is, per axis,
  * the larger of the two boxes' low cells (the cell of a coordinate does not decrease with it):
- * A's are (i0, j0, k0), B's qcell (the host's, the same arithmetic), so most pairs met in
+ * A's are (i0, j0, k0), B's the first three of qcell (the host's cells of B's low and high
+ * corners, the same arithmetic), so most pairs met in
  * another of their common cells are passed over before B's box is read. */
 inline int tcc_sg_owner_cell(double3 alo, double3 ahi, int i0, int j0, int k0, __global const double* b,
                              __global const int* qcell, int i, int j, int k) {
@@ -279,7 +280,7 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
     int has_plane = 0; /* the face's plane, computed at its first triangle test */
     tc_sg_plane fplane;
     TCC_SG_FOR_CELL_QUERIES(lo, hi, qi, {
-      if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, qbox + 6 * qi, qcell + 3 * qi, ci, cj, ck)) continue;
+      if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, qbox + 6 * qi, qcell + 6 * qi, ci, cj, ck)) continue;
       /* the face is one the collapse moves or removes: it has x, or y when y moves (-1 else) */
       const int rx = qrep[2 * qi], ry = qrep[2 * qi + 1];
       if (fid[0] == rx || fid[1] == rx || fid[2] == rx || fid[0] == ry || fid[1] == ry || fid[2] == ry) continue;
@@ -330,7 +331,7 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
     }
   }
   TCC_SG_FOR_CELL_QUERIES(lo, hi, qb, {
-    if (qb == qa || !tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, qbox + 6 * qb, qcell + 3 * qb, ci, cj, ck)) continue;
+    if (qb == qa || !tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, qbox + 6 * qb, qcell + 6 * qb, ci, cj, ck)) continue;
     for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
       double3 alo, ahi;
       tcc_sg_load_box(tbox, na, &alo, &ahi);

@@ -119,26 +119,22 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   int g[3];
   for (int a = 0; a < 3; ++a) g[a] = std::min(kMaxCellsPerAxis + 1, int(std::floor((hi[a] - lo[a]) / h)) + 1);
   const size_t ncells = size_t(g[0]) * g[1] * g[2];
+  // each query's cells: low (the first 3, also tcc_sg_owner_cell's) and high corner, per axis
+  std::vector<int32_t> range(size_t(nq) * 6);
+  for (uint32_t q = 0; q < nq; ++q)
+    for (int a = 0; a < 6; ++a) range[6 * size_t(q) + a] = cell_of(box[6 * q + a], lo[a % 3], ih, g[a % 3]);
   // counting sort of the (cell, query) pairs by cell
   std::vector<uint32_t> off(ncells + 1, 0);
   auto for_cells = [&](uint32_t q, auto&& fn) {
-    int r0[3], r1[3];
-    for (int a = 0; a < 3; ++a) {
-      r0[a] = cell_of(box[6 * q + a], lo[a], ih, g[a]);
-      r1[a] = cell_of(box[6 * q + 3 + a], lo[a], ih, g[a]);
-    }
-    for (int k = r0[2]; k <= r1[2]; ++k)
-      for (int j = r0[1]; j <= r1[1]; ++j)
-        for (int i = r0[0]; i <= r1[0]; ++i) fn((size_t(k) * g[1] + j) * g[0] + i);
+    const int32_t* r = &range[6 * size_t(q)];
+    for (int k = r[2]; k <= r[5]; ++k)
+      for (int j = r[1]; j <= r[4]; ++j)
+        for (int i = r[0]; i <= r[3]; ++i) fn((size_t(k) * g[1] + j) * g[0] + i);
   };
   for (uint32_t q = 0; q < nq; ++q) for_cells(q, [&](size_t cell) { ++off[cell + 1]; });
   for (size_t i = 0; i < ncells; ++i) off[i + 1] += off[i];
   std::vector<uint32_t> items(std::max<uint32_t>(off[ncells], 1)), cursor(off.begin(), off.end() - 1);
   for (uint32_t q = 0; q < nq; ++q) for_cells(q, [&](size_t cell) { items[cursor[cell]++] = q; });
-  // each query's low cell (tcc_sg_owner_cell)
-  std::vector<int32_t> low(size_t(nq) * 3);
-  for (uint32_t q = 0; q < nq; ++q)
-    for (int a = 0; a < 3; ++a) low[3 * size_t(q) + a] = cell_of(box[6 * q + a], lo[a], ih, g[a]);
   if (kProfile)
     std::fprintf(stderr, "  surface guard grid: h %g, %d x %d x %d cells, %u entries for %u queries\n", h, g[0], g[1],
                  g[2], off[ncells], nq);
@@ -146,8 +142,8 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   cell_off.upload(off);
   ensure_nonempty(cell_items, ctx, items.size());
   cell_items.upload(items);
-  ensure_nonempty(qcell, ctx, low.size());
-  qcell.upload(low);
+  ensure_nonempty(qcell, ctx, range.size());
+  qcell.upload(range);
 
   ensure_nonempty(qbad, ctx, nq);
   qbad.fill(0u);

@@ -16,7 +16,7 @@ struct SurfaceGuard {
   DeviceBuffer<int32_t> qrep;                // per query: x, and y when it moves (else -1)
   DeviceBuffer<double> qbox, tpos, tbox, tplane;  // per query: box; per new triangle: positions, box, plane
   DeviceBuffer<uint32_t> qntri, qoff, qcount, qbad, cell_off, cell_items;
-  DeviceBuffer<int32_t> qcell;               // per query: its box's low cell (3 ints)
+  DeviceBuffer<int32_t> qcell;               // per query: the cells of its box's low and high corners (6 ints)
   uint32_t last_queries = 0;  // collapses tested by the last run (that change S)
   DeviceBuffer<uint32_t> stets;  // the tets owning an S face (n_stets), listed for the connectivity
   uint64_t stets_generation = 0;  // of this Connectivity::generation
