@@ -152,22 +152,21 @@ void TextCursor::set_pos(size_t p) {
 
 // ---------------------------------------------------------------- AtomicFile
 
-void require_output_folder(const std::string& path) {
+std::filesystem::path require_output_folder(const std::string& path) {
   const std::filesystem::path p(path);
-  const std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+  std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec))
     throw OutputError(path + ": folder '" + dir.string() + "' does not exist");
+  return dir;
 }
 
 AtomicFile::AtomicFile(const std::string& path, bool binary) : path_(path) {
-  require_output_folder(path);
-  std::filesystem::path p(path);
-  std::filesystem::path dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+  const std::filesystem::path dir = require_output_folder(path);
   std::random_device rd;
   // appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) on "." + std::string&&
   std::string name = ".";
-  name += p.filename().string();
+  name += std::filesystem::path(path).filename().string();
   name += ".tmp" + std::to_string(::getpid()) + "_" + std::to_string(rd() % 1000000);
   tmp_ = (dir / name).string();
   out_.open(tmp_, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);

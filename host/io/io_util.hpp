@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <string>
 #include <string_view>
@@ -122,9 +123,9 @@ class BinaryCursor {
 // unknown one: OutputError).
 Format output_format(const std::string& path, Format f);
 
-// Throws OutputError unless the folder `path` is to be written in exists (AtomicFile's first
-// check, also made before a long run by the CLI).
-void require_output_folder(const std::string& path);
+// The folder `path` is to be written in; throws OutputError unless it exists (AtomicFile's
+// first check, also made before a long run by the CLI).
+std::filesystem::path require_output_folder(const std::string& path);
 
 // A file written under a temporary name in the target's folder and renamed onto the
 // target by commit(). Destroyed without commit(), the temporary is removed, so a failed
