@@ -317,6 +317,7 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
     int ida[3];
     double3 posa[3];
     tcc_sg_load_tri(tid, tpos, na, ida, posa);
+    const tc_sg_plane pla = tcc_sg_load_plane(tplane, na);
     double3 alo, ahi;
     tcc_sg_load_box(tbox, na, &alo, &ahi);
     for (uint nb = na + 1; nb < qoff[qa + 1]; ++nb) {
@@ -324,8 +325,7 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
       int idb[3];
       double3 posb[3];
       tcc_sg_load_tri(tid, tpos, nb, idb, posb);
-      if (!tc_sg_tri_tri_planes(ida, posa, tcc_sg_load_plane(tplane, na), idb, posb, tcc_sg_load_plane(tplane, nb)))
-        continue;
+      if (!tc_sg_tri_tri_planes(ida, posa, pla, idb, posb, tcc_sg_load_plane(tplane, nb))) continue;
       qbad[qa] = 0x80000000u | qa;
       return;
     }
@@ -337,18 +337,19 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
       tcc_sg_load_box(tbox, na, &alo, &ahi);
       int ida[3];
       double3 posa[3];
+      tc_sg_plane pla;
       int loaded = 0;
       for (uint nb = qoff[qb]; nb < qoff[qb + 1]; ++nb) {
         if (tcc_sg_tri_box_apart(alo, ahi, tbox, nb)) continue;
         if (!loaded) {
           tcc_sg_load_tri(tid, tpos, na, ida, posa);
+          pla = tcc_sg_load_plane(tplane, na);
           loaded = 1;
         }
         int idb[3];
         double3 posb[3];
         tcc_sg_load_tri(tid, tpos, nb, idb, posb);
-        if (!tc_sg_tri_tri_planes(ida, posa, tcc_sg_load_plane(tplane, na), idb, posb, tcc_sg_load_plane(tplane, nb)))
-          continue;
+        if (!tc_sg_tri_tri_planes(ida, posa, pla, idb, posb, tcc_sg_load_plane(tplane, nb))) continue;
         qbad[qa] = 0x80000000u | qb; /* names the other query for debugging */
         return;
       }

@@ -67,35 +67,10 @@ TC_FN int tc_sg_in_tri2(tc_sg_d2 p, tc_sg_d2 a, tc_sg_d2 b, tc_sg_d2 c, double t
   return 1;
 }
 
-/* Does the closed segment (p, q) meet the closed triangle (a, b, c), up to 1e-9 times their
- * size? A segment within that distance of the triangle's plane is tested in the plane (in 2D,
- * the dominant axis of the normal dropped); otherwise the point where it crosses the plane.
- * n = cross(b - a, c - a), ln its length, e2 the triangle's longest squared edge (tc_sg_plane). */
-TC_FN int tc_sg_seg_tri_n(tc_d3 p, tc_d3 q, tc_d3 a, tc_d3 b, tc_d3 c, tc_d3 n, double ln, double e2) {
-  tc_d3 pq = q - p;
-  if (!(ln > 0.0)) return 1; /* a degenerate triangle: cannot tell */
-  double s2 = dot(pq, pq);
-  s2 = e2 > s2 ? e2 : s2;
-  double tol = 1e-9 * sqrt(s2);
-  double dp = dot(n, p - a) / ln, dq = dot(n, q - a) / ln; /* signed distances to the plane */
-  if ((dp > tol && dq > tol) || (dp < -tol && dq < -tol)) return 0;
-  double nx = fabs(n.x), ny = fabs(n.y), nz = fabs(n.z);
-  int drop = nx >= ny && nx >= nz ? 0 : ny >= nz ? 1 : 2;
-  tc_sg_d2 a2 = tc_sg_proj(a, drop), b2 = tc_sg_proj(b, drop), c2 = tc_sg_proj(c, drop);
-  if (fabs(dp) <= tol && fabs(dq) <= tol) { /* in the plane */
-    tc_sg_d2 p2 = tc_sg_proj(p, drop), q2 = tc_sg_proj(q, drop);
-    return tc_sg_in_tri2(p2, a2, b2, c2, tol) || tc_sg_in_tri2(q2, a2, b2, c2, tol) ||
-           tc_sg_seg_seg2(p2, q2, a2, b2, tol) || tc_sg_seg_seg2(p2, q2, b2, c2, tol) ||
-           tc_sg_seg_seg2(p2, q2, c2, a2, tol);
-  }
-  double t = dp / (dp - dq); /* dp != dq: they are not both within tol, nor on one side */
-  t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
-  return tc_sg_in_tri2(tc_sg_proj(p + pq * t, drop), a2, b2, c2, tol);
-}
-
-/* What tc_sg_one_side needs of a triangle p: its normal cross(p1 - p0, p2 - p0), the normal's
- * length and the longest squared edge. Computed once per triangle by the kernels that test one
- * triangle against many (the same arithmetic as computing it per pair: the same decisions). */
+/* What tc_sg_one_side and tc_sg_seg_tri need of a triangle p: its normal cross(p1 - p0,
+ * p2 - p0), the normal's length and the longest squared edge. Computed once per triangle by
+ * the kernels that test one triangle against many (the same arithmetic as computing it per
+ * pair: the same decisions). */
 typedef struct {
   tc_d3 n;
   double ln, e2;
@@ -112,6 +87,32 @@ TC_FN tc_sg_plane tc_sg_plane_of(const tc_d3* p) {
     r.e2 = r.e2 > l ? r.e2 : l;
   }
   return r;
+}
+
+/* Does the closed segment (p, q) meet the closed triangle (a, b, c), up to 1e-9 times their
+ * size? A segment within that distance of the triangle's plane is tested in the plane (in 2D,
+ * the dominant axis of the normal dropped); otherwise the point where it crosses the plane.
+ * pl is the triangle's plane (tc_sg_plane_of). */
+TC_FN int tc_sg_seg_tri(tc_d3 p, tc_d3 q, tc_d3 a, tc_d3 b, tc_d3 c, tc_sg_plane pl) {
+  tc_d3 pq = q - p, n = pl.n;
+  if (!(pl.ln > 0.0)) return 1; /* a degenerate triangle: cannot tell */
+  double s2 = dot(pq, pq);
+  s2 = pl.e2 > s2 ? pl.e2 : s2;
+  double tol = 1e-9 * sqrt(s2);
+  double dp = dot(n, p - a) / pl.ln, dq = dot(n, q - a) / pl.ln; /* signed distances to the plane */
+  if ((dp > tol && dq > tol) || (dp < -tol && dq < -tol)) return 0;
+  double nx = fabs(n.x), ny = fabs(n.y), nz = fabs(n.z);
+  int drop = nx >= ny && nx >= nz ? 0 : ny >= nz ? 1 : 2;
+  tc_sg_d2 a2 = tc_sg_proj(a, drop), b2 = tc_sg_proj(b, drop), c2 = tc_sg_proj(c, drop);
+  if (fabs(dp) <= tol && fabs(dq) <= tol) { /* in the plane */
+    tc_sg_d2 p2 = tc_sg_proj(p, drop), q2 = tc_sg_proj(q, drop);
+    return tc_sg_in_tri2(p2, a2, b2, c2, tol) || tc_sg_in_tri2(q2, a2, b2, c2, tol) ||
+           tc_sg_seg_seg2(p2, q2, a2, b2, tol) || tc_sg_seg_seg2(p2, q2, b2, c2, tol) ||
+           tc_sg_seg_seg2(p2, q2, c2, a2, tol);
+  }
+  double t = dp / (dp - dq); /* dp != dq: they are not both within tol, nor on one side */
+  t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+  return tc_sg_in_tri2(tc_sg_proj(p + pq * t, drop), a2, b2, c2, tol);
 }
 
 /* Are the vertices of B not shared with A all farther than 1e-9 times the two triangles' size
@@ -150,11 +151,11 @@ TC_FN int tc_sg_tri_tri_planes(const int* ia, const tc_d3* pa, tc_sg_plane qa, c
   /* cheap and most frequent: one triangle on one side of the other's plane */
   if (tc_sg_one_side(ia, pa, qa, ib, pb, qb) || tc_sg_one_side(ib, pb, qb, ia, pa, qa)) return 0;
   if (shared == 1)
-    return tc_sg_seg_tri_n(pa[(sa + 1) % 3], pa[(sa + 2) % 3], pb[0], pb[1], pb[2], qb.n, qb.ln, qb.e2) ||
-           tc_sg_seg_tri_n(pb[(sb + 1) % 3], pb[(sb + 2) % 3], pa[0], pa[1], pa[2], qa.n, qa.ln, qa.e2);
+    return tc_sg_seg_tri(pa[(sa + 1) % 3], pa[(sa + 2) % 3], pb[0], pb[1], pb[2], qb) ||
+           tc_sg_seg_tri(pb[(sb + 1) % 3], pb[(sb + 2) % 3], pa[0], pa[1], pa[2], qa);
   for (int i = 0; i < 3; ++i) {
-    if (tc_sg_seg_tri_n(pa[i], pa[(i + 1) % 3], pb[0], pb[1], pb[2], qb.n, qb.ln, qb.e2)) return 1;
-    if (tc_sg_seg_tri_n(pb[i], pb[(i + 1) % 3], pa[0], pa[1], pa[2], qa.n, qa.ln, qa.e2)) return 1;
+    if (tc_sg_seg_tri(pa[i], pa[(i + 1) % 3], pb[0], pb[1], pb[2], qb)) return 1;
+    if (tc_sg_seg_tri(pb[i], pb[(i + 1) % 3], pa[0], pa[1], pa[2], qa)) return 1;
   }
   return 0;
 }
