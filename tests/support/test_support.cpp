@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <map>
 #include <random>
 #include <sstream>
 #include <sys/wait.h>
@@ -118,24 +117,9 @@ Mesh slab(int n) {
 }
 
 Mesh cone_boundary(const Mesh& m, double x, double y, double z) {
-  struct Seen {
-    int count = 0;
-    std::array<int32_t, 3> face;  // as its tet has it
-    int64_t tet = 0;
-  };
-  std::map<std::array<int32_t, 3>, Seen> faces;  // by sorted vertices
-  for (int64_t t = 0; t < m.num_tets(); ++t)
-    for (int f = 0; f < 4; ++f) {
-      std::array<int32_t, 3> q;
-      for (int i = 0, n = 0; i < 4; ++i)
-        if (i != f) q[n++] = m.tets[4 * t + i];
-      std::array<int32_t, 3> k = q;
-      std::sort(k.begin(), k.end());
-      Seen& e = faces[k];
-      ++e.count;
-      e.face = q;
-      e.tet = t;
-    }
+  TopologyOptions no_labels;
+  no_labels.use_labels = false;  // the boundary faces only, not material interfaces
+  const Topology topo = build_topology(m, no_labels);
   Mesh out;  // points, tets and labels (a cone tet has the label of the tet it closes)
   out.points = m.points;
   out.tets = m.tets;
@@ -143,12 +127,11 @@ Mesh cone_boundary(const Mesh& m, double x, double y, double z) {
   const int32_t apex = int32_t(m.num_vertices());
   out.points.insert(out.points.end(), {x, y, z});
   auto p = [&](int32_t v) { return geo::tc_point(out.points.data(), v); };
-  for (const auto& [key, e] : faces) {
-    if (e.count != 1) continue;
-    std::array<int32_t, 4> t{e.face[0], e.face[1], e.face[2], apex};
+  for (int32_t f = 0; f < topo.num_sfaces(); ++f) {
+    std::array<int32_t, 4> t{topo.sfaces[3 * f], topo.sfaces[3 * f + 1], topo.sfaces[3 * f + 2], apex};
     if (geo::tc_orient3d(p(t[0]), p(t[1]), p(t[2]), p(t[3])) < 0) std::swap(t[0], t[1]);
     out.tets.insert(out.tets.end(), t.begin(), t.end());
-    for (Labels& l : out.tet_labels) l.values.push_back(l.values[size_t(e.tet)]);
+    for (Labels& l : out.tet_labels) l.values.push_back(l.values[size_t(topo.sface_tet[f])]);
   }
   return out;
 }
