@@ -221,24 +221,28 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     s.marked = cost_and_mark(ctx, dm, conn, st, p);
     double t2 = now();
     s.seconds_cost = t2 - t1;
-    double t4 = 0;
-    for (;;) {  // selection; again when the surface guard refuses some of it
+    // Selection; again when the surface guard refuses some of it. marked and passed_q are
+    // counted before the first selection, tested and the seconds add up over the selections
+    // (a selection tests only edges no earlier one tested), the other counts are the last's.
+    double t_sel = t2;
+    for (bool first = true;; first = false) {
       if (options.conflicts == CollapseOptions::AtomicMin) {
         // every marked edge tested, then one conflict stage
         s.admissible = admissible(ctx, dm, conn, st, p);
         s.tested = s.marked;
-        t4 = now();
-        s.seconds_admissible = t4 - t2;
+        const double t4 = now();
+        s.seconds_admissible += t4 - t_sel;
+        t_sel = t4;
         s.after_pass2 = s.after_pass1 = conflicts_atomic_min(ctx, dm, conn, st);
       } else {
         uint32_t passed_q = 0, tested = 0;
         s.after_pass1 = lazy_admissible_pass1(ctx, dm, conn, st, p, passed_q, tested);
         s.admissible = s.after_pass1;
-        s.passed_q = passed_q;
-        s.tested = tested;
-        t4 = now();
-        s.seconds_admissible = t4 - t2;
-        s.seconds_pass1 = 0;
+        if (first) s.passed_q = passed_q;
+        s.tested += tested;
+        const double t4 = now();
+        s.seconds_admissible += t4 - t_sel;
+        t_sel = t4;
         s.after_pass2 = conflict_pass2(ctx, dm, conn, st);
       }
       for (int r = 1; r < options.selection_rounds && s.after_pass2 > 0; ++r) {
@@ -248,12 +252,14 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
       }
       // Surface guard (guard_surface.hpp): the refused edges are unmarked; this iteration's
       // verdicts still hold for the next selection.
-      if (guard.run(ctx, dm, conn, st, p, uint32_t(s.after_pass2)) == 0) break;
+      const uint32_t refused = guard.run(ctx, dm, conn, st, p, uint32_t(s.after_pass2));
+      const double t5 = now();
+      s.seconds_pass2 += t5 - t_sel;
+      t_sel = t5;
+      if (refused == 0) break;
       st.verdict_ready = true;
     }
     s.collapsed = s.after_pass2;
-    double t5 = now();
-    s.seconds_pass2 = t5 - t4;
     if (s.collapsed > 0) {
       if (options.reuse_across_iterations) remember_for_carry(ctx, dm, conn, st);
       collapse_and_compact(ctx, dm, next, conn, st, origin, n_origin);
@@ -261,7 +267,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     }
     ctx.finish();
     double t6 = now();
-    s.seconds_collapse = t6 - t5;
+    s.seconds_collapse = t6 - t_sel;
     s.seconds_total = t6 - t0;
     s.vertices_after = dm.nv;
     s.tets_after = dm.nt;

@@ -52,14 +52,19 @@ struct IterationStats {
   // marked edge, but the link condition and the volume test only on the edges whose cheaper
   // rivals are all decided, which gives the same pass-1 result as testing every edge.
   int64_t passed_q = 0;           // marked edges passing the predicate Q
-  int64_t tested = 0;             // of those, link condition and volume test evaluated
+  // Of those, link condition and volume test evaluated. When the surface guard refuses a
+  // collapse, the edges are selected again, testing only edges not tested before: marked and
+  // passed_q are counted before the first selection, tested adds up over the selections, and
+  // admissible, after_pass1 and after_pass2 are the last selection's.
+  int64_t tested = 0;
   int64_t admissible = 0;         // tested and passed (= after_pass1 with the lazy filter)
   int64_t after_pass1 = 0;        // survived conflict pass 1 (edges)
   int64_t after_pass2 = 0;        // survived conflict pass 2 (tets) = collapsed
   int64_t collapsed = 0;
   int64_t tets_after = 0, vertices_after = 0;
-  // Seconds per stage (wall time, the queue finished after each stage). seconds_admissible
-  // holds the lazy filter together with conflict pass 1; seconds_pass1 is then 0.
+  // Seconds per stage (wall time, the queue finished after each stage), summed over the
+  // iteration's selections. seconds_admissible holds the lazy filter together with conflict
+  // pass 1; seconds_pass1 is then 0. seconds_pass2 holds conflict pass 2 and the surface guard.
   double seconds_connectivity = 0, seconds_cost = 0, seconds_admissible = 0, seconds_pass1 = 0,
          seconds_pass2 = 0, seconds_collapse = 0, seconds_total = 0;
   // An iteration of the host tail (CollapseOptions::host_tail): the sequential method's, greedy;

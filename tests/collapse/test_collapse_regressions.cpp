@@ -151,7 +151,15 @@ TEST(CollapseRegressions, FlatteningDoesNotPushTheSurfaceIntoAnotherBody) {
     opt.min_quality = q;
     tc::Mesh out = in;
     tc::Context ctx;
-    tc::collapse(out, opt, ctx);
+    const tc::CollapseReport report = tc::collapse(out, opt, ctx);
+    // The guard refused in iteration 0, which selected again: its stats count the tests of both
+    // selections (the refused edge was tested in the first, and an edge of the last selection
+    // was tested in one of them), and passed_q is the first's.
+    ASSERT_FALSE(report.iterations.empty());
+    const tc::IterationStats& s0 = report.iterations[0];
+    EXPECT_EQ(s0.collapsed, 0);
+    EXPECT_GE(s0.tested, s0.admissible + 1);
+    EXPECT_LE(s0.tested, s0.passed_q);
     tc::CheckReport r = check(out, in);
     EXPECT_FALSE(has_finding(r, "boundary_self_intersection"));
     EXPECT_TRUE(r.valid) << (r.errors.empty() ? "" : r.errors[0]);
