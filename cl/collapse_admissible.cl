@@ -60,11 +60,11 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
                                  __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
                                  __global const uint* nb_off,
                                  __global const int* nb, __global const int* nb_edge, __global const int* labels,
-                                 int use_labels, __global const double* pts, __global const uchar* vflags,
-                                 __global const uchar* eflags, double eps_v,
-                                 double q_min, __global const double* tet_quality) {
+                                 int use_labels, __global const double* pts, __global const double* vfield,
+                                 uint vfield_stride, __global const uchar* vflags, __global const uchar* eflags,
+                                 double eps_v, double q_min, __global const double* tet_quality) {
   /* --- volumes after the tentative collapse (first: cheaper, and it refuses more edges) --- */
-  double3 p = tcc_placement(pts, a, b, (uint)dir);
+  double3 p = tcc_placement(pts, vfield, vfield_stride, a, b, (uint)dir);
   double3 pa = tc_point(pts, a), pb = tc_point(pts, b);
   /* Quality guard (q_min > 0): the worst mean ratio among the tets that change shape may not
    * fall below min(its value before the collapse, q_min): a collapse never makes a good
@@ -256,10 +256,11 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
                          __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
                          __global const uint* nb_off,
                          __global const int* nb, __global const int* nb_edge, __global const int* labels,
-                         int use_labels, __global const double* pts, __global const uchar* vflags,
-                         __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
-                         double eps_v, double q_min, __global const double* tet_quality, __global uint* adm,
-                         __global uchar* edge_dir, __global uchar* reason, __global uint* counters) {
+                         int use_labels, __global const double* pts, __global const double* vfield,
+                         uint vfield_stride, __global const uchar* vflags, __global const uchar* vclass,
+                         __global const uchar* eflags, int mode, int paper_rule, double eps_v, double q_min,
+                         __global const double* tet_quality, __global uint* adm, __global uchar* edge_dir,
+                         __global uchar* reason, __global uint* counters) {
   uint e = get_global_id(0);
   if (e >= ne) return;
   adm[e] = 0u;
@@ -270,13 +271,13 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
   }
   int a = edges[2 * e], b = edges[2 * e + 1];
   uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
-  int dir = tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule);
-  if (dir < 0) {
+  int dir = tcc_user_dir(tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule), fa, fb, mode);
+  if (dir < 0 || !tcc_user_allows(pts, vfield, vfield_stride, a, b)) {
     reason[e] = TCC_REFUSED_Q;
     return;
   }
   uchar r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts,
-                                vflags, eflags, eps_v, q_min, tet_quality);
+                                vfield, vfield_stride, vflags, eflags, eps_v, q_min, tet_quality);
   reason[e] = r;
   if (r != TCC_OK) return;
   adm[e] = 1u;
@@ -305,7 +306,8 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
 /* lazy_init for edge e; returns whether it passes Q (counted in counters[5]). */
 inline uint tcc_lazy_init_edge(uint e, __global const int* edges, __global const uint* marked,
                                __global const uchar* vflags, __global const uchar* vclass, __global const uchar* eflags,
-                               int mode, int paper_rule, __global uchar* state, __global uchar* edge_dir,
+                               int mode, int paper_rule, __global const double* pts, __global const double* vfield,
+                               uint vfield_stride, __global uchar* state, __global uchar* edge_dir,
                                __global uchar* reason, __global uint* cand, int restrict_clean,
                                __global const uchar* vdirty, __global const uchar* verdict, __global const double* cost,
                                volatile __global int* slot) {
@@ -319,7 +321,8 @@ inline uint tcc_lazy_init_edge(uint e, __global const int* edges, __global const
   int a = edges[2 * e], b = edges[2 * e + 1];
   /* a later selection round: only edges away from the collapses chosen so far */
   if (restrict_clean && (vdirty[a] || vdirty[b])) return 0u;
-  if (tcc_predicate_q(a, b, vflags[a], vflags[b], eflags[e], vclass[a], vclass[b], mode, paper_rule) < 0) {
+  if (tcc_predicate_q(a, b, vflags[a], vflags[b], eflags[e], vclass[a], vclass[b], mode, paper_rule) < 0 ||
+      !tcc_user_allows(pts, vfield, vfield_stride, a, b)) {
     reason[e] = TCC_REFUSED_Q;
     return 0u;
   }
@@ -339,13 +342,15 @@ inline uint tcc_lazy_init_edge(uint e, __global const int* edges, __global const
 
 __kernel void lazy_init(uint ne, __global const int* edges, __global const uint* marked, __global const uchar* vflags,
                         __global const uchar* vclass, __global const uchar* eflags, int mode, int paper_rule,
+                        __global const double* pts, __global const double* vfield, uint vfield_stride,
                         __global uchar* state, __global uchar* edge_dir, __global uchar* reason, __global uint* cand,
                         __global uint* counters, int restrict_clean, __global const uchar* vdirty,
                         __global const uchar* verdict, __global const double* cost, volatile __global int* slot) {
   __local uint group_passed_q;
   uint e = get_global_id(0);
-  uint q = e < ne ? tcc_lazy_init_edge(e, edges, marked, vflags, vclass, eflags, mode, paper_rule, state, edge_dir,
-                                       reason, cand, restrict_clean, vdirty, verdict, cost, slot)
+  uint q = e < ne ? tcc_lazy_init_edge(e, edges, marked, vflags, vclass, eflags, mode, paper_rule, pts, vfield,
+                                       vfield_stride, state, edge_dir, reason, cand, restrict_clean, vdirty, verdict,
+                                       cost, slot)
                   : 0u;
   tcc_group_count(q, &group_passed_q, &counters[5]);
 }
@@ -355,13 +360,14 @@ __kernel void lazy_init(uint ne, __global const int* edges, __global const uint*
 #define TCC_TEST_PARAMS                                                                                     \
   __global const int *tets, __global const uint *vt_off, __global const int *vt, __global const int *tet_nbr, \
       __global const uint *nb_off, __global const int *nb, __global const int *nb_edge,                       \
-      __global const int *labels, int use_labels, __global const double *pts, __global const uchar *vflags,   \
-      __global const uchar *vclass, __global const uchar *eflags, int mode, int paper_rule, double eps_v,      \
+      __global const int *labels, int use_labels, __global const double *pts, __global const double *vfield,  \
+      uint vfield_stride, __global const uchar *vflags, __global const uchar *vclass,                         \
+      __global const uchar *eflags, int mode, int paper_rule, double eps_v,                                   \
       double q_min, __global const double *tet_quality, __global uchar *edge_dir, __global uchar *reason,     \
       __global uint *counters, __global uchar *verdict
 #define TCC_TEST_ARGS                                                                                       \
-  tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vflags, vclass, eflags, mode,     \
-      paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict
+  tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vfield, vfield_stride, vflags,     \
+      vclass, eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict
 
 /* The turn of edge e in the lazy filter: its link and volume tests (or the verdict carried
  * from an earlier iteration), then IN (vaff of both end points; returns 1) or OUT (0). */
@@ -369,12 +375,12 @@ inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* sta
                             TCC_TEST_PARAMS) {
   int a = edges[2 * e], b = edges[2 * e + 1];
   uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
-  int dir = tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule);
+  int dir = tcc_user_dir(tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule), fa, fb, mode);
   /* a verdict carried from an earlier iteration (the rings of a and b are unchanged since) */
   uchar r = verdict[e];
   if (r == TCC_VERDICT_UNKNOWN) {
     r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts,
-                            vflags, eflags, eps_v, q_min, tet_quality);
+                            vfield, vfield_stride, vflags, eflags, eps_v, q_min, tet_quality);
     verdict[e] = r;
     atomic_inc(&counters[4]);
   }

@@ -158,8 +158,67 @@ inline double3 tcc_face_normal(__global const double* pts, __global const int* t
   return tcc_normalize(tcc_cross(p1 - p0, p2 - p0));
 }
 
-inline double3 tcc_placement(__global const double* pts, int v0, int v1, uint dir) {
+/* --- The user's placement and predicate (tc::CollapseOptions::placement_cl_source and
+ * predicate_cl_source), compiled in with -DTCC_USER_PLACEMENT / -DTCC_USER_PREDICATE after
+ * this header (the host builds "this header, the user's source, the stage's file"):
+ *     double3 tc_user_placement(double3 p0, double3 p1, double f0, double f1);
+ *     int tc_user_predicate(double3 p0, double3 p1, double f0, double f1);
+ * p0, p1: the edge's end points (v0 < v1); f0, f1: the first component of the first vertex
+ * field at them (0 without vertex fields), as for the user cost (collapse_cost.cl). --- */
+#ifdef TCC_USER_PLACEMENT
+double3 tc_user_placement(double3 p0, double3 p1, double f0, double f1);
+#endif
+#ifdef TCC_USER_PREDICATE
+int tc_user_predicate(double3 p0, double3 p1, double f0, double f1);
+#endif
+
+/* The first component of the first vertex field at v (vf packs every component of every field,
+ * vstride per vertex; 0 without fields). */
+inline double tcc_field0(__global const double* vf, uint vstride, int v) {
+  return vstride > 0u ? vf[(size_t)v * vstride] : 0.0;
+}
+
+/* Q's direction bits (tcc_predicate_q, dir >= 0) with the user's placement where it applies:
+ * in place of the midpoint, when both end points are off S, or on every edge in free mode (so
+ * that the boundary modes keep their promises: S vertices move along S only by the built-in
+ * rules). */
+inline int tcc_user_dir(int dir, uint fa, uint fb, int mode) {
+#ifdef TCC_USER_PLACEMENT
+  if (dir >= 0 && (dir & (int)TCC_DIR_MIDPOINT) && (mode == TCC_FREE || (fa == 0u && fb == 0u)))
+    dir |= (int)TCC_DIR_USER;
+#else
+  (void)fa;
+  (void)fb;
+  (void)mode;
+#endif
+  return dir;
+}
+
+/* Does the user's predicate allow collapsing (v0, v1)? (Always without one.) */
+inline int tcc_user_allows(__global const double* pts, __global const double* vf, uint vstride, int v0, int v1) {
+#ifdef TCC_USER_PREDICATE
+  return tc_user_predicate(tc_point(pts, v0), tc_point(pts, v1), tcc_field0(vf, vstride, v0),
+                           tcc_field0(vf, vstride, v1)) != 0;
+#else
+  (void)pts;
+  (void)vf;
+  (void)vstride;
+  (void)v0;
+  (void)v1;
+  return 1;
+#endif
+}
+
+/* Where the survivor of the collapse of (v0, v1) with the direction bits dir goes. */
+inline double3 tcc_placement(__global const double* pts, __global const double* vf, uint vstride, int v0, int v1,
+                             uint dir) {
   double3 p0 = tc_point(pts, v0), p1 = tc_point(pts, v1);
+#ifdef TCC_USER_PLACEMENT
+  if (dir & TCC_DIR_USER) return tc_user_placement(p0, p1, tcc_field0(vf, vstride, v0), tcc_field0(vf, vstride, v1));
+#else
+  (void)vf;
+  (void)vstride;
+#endif
   if (dir & TCC_DIR_MIDPOINT) return (p0 + p1) * 0.5;
   return (dir & TCC_DIR_REMOVE_V1) ? p0 : p1;
 }

@@ -4,7 +4,7 @@
  *   (host)         exclusive scan of keep -> new index of every kept vertex
  *   vertex_map     vmap[v] = new index of v, or of the survivor for a removed vertex
  *   vertex_write   positions (survivor at the placement), vertex fields (averaged for midpoint
- *                  placement), vertex mask
+ *                  placement, interpolated for a user placement), vertex mask
  *   tet_keep       a tet holding both end points of a final edge disappears
  *   (host)         exclusive scan of the tet flags
  *   tet_write      tets remapped through vmap, labels and tet fields carried
@@ -45,16 +45,31 @@ __kernel void vertex_write(uint nv, __global const int* vaff, __global const int
   int e = vaff[v];
   double3 p = tc_point(pts, (int)v);
   int partner = -1;
+  /* the fields of v and of the removed vertex: averaged at the midpoint; at a user placement p,
+   * interpolated at p's parameter s along the edge (v0 + s (v1 - v0), clamped to [0, 1]) */
+  double s = 0.5;
   if (e >= 0) { /* v survives the collapse of e */
-    p = tcc_placement(pts, edges[2 * e], edges[2 * e + 1], edge_dir[e]);
-    if (edge_dir[e] & TCC_DIR_MIDPOINT) partner = tcc_removed_vertex(edges, edge_dir, e);
+    const uint d = edge_dir[e];
+    const int v0 = edges[2 * e], v1 = edges[2 * e + 1];
+    p = tcc_placement(pts, vfields, ncomp, v0, v1, d);
+    if (d & TCC_DIR_MIDPOINT) partner = tcc_removed_vertex(edges, edge_dir, e);
+    if (d & TCC_DIR_USER) {
+      const double3 p0 = tc_point(pts, v0), d01 = tc_point(pts, v1) - p0;
+      const double len2 = tcc_dot(d01, d01);
+      const double s01 = len2 > 0.0 ? tcc_dot(p - p0, d01) / len2 : 0.5;
+      const double s0 = s01 < 0.0 ? 0.0 : s01 > 1.0 ? 1.0 : s01; /* the parameter of v1 */
+      s = (int)v == v0 ? s0 : 1.0 - s0; /* of the partner, seen from v */
+    }
   }
   out_pts[3 * o] = p.x;
   out_pts[3 * o + 1] = p.y;
   out_pts[3 * o + 2] = p.z;
   for (uint c = 0; c < ncomp; ++c) {
     double x = vfields[(size_t)v * ncomp + c];
-    if (partner >= 0) x = 0.5 * (x + vfields[(size_t)partner * ncomp + c]);
+    if (partner >= 0) {
+      const double y = vfields[(size_t)partner * ncomp + c];
+      x = s == 0.5 ? 0.5 * (x + y) : x + s * (y - x);
+    }
     out_vfields[(size_t)o * ncomp + c] = x;
   }
   if (has_mask) out_vmask[o] = vmask[v];

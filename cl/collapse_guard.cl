@@ -38,12 +38,12 @@
 
 /* The collapse of edge e as chosen: x removed, y survives at *p; returns whether y moves. */
 inline int tcc_sg_collapse(int e, __global const int* edges, __global const uchar* dir, __global const double* pts,
-                           int* x, int* y, double3* p) {
+                           __global const double* vfield, uint vfield_stride, int* x, int* y, double3* p) {
   int v0 = edges[2 * e], v1 = edges[2 * e + 1];
   uint d = dir[e];
   *x = (d & TCC_DIR_REMOVE_V1) ? v1 : v0;
   *y = (d & TCC_DIR_REMOVE_V1) ? v0 : v1;
-  *p = tcc_placement(pts, v0, v1, d);
+  *p = tcc_placement(pts, vfield, vfield_stride, v0, v1, d);
   double3 py = tc_point(pts, *y);
   return !(py.x == p->x && py.y == p->y && py.z == p->z);
 }
@@ -100,7 +100,8 @@ inline int tcc_sg_new_tri(int t, int f, int side, int x, int y, int moves_y, dou
 /* Queries: the chosen collapses that change S, with the box and the number of their new S
  * triangles. */
 __kernel void sguard_queries(uint ne, __global const int* edges, __global const uint* fin, __global const uchar* dir,
-                             __global const double* pts, __global const int* tets, __global const uint* vt_off,
+                             __global const double* pts, __global const double* vfield, uint vfield_stride,
+                             __global const int* tets, __global const uint* vt_off,
                              __global const int* vt, __global const int* tet_nbr, __global const int* labels,
                              int use_labels, __global const uchar* vflags, __global int* qedge,
                              __global double* qbox, __global uint* qntri, __global uint* qcount) {
@@ -108,7 +109,7 @@ __kernel void sguard_queries(uint ne, __global const int* edges, __global const 
   if (e >= ne || !fin[e]) return;
   int x, y;
   double3 p;
-  int moves_y = tcc_sg_collapse((int)e, edges, dir, pts, &x, &y, &p);
+  int moves_y = tcc_sg_collapse((int)e, edges, dir, pts, vfield, vfield_stride, &x, &y, &p);
   if (!vflags[x] && !(moves_y && vflags[y])) return; /* S is not touched */
   double3 lo = (double3)(INFINITY, INFINITY, INFINITY), hi = -lo;
   int id[3];
@@ -162,15 +163,16 @@ inline tc_sg_plane tcc_sg_load_plane(__global const double* tplane, uint n) {
 /* The new S triangles of each query, at qoff[q] .. qoff[q + 1] (ids, positions, boxes and
  * planes). */
 __kernel void sguard_tris(uint nq, __global const int* qedge, __global const uint* qoff, __global const int* edges,
-                          __global const uchar* dir, __global const double* pts, __global const int* tets,
-                          __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
-                          __global const int* labels, int use_labels, __global int* tid, __global double* tpos,
+                          __global const uchar* dir, __global const double* pts, __global const double* vfield,
+                          uint vfield_stride, __global const int* tets, __global const uint* vt_off,
+                          __global const int* vt, __global const int* tet_nbr, __global const int* labels,
+                          int use_labels, __global int* tid, __global double* tpos,
                           __global double* tbox, __global double* tplane, __global int* qrep) {
   uint qi = get_global_id(0);
   if (qi >= nq) return;
   int x, y;
   double3 p;
-  int moves_y = tcc_sg_collapse(qedge[qi], edges, dir, pts, &x, &y, &p);
+  int moves_y = tcc_sg_collapse(qedge[qi], edges, dir, pts, vfield, vfield_stride, &x, &y, &p);
   qrep[2 * qi] = x;
   qrep[2 * qi + 1] = moves_y ? y : -1;
   uint n = qoff[qi];

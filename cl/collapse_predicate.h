@@ -28,6 +28,9 @@
  * bit 1 set: midpoint placement, else the survivor keeps its position. */
 #define TCC_DIR_REMOVE_V1 1u
 #define TCC_DIR_MIDPOINT 2u
+/* bit 2 set (with bit 1): the user's placement instead of the midpoint (tcc_user_dir in
+ * collapse_common.h; never set by tcc_predicate_q) */
+#define TCC_DIR_USER 4u
 
 #ifndef __OPENCL_C_VERSION__
 namespace tc::rules {

@@ -27,7 +27,7 @@ struct CollapseCli {
   CollapseOptions opt;
   double target_length = 0, target_factor = 0;
   std::string boundary = "features", method = "parallel", conflicts = "two-pass";
-  std::string region, sizing_field, labels, cost_cl, device, stats;
+  std::string region, sizing_field, labels, cost_cl, placement_cl, predicate_cl, device, stats;
   bool check = false, quiet = false, no_labels = false, no_spatial_order = false;
 };
 
@@ -154,6 +154,17 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, double sec
   return w.str();
 }
 
+// An OpenCL C file of the user (--cost-cl, --placement-cl, --predicate-cl), headed by a #line
+// directive so that the compiler's messages name the file and its lines.
+std::string cl_file(const std::string& path) {
+  std::string quoted;
+  for (char ch : path) {
+    if (ch == '"' || ch == '\\') quoted += '\\';
+    quoted += ch;
+  }
+  return "#line 1 \"" + quoted + "\"\n" + io::load_file(path);
+}
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -204,6 +215,13 @@ void register_collapse(CLI::App& app, int& exit_code) {
   app.add_option("--cost-cl", c->cost_cl,
                  "OpenCL C file defining double tc_user_cost(double3 p0, double3 p1, double f0, double f1);\n"
                  "edges with a cost below --target-length are collapsed (see README)");
+  app.add_option("--placement-cl", c->placement_cl,
+                 "OpenCL C file defining double3 tc_user_placement(double3 p0, double3 p1, double f0, double f1);\n"
+                 "where the survivor goes instead of the midpoint, on edges with both ends off the boundary\n"
+                 "and interfaces (every edge with --boundary free); vertex fields are interpolated there");
+  app.add_option("--predicate-cl", c->predicate_cl,
+                 "OpenCL C file defining int tc_user_predicate(double3 p0, double3 p1, double f0, double f1);\n"
+                 "0 refuses the collapse of the edge (besides the built-in checks)");
   app.add_option("--method", c->method,
                  "parallel (default): the OpenCL pipeline; sequential: the CPU priority-queue baseline\n"
                  "with the same checks (no OpenCL device needed)")
@@ -256,9 +274,16 @@ void register_collapse(CLI::App& app, int& exit_code) {
     opt.conflicts = c->conflicts == "atomic-min" ? CollapseOptions::AtomicMin : CollapseOptions::TwoPass;
     if (opt.method == CollapseOptions::Sequential && !c->device.empty())
       throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
-    if (opt.method == CollapseOptions::Sequential && (!c->cost_cl.empty() || !c->sizing_field.empty()))
-      throw CLI::ValidationError(!c->cost_cl.empty() ? "--cost-cl" : "--sizing-field",
-                                 "needs the parallel method (it is compiled as OpenCL C); not with --method sequential");
+    if (opt.method == CollapseOptions::Sequential)
+      for (const auto& [name, value] : {std::pair<const char*, const std::string*>{"--cost-cl", &c->cost_cl},
+                                        {"--sizing-field", &c->sizing_field},
+                                        {"--placement-cl", &c->placement_cl},
+                                        {"--predicate-cl", &c->predicate_cl}})
+        if (!value->empty())
+          throw CLI::ValidationError(name,
+                                     "needs the parallel method (it is compiled as OpenCL C); not with --method sequential");
+    if (!c->placement_cl.empty()) opt.placement_cl_source = cl_file(c->placement_cl);
+    if (!c->predicate_cl.empty()) opt.predicate_cl_source = cl_file(c->predicate_cl);
     if (c->target_length > 0) opt.target_length = c->target_length;
     if (c->target_factor > 0) opt.target_factor = c->target_factor;
     if (!c->region.empty()) combine(opt.vertex_mask, region_mask(mesh, c->region));
@@ -267,7 +292,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
     if (!c->cost_cl.empty()) {
       if (!c->sizing_field.empty())
         throw CLI::ValidationError("--cost-cl", "cannot be combined with --sizing-field");
-      opt.cost_cl_source = io::load_file(c->cost_cl);
+      opt.cost_cl_source = cl_file(c->cost_cl);
       if (opt.target_length <= 0) throw CLI::ValidationError("--cost-cl", "needs --target-length");
     } else if (!c->sizing_field.empty()) {
       // The user cost sees the first vertex field: move the sizing field there for the run.

@@ -109,7 +109,7 @@ double host_tail_fraction(const CollapseOptions& o, const DeviceInfo& device) {
 // host_tail_min_iterations more iterations (a tail that dies out fast, r ~0.6, is cheaper on
 // the device than the host's fixed cost). Counts only: the choice is deterministic.
 bool host_tail_due(const CollapseOptions& o, double fraction, const std::vector<IterationStats>& its) {
-  if (!(fraction > 0) || o.conflicts != CollapseOptions::TwoPass || o.eps_c > 1 || !o.cost_cl_source.empty() ||
+  if (!(fraction > 0) || o.conflicts != CollapseOptions::TwoPass || o.eps_c > 1 || o.has_user_functions() ||
       its.size() < 2)
     return false;
   const IterationStats& s = its.back();
@@ -262,7 +262,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     s.collapsed = s.after_pass2;
     if (s.collapsed > 0) {
       if (options.reuse_across_iterations) remember_for_carry(ctx, dm, conn, st);
-      collapse_and_compact(ctx, dm, next, conn, st, origin, n_origin);
+      collapse_and_compact(ctx, p, dm, next, conn, st, origin, n_origin);
       if (options.reuse_across_iterations) note_compaction(ctx, dm, conn, st);
     }
     ctx.finish();

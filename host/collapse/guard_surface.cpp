@@ -6,7 +6,6 @@
 #include "collapse/guard_surface.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cmath>
@@ -27,23 +26,17 @@ void ensure_nonempty(DeviceBuffer<T>& b, Context& ctx, size_t n) {
   ensure(b, ctx, std::max<size_t>(n, 1));
 }
 
-// TETCOLLAPSE_PROFILE=1 prints the wall time of every launch on stderr (as stages.cpp does).
+// TETCOLLAPSE_PROFILE=1 prints the grid and the refusals on stderr (and the launches' times).
 const bool kProfile = std::getenv("TETCOLLAPSE_PROFILE") != nullptr;
 
 template <class... A>
-void launch(Context& ctx, const char* name, size_t n, const A&... args) {
-  cl::Kernel k = ctx.kernel("collapse_guard.cl", name);
+void launch(Context& ctx, const StageParams& p, const char* name, size_t n, const A&... args) {
+  cl::Kernel k = stage_kernel(ctx, p, "collapse_guard.cl", name);  // the placement may be the user's
   detail::cl_call(name, [&] {
     cl_uint i = 0;
     (k.setArg(i++, args), ...);
   });
-  auto t0 = std::chrono::steady_clock::now();
-  ctx.launch(k, n, name);
-  if (kProfile) {
-    ctx.finish();
-    std::fprintf(stderr, "  %-28s n=%-9zu %8.4f s\n", name, n,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
+  launch_profiled(ctx, k, name, n);
 }
 
 // The cell of coordinate v on one axis (ih = 1 / the cell size); the same arithmetic as
@@ -70,8 +63,8 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   qcount.fill(0u);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   const cl::Buffer& labels = dm.labels[0].buffer();
-  launch(ctx, "sguard_queries", c.ne, cl_uint(c.ne), c.edges.buffer(), s.fin.buffer(), s.dir.buffer(),
-         dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
+  launch(ctx, p, "sguard_queries", c.ne, cl_uint(c.ne), c.edges.buffer(), s.fin.buffer(), s.dir.buffer(),
+         dm.points.buffer(), dm.vfields.buffer(), cl_uint(dm.vfield_comps), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
          c.vflags.buffer(), qedge.buffer(), qbox.buffer(), qntri.buffer(), qcount.buffer());
   uint32_t nq = 0;
   qcount.download(&nq, 1);
@@ -90,8 +83,8 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   ensure_nonempty(tbox, ctx, size_t(ntri) * 6);
   ensure_nonempty(tplane, ctx, size_t(ntri) * 5);
   ensure_nonempty(qrep, ctx, size_t(nq) * 2);
-  launch(ctx, "sguard_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(), s.dir.buffer(),
-         dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
+  launch(ctx, p, "sguard_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(), s.dir.buffer(),
+         dm.points.buffer(), dm.vfields.buffer(), cl_uint(dm.vfield_comps), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
          tid.buffer(), tpos.buffer(), tbox.buffer(), tplane.buffer(), qrep.buffer());
 
   // The grid: cells twice the median query box (most boxes span <= 2 cells per axis, the large
@@ -153,16 +146,16 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
     n_stets = dev::compact_indices(ctx, c.owns_s, stets, dm.nt);
     stets_generation = c.generation;
   }
-  launch(ctx, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), dm.points.buffer(), dm.tets.buffer(),
+  launch(ctx, p, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), dm.points.buffer(), dm.tets.buffer(),
          c.tet_nbr.buffer(), labels, use_labels, qrep.buffer(), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
          tbox.buffer(), tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
          cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer());
-  launch(ctx, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),
+  launch(ctx, p, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),
          tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
          cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer());
   qcount.fill(0u);
   const bool has_verdict = s.verdict.size() >= c.ne && s.verdict.buffer()();
-  launch(ctx, "sguard_drop", nq, cl_uint(nq), qedge.buffer(), qbad.buffer(), s.marked.buffer(),
+  launch(ctx, p, "sguard_drop", nq, cl_uint(nq), qedge.buffer(), qbad.buffer(), s.marked.buffer(),
          cl_int(has_verdict ? 1 : 0), has_verdict ? s.verdict.buffer() : qbad.buffer(), qcount.buffer());
   uint32_t refused = 0;
   qcount.download(&refused, 1);

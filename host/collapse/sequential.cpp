@@ -23,10 +23,11 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 // Options first (std::invalid_argument), as collapse() checks them before touching the mesh.
 SeqParams checked_params(const Mesh& mesh, const CollapseOptions& o) {
   if (o.max_iterations < 0) throw std::invalid_argument("max_iterations must be >= 0");
-  if (!o.cost_cl_source.empty())
+  if (o.has_user_functions())
     throw std::invalid_argument(
-        "the sequential method cannot evaluate a user cost (cost_cl_source, also behind --sizing-field): it is "
-        "OpenCL C, compiled for a device; use the parallel method");
+        "the sequential method cannot evaluate a user cost, placement or predicate (cost_cl_source, also behind "
+        "--sizing-field, placement_cl_source, predicate_cl_source): they are OpenCL C, compiled for a device; use "
+        "the parallel method");
   if (!(o.target_length > 0) && !(o.target_factor > 0))
     throw std::invalid_argument("target_factor must be > 0 when target_length is not given");
   if (!o.vertex_mask.empty() && o.vertex_mask.size() != size_t(mesh.num_vertices()))

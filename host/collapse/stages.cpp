@@ -41,13 +41,7 @@ void run(Context& ctx, const std::string& file, const char* name, size_t n, cons
          const auto&... args) {
   cl::Kernel k = ctx.kernel(file, name, options);
   set_args(k, name, args...);
-  auto t0 = std::chrono::steady_clock::now();
-  ctx.launch(k, n, name);
-  if (kProfile) {
-    ctx.finish();
-    std::fprintf(stderr, "  %-28s n=%-9zu %8.4f s\n", name, n,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
+  launch_profiled(ctx, k, name, n);
 }
 
 // Exclusive scan of counts[0..n) into off[0..n], off[n] = total.
@@ -60,7 +54,25 @@ uint32_t scan_offsets(Context& ctx, DeviceBuffer<uint32_t>& counts, DeviceBuffer
 
 const cl::Buffer& primary_labels(DeviceMesh& dm) { return dm.labels[0].buffer(); }
 
+// run() for the kernels that see the user's placement or predicate (stage_kernel).
+void run_stage(Context& ctx, const StageParams& p, const std::string& file, const char* name, size_t n,
+               const auto&... args) {
+  cl::Kernel k = stage_kernel(ctx, p, file, name);
+  set_args(k, name, args...);
+  launch_profiled(ctx, k, name, n);
+}
+
 }  // namespace
+
+void launch_profiled(Context& ctx, cl::Kernel& k, const char* name, size_t n) {
+  auto t0 = std::chrono::steady_clock::now();
+  ctx.launch(k, n, name);
+  if (kProfile) {
+    ctx.finish();
+    std::fprintf(stderr, "  %-28s n=%-9zu %8.4f s\n", name, n,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+}
 
 StageParams params_from(const CollapseOptions& o) {
   StageParams p;
@@ -73,7 +85,28 @@ StageParams params_from(const CollapseOptions& o) {
   p.min_quality = o.min_quality;
   p.mask_mode = o.vertex_mask.empty() ? 0 : o.mask_either ? 2 : 1;
   p.cost_source = o.cost_cl_source;
+  // (#line: the compiler's messages give the line in the user's source, under its option's name)
+  if (!o.placement_cl_source.empty()) {
+    p.user_source += "#line 1 \"placement_cl_source\"\n" + o.placement_cl_source + "\n";
+    p.user_defines += " -DTCC_USER_PLACEMENT";
+  }
+  if (!o.predicate_cl_source.empty()) {
+    p.user_source += "#line 1 \"predicate_cl_source\"\n" + o.predicate_cl_source + "\n";
+    p.user_defines += " -DTCC_USER_PREDICATE";
+  }
   return p;
+}
+
+cl::Kernel stage_kernel(Context& ctx, const StageParams& p, const std::string& file, const char* name) {
+  if (p.user_source.empty()) return ctx.kernel(file, name);
+  // the helpers (with the user functions' prototypes), the user's source, the stage's kernels;
+  // the Context caches programs by (name, options): the name carries a hash of the source
+  const std::string src = "#include \"collapse_common.h\"\n" + p.user_source + "\n#include \"" + file + "\"\n";
+  const std::string program =
+      file + " with user placement / predicate (" + std::to_string(std::hash<std::string>{}(src)) + ")";
+  cl::Program& prog = ctx.build(program, src, p.user_defines);
+  return detail::cl_call(("clCreateKernel(" + std::string(name) + ")").c_str(),
+                         [&] { return cl::Kernel(prog, name); });
 }
 
 void check_collapse_input(const Mesh& mesh) {
@@ -334,7 +367,8 @@ uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
     k = ctx.kernel("collapse_cost.cl", "cost_and_mark");
   } else {
     // the user's function between the shared helpers and the kernel (see collapse_cost.cl)
-    const std::string src = "#include \"collapse_common.h\"\n" + p.cost_source + "\n#include \"collapse_cost.cl\"\n";
+    const std::string src = "#include \"collapse_common.h\"\n#line 1 \"cost_cl_source\"\n" + p.cost_source +
+                            "\n#include \"collapse_cost.cl\"\n";
     // Context caches programs by (name, options): the name carries a hash of the source
     const std::string name = "user cost (cost_cl_source " + std::to_string(std::hash<std::string>{}(src)) + ")";
     cl::Program& prog = ctx.build(name, src, "-DTCC_USER_COST");
@@ -380,11 +414,11 @@ uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
   ensure(s.dir, ctx, c.ne);
   ensure(s.reason, ctx, c.ne);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
-  run(ctx, "collapse_admissible.cl", "admissible", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(dm.tets),
-      B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points),
-      B(c.vflags), B(c.vclass), B(c.eflags), I(p.mode), I(p.paper_rule ? 1 : 0), p.eps_v, p.min_quality,
-      tet_qualities(ctx, dm, c, s, p), B(s.adm), B(s.dir),
-      B(s.reason), B(s.counters));
+  run_stage(ctx, p, "collapse_admissible.cl", "admissible", c.ne, U(c.ne), B(c.edges), B(s.marked), B(dm.tets),
+            B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels,
+            B(dm.points), B(dm.vfields), U(dm.vfield_comps), B(c.vflags), B(c.vclass), B(c.eflags), I(p.mode),
+            I(p.paper_rule ? 1 : 0), p.eps_v, p.min_quality, tet_qualities(ctx, dm, c, s, p), B(s.adm), B(s.dir),
+            B(s.reason), B(s.counters));
   return counter(s, 1);
 }
 
@@ -585,17 +619,18 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   s.restrict_clean = false;
   ensure(s.slot[0], ctx, dm.nv);
   s.slot[0].fill(-1);
-  run(ctx, A, "lazy_init", c.ne, "", U(c.ne), B(c.edges), B(s.marked), B(c.vflags), B(c.vclass), B(c.eflags), mode,
-      paper_rule, B(s.state), B(s.dir), B(s.reason), B(s.cand), B(s.counters), cl_int(restrict_clean ? 1 : 0),
-      restrict_clean ? B(s.vdirty) : B(c.vflags), B(s.verdict), B(s.cost), B(s.slot[0]));
+  run_stage(ctx, p, A, "lazy_init", c.ne, U(c.ne), B(c.edges), B(s.marked), B(c.vflags), B(c.vclass), B(c.eflags),
+            mode, paper_rule, B(dm.points), B(dm.vfields), U(dm.vfield_comps), B(s.state), B(s.dir), B(s.reason),
+            B(s.cand), B(s.counters), cl_int(restrict_clean ? 1 : 0), restrict_clean ? B(s.vdirty) : B(c.vflags),
+            B(s.verdict), B(s.cost), B(s.slot[0]));
   // the test's arguments, the same for the per-round kernel and the one-work-group loop
-  cl::Kernel decide = ctx.kernel(A, "lazy_p1_decide"), loop = ctx.kernel(A, "lazy_p1_loop");
+  cl::Kernel decide = stage_kernel(ctx, p, A, "lazy_p1_decide"), loop = stage_kernel(ctx, p, A, "lazy_p1_loop");
   const cl::Buffer& quality = tet_qualities(ctx, dm, c, s, p);
   for (auto [k, first] : {std::pair<cl::Kernel*, cl_uint>{&decide, 8}, {&loop, 15}})
     set_args_from(*k, first, "lazy_p1_decide", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb),
-                  B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(c.vflags), B(c.vclass), B(c.eflags),
-                  mode, paper_rule, p.eps_v, p.min_quality, quality, B(s.dir), B(s.reason), B(s.counters),
-                  B(s.verdict));
+                  B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(dm.vfields), U(dm.vfield_comps),
+                  B(c.vflags), B(c.vclass), B(c.eflags), mode, paper_rule, p.eps_v, p.min_quality, quality, B(s.dir),
+                  B(s.reason), B(s.counters), B(s.verdict));
   lazy_p1_rounds(ctx, s, c, decide, loop, p);
   run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1),
       B(s.vaff), B(s.counters));
@@ -634,8 +669,8 @@ uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s
   return counter(s, 3);
 }
 
-void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connectivity& c, EdgeState& s,
-                          DeviceBuffer<int32_t>& origin, uint32_t n_origin) {
+void collapse_and_compact(Context& ctx, const StageParams& p, DeviceMesh& dm, DeviceMesh& next, Connectivity& c,
+                          EdgeState& s, DeviceBuffer<int32_t>& origin, uint32_t n_origin) {
   const std::string F = "collapse_compact.cl";
   const uint32_t nv = dm.nv, nt = dm.nt;
   // vertices
@@ -654,7 +689,7 @@ void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connec
   next.tfield_comps = dm.tfield_comps;
   next.has_mask = dm.has_mask;
   next.has_labels = dm.has_labels;
-  run(ctx, F, "vertex_write", nv, "", U(nv), B(s.vaff), B(c.edges), B(s.dir), B(vkeep), B(vnew), B(dm.points),
+  run_stage(ctx, p, F, "vertex_write", nv, U(nv), B(s.vaff), B(c.edges), B(s.dir), B(vkeep), B(vnew), B(dm.points),
       B(next.points), U(dm.vfield_comps), B(dm.vfields), B(next.vfields), I(dm.has_mask ? 1 : 0), B(dm.vmask),
       B(next.vmask));
   // tets

@@ -123,6 +123,10 @@ struct StageParams {
   double target = 0;
   int mask_mode = 0;  // 0 none, 1 both, 2 either
   std::string cost_source;  // user cost, "" for the edge length
+  // The user's placement and predicate (OpenCL C, "" for none) and the -D options that switch
+  // them on (collapse_common.h): compiled into the kernels that place a survivor or evaluate Q
+  // (stage_kernel).
+  std::string user_source, user_defines;
   // One work-group for the conflict rounds (no launch and read-back per round): lazy pass 1
   // once at most loop_tests edges of a turn list are to be tested and loop_turns in all, back
   // to per-round launches when a list has more than loop_exit_tests to test; pass 2
@@ -131,6 +135,14 @@ struct StageParams {
   uint32_t loop_tests = 128, loop_turns = 4096, loop_exit_tests = 512;
 };
 StageParams params_from(const CollapseOptions& o);
+
+// Launches k over n work items; with TETCOLLAPSE_PROFILE set, waits for it and prints its wall
+// time on stderr.
+void launch_profiled(Context& ctx, cl::Kernel& k, const char* name, size_t n);
+
+// Kernel `name` of the stage file `file`, compiled with the user's placement and predicate
+// (p.user_source) when there are any: a program of its own per source, cached by the Context.
+cl::Kernel stage_kernel(Context& ctx, const StageParams& p, const std::string& file, const char* name);
 
 // With vertex_new, the device mesh is renumbered in spatial order (spatial_order.hpp) and
 // *vertex_new receives the map input vertex -> device vertex; else it keeps the input's order.
@@ -159,10 +171,10 @@ uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
 // of admissible(): replaces both conflict passes, with the same outputs as conflict_pass2.
 // Returns the number of edges to collapse.
 uint32_t conflicts_atomic_min(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
-// Applies the final collapses: dm becomes the new mesh (via `next`, swapped in); origin (input
-// vertex -> current vertex) is updated when non-empty.
-void collapse_and_compact(Context& ctx, DeviceMesh& dm, DeviceMesh& next, Connectivity& c, EdgeState& s,
-                          DeviceBuffer<int32_t>& origin, uint32_t n_origin);
+// Applies the final collapses (the survivors at p's placement): dm becomes the new mesh (via
+// `next`, swapped in); origin (input vertex -> current vertex) is updated when non-empty.
+void collapse_and_compact(Context& ctx, const StageParams& p, DeviceMesh& dm, DeviceMesh& next, Connectivity& c,
+                          EdgeState& s, DeviceBuffer<int32_t>& origin, uint32_t n_origin);
 
 // A further selection round in the same connectivity after conflict_pass2: edges whose end
 // points are neither end points of the collapses chosen so far nor their neighbours (their

@@ -139,16 +139,16 @@ struct CollapseOptions {
   // The output's vertices and tets follow that order instead of the input's.
   bool spatial_order = true;
   // Host tail. Parallel method with the two-pass conflict detection, run until nothing
-  // collapses (eps_c <= 1), with the built-in cost: once an iteration collapses fewer than
-  // host_tail x (its tets) edges and the counts shrink slowly enough to promise many more
-  // iterations (at the ratio of the last two, at least host_tail_min_iterations until none), the
-  // rest runs on the host with the sequential method's checks, greedily (after each collapse
-  // the marked edges around it are queued at once, so one iteration leaves nothing admissible;
-  // another runs only when the surface guard refused an edge, since it looks beyond the
-  // star). The last
-  // iterations of the parallel method collapse a few edges each (a cascade: a collapse makes a
-  // neighbour admissible) at the price of passes over the whole mesh, which on a CPU device
-  // cost more than collapsing them one by one: W1 (bench/README.md) saves ~0.2 s of ~3 s. On a
+  // collapses (eps_c <= 1), without user functions (has_user_functions): once an iteration
+  // collapses fewer than host_tail x (its tets) edges and the counts shrink slowly enough to
+  // promise many more iterations (at the ratio of the last two, at least
+  // host_tail_min_iterations until none), the rest runs on the host with the sequential
+  // method's checks, greedily (after each collapse the marked edges around it are queued at
+  // once, so one iteration leaves nothing admissible; another runs only when the surface guard
+  // refused an edge, since it looks beyond the star). The last iterations of the parallel
+  // method collapse a few edges each (a cascade: a collapse makes a neighbour admissible) at
+  // the price of passes over the whole mesh, which on a CPU device cost more than collapsing
+  // them one by one: W1 (bench/README.md) saves ~0.2 s of ~3 s. On a
   // GPU those passes are cheap. Negative (default): kHostTailCpu on CPU devices, 0 on others;
   // 0: every iteration on the device. Decided by counts only: the output stays deterministic.
   static constexpr double kHostTailCpu = 0.002;
@@ -170,6 +170,26 @@ struct CollapseOptions {
   // vertex fields). Edges with tc_user_cost < target_length are marked (target_length must then
   // be > 0, there is no median of a user cost). Compiled into the cost kernel at run time.
   std::string cost_cl_source;
+
+  // Optional user placement, OpenCL C source defining
+  //     double3 tc_user_placement(double3 p0, double3 p1, double f0, double f1);
+  // (p0, p1, f0, f1 as for the cost; p0 is the end point with the lower index): where the
+  // survivor goes, in place of the midpoint, when both end points are off S (every edge in free
+  // mode). The boundary modes keep their rules for the vertices of S (a face vertex moves along
+  // its face, etc.). The survivor's vertex fields are interpolated at the placement's parameter
+  // along the edge (clamped to the edge). The volume test, the quality guard and the surface
+  // guard see the placement, so an unwise one is refused, never applied.
+  std::string placement_cl_source;
+
+  // Optional user predicate, OpenCL C source defining
+  //     int tc_user_predicate(double3 p0, double3 p1, double f0, double f1);
+  // (arguments as for the cost): 0 refuses the collapse of the edge, as the predicate Q does;
+  // evaluated with Q on every marked edge of every iteration.
+  std::string predicate_cl_source;
+
+  bool has_user_functions() const {
+    return !cost_cl_source.empty() || !placement_cl_source.empty() || !predicate_cl_source.empty();
+  }
 
   // Called after every iteration (e.g. for a progress line).
   std::function<void(const IterationStats&)> progress;

@@ -208,6 +208,35 @@ TEST(Cli, CoarsenWritesAValidMeshAndStats) {
 
 namespace {
 
+TEST(Cli, UserPlacementAndPredicateFiles) {
+  tc::test::TempDir dir;
+  std::string out;
+  const std::string in = q(tc::test::project_mesh("bracket.msh")), result = q(dir.file("o.vtu")),
+                    stats = q(dir.file("s.json"));
+  const std::string none = dir.file("none.cl"), keep = dir.file("keep.cl"), bad = dir.file("bad.cl");
+  tc::test::write_text(none, "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) { return 0; }\n");
+  tc::test::write_text(keep, "double3 tc_user_placement(double3 p0, double3 p1, double f0, double f1) { return p0; }\n");
+  tc::test::write_text(bad, "double3 tc_user_placement(double3 p0) { return nonsense; }\n");
+  // a predicate refusing every edge: nothing collapses
+  ASSERT_EQ(run_command(cli() + " " + in + " " + result + " -q --predicate-cl " + q(none) + " --stats " + stats, &out), 0)
+      << out;
+  EXPECT_NE(tc::test::read_text(dir.file("s.json")).find("\"tets_out\":23925"), std::string::npos);
+  // a placement: a valid result, coarser
+  ASSERT_EQ(run_command(cli() + " " + in + " " + result + " -q --check --placement-cl " + q(keep) + " --stats " + stats,
+                        &out),
+            0)
+      << out;
+  EXPECT_EQ(tc::test::read_text(dir.file("s.json")).find("\"tets_out\":23925"), std::string::npos);
+  // a missing file names it (usage error); a source that does not compile is a device error
+  EXPECT_EQ(run_command(cli() + " " + in + " " + result + " --placement-cl " + q(dir.file("absent.cl")), &out), 2);
+  EXPECT_NE(out.find("absent.cl"), std::string::npos) << out;
+  EXPECT_EQ(run_command(cli() + " " + in + " " + result + " --placement-cl " + q(bad), &out), 3) << out;
+  EXPECT_NE(out.find("bad.cl:1:"), std::string::npos) << out;  // the compiler's messages name the file and line
+  // OpenCL C needs the parallel method
+  EXPECT_EQ(run_command(cli() + " " + in + " " + result + " --method sequential --predicate-cl " + q(none), &out), 2);
+  EXPECT_NE(out.find("--predicate-cl"), std::string::npos) << out;
+}
+
 TEST(Cli, DeviceErrorsExitWithThree) {
   tc::test::TempDir dir;
   std::string out;

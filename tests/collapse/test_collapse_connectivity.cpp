@@ -227,7 +227,7 @@ TEST(CollapseConnectivity, CarriedAfterCollapsesEqualsFreshBuild) {
       lazy_admissible_pass1(ctx, dm, c, s, p, passed_q, tested);
       if (conflict_pass2(ctx, dm, c, s) == 0) break;
       remember_for_carry(ctx, dm, c, s);
-      collapse_and_compact(ctx, dm, next, c, s, origin, 0);
+      collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
       note_compaction(ctx, dm, c, s);
       Connectivity fresh;
       build_connectivity(ctx, dm, fresh, p);

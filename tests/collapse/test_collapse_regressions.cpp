@@ -180,6 +180,36 @@ TEST(CollapseRegressions, GuardRefusesOnlyWhatIntersects) {
   EXPECT_TRUE(check(out, in).valid);
 }
 
+
+// A user placement in free mode moves S, so the surface guard must see it: cube A = [0,1]^3
+// (cube_tets(2)) under a block B = [-0.5,1.5]^2 x [z0, z0 + 0.5]; only A's vertical edges from
+// z = 0.5 to z = 1 may collapse (predicate), to 1.375 (placement, past the top): into B when
+// z0 < 1.375.
+tc::Mesh cube_under_block(double z0) {
+  tc::Mesh m = tc::test::cube_tets(2);
+  const tc::Mesh b = tc::test::cube_tets(1);
+  const int32_t off = int32_t(m.num_vertices());
+  for (int64_t v = 0; v < b.num_vertices(); ++v) {
+    m.points.push_back(-0.5 + 2 * b.points[3 * v]);
+    m.points.push_back(-0.5 + 2 * b.points[3 * v + 1]);
+    m.points.push_back(z0 + 0.5 * b.points[3 * v + 2]);
+  }
+  for (int32_t i : b.tets) m.tets.push_back(i + off);
+  return m;
+}
+
+tc::CollapseOptions push_up_the_top() {
+  tc::CollapseOptions opt;
+  opt.boundary = tc::CollapseOptions::Free;
+  opt.min_quality = 0;
+  opt.target_length = 10;
+  opt.predicate_cl_source =
+      "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) {\n"
+      "  return p0.x == p1.x && p0.y == p1.y && p0.z == 0.5 && p1.z == 1.0;\n}\n";
+  opt.placement_cl_source =
+      "double3 tc_user_placement(double3 p0, double3 p1, double f0, double f1) { return p1 + 0.75 * (p1 - p0); }\n";
+  return opt;
+}
 }  // namespace
 
 // Free mode flattened lone tets away: an edge (a, b) of a tet whose faces (a,c,d) and (b,c,d)
@@ -204,4 +234,25 @@ TEST(CollapseRegressions, LoneTetsAreNotFlattenedAway) {
         EXPECT_TRUE(tc::check_mesh(m, tc::CheckOptions{}, &in).valid);
       }
   }
+}
+
+TEST(CollapseRegressions, GuardSeesTheUserPlacement) {
+  // The control: B out of reach (z0 = 3), the top is pushed up.
+  tc::Context ctx;
+  const tc::Mesh far = cube_under_block(3.0);
+  ASSERT_TRUE(check(far, far).valid);
+  tc::Mesh out_far = far;
+  const tc::CollapseReport r_far = tc::collapse(out_far, push_up_the_top(), ctx);
+  EXPECT_LT(r_far.tets_out, r_far.tets_in);
+  EXPECT_TRUE(check(out_far, far).valid);
+  // B just above A's top (z0 = 1.1): the same collapses would push A's top into B; the guard
+  // refuses them (with the midpoint, 0.75, it would see nothing to refuse).
+  const tc::Mesh near = cube_under_block(1.1);
+  ASSERT_TRUE(check(near, near).valid);
+  tc::Mesh out_near = near;
+  const tc::CollapseReport r_near = tc::collapse(out_near, push_up_the_top(), ctx);
+  const tc::CheckReport rc = check(out_near, near);
+  EXPECT_FALSE(has_finding(rc, "boundary_self_intersection"));
+  EXPECT_TRUE(rc.valid) << (rc.errors.empty() ? "" : rc.errors[0]);
+  EXPECT_GT(r_near.tets_out, r_far.tets_out);
 }

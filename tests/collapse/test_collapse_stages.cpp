@@ -4,9 +4,11 @@
 
 #include <cmath>
 #include <map>
+#include <set>
 
 #include "collapse/stages.hpp"
 #include "geometry.h"
+#include "tetcollapse/check.hpp"
 #include "tetcollapse/io.hpp"
 #include "tetcollapse/topology.hpp"
 #include "test_support.hpp"
@@ -42,6 +44,24 @@ struct Staged {
     return it == id.end() ? -1 : it->second;
   }
 };
+
+// The smallest volume the tets of ring(a) U ring(b) that survive the collapse of (a, b) have
+// with a and b at p, on the host.
+double volume_after(const Mesh& m, const Topology& t, int32_t a, int32_t b, geo::tc_d3 p) {
+  double vmin = INFINITY;
+  for (int32_t x : {a, b}) {
+    for (int32_t i = t.vertex_tets_offsets[x]; i < t.vertex_tets_offsets[x + 1]; ++i) {
+      const int32_t* q = &m.tets[4 * size_t(t.vertex_tets[i])];
+      bool both = false;
+      for (int k = 0; k < 4; ++k) both = both || q[k] == (x == a ? b : a);
+      if (both) continue;
+      geo::tc_d3 c[4];
+      for (int k = 0; k < 4; ++k) c[k] = q[k] == x ? p : geo::tc_point(m.points.data(), q[k]);
+      vmin = std::min(vmin, geo::tc_tet_volume(c[0], c[1], c[2], c[3]));
+    }
+  }
+  return vmin;
+}
 
 int32_t vertex_at(const Mesh& m, double x, double y, double z) {
   for (int64_t v = 0; v < m.num_vertices(); ++v)
@@ -233,17 +253,7 @@ TEST(CollapseAdmissible, VolumeTestMatchesHostReference) {
     int32_t d = st.edge(a, b);
     if (st.reason[d] != kOk && st.reason[d] != kRefusedVolume) continue;
     geo::tc_d3 p = (geo::tc_point(m.points.data(), a) + geo::tc_point(m.points.data(), b)) * 0.5;
-    double vmin = INFINITY;
-    for (int32_t x : {a, b})
-      for (int32_t i = t.vertex_tets_offsets[x]; i < t.vertex_tets_offsets[x + 1]; ++i) {
-        const int32_t* q = &m.tets[4 * size_t(t.vertex_tets[i])];
-        bool both = false;
-        for (int k = 0; k < 4; ++k) both = both || q[k] == (x == a ? b : a);
-        if (both) continue;
-        geo::tc_d3 c[4];
-        for (int k = 0; k < 4; ++k) c[k] = q[k] == x ? p : geo::tc_point(m.points.data(), q[k]);
-        vmin = std::min(vmin, geo::tc_tet_volume(c[0], c[1], c[2], c[3]));
-      }
+    const double vmin = volume_after(m, t, a, b, p);
     EXPECT_EQ(st.reason[d] == kRefusedVolume, vmin < o.eps_v) << "edge " << a << "-" << b << " vmin " << vmin;
     inverted += vmin < 0;
     passed += st.reason[d] == kOk;
@@ -510,4 +520,153 @@ TEST(CollapseCost, UserCostFromOpenCLSource) {
   o.cost_cl_source = "double tc_user_cost(double3 p0) { return nonsense; }";
   Mesh r2 = m;
   EXPECT_THROW(collapse(r2, o, ctx), DeviceError);
+}
+
+// --- The user's placement and predicate (CollapseOptions::placement_cl_source,
+// predicate_cl_source; cl/collapse_common.h) ---
+
+namespace {
+
+const char* kBeyondV1 =  // past the end point v1: many such collapses invert a tet
+    "double3 tc_user_placement(double3 p0, double3 p1, double f0, double f1) { return p1 + 0.75 * (p1 - p0); }\n";
+
+}  // namespace
+
+TEST(CollapseUserFunctions, ThePlacementIsWhatTheVolumeTestSees) {
+  // Free mode: the user's placement replaces the midpoint on every edge (dir bit
+  // TCC_DIR_USER), and the volume test must refuse exactly the edges whose collapse to it
+  // leaves a tet below eps_v, among them edges that the midpoint would not refuse.
+  Context ctx;
+  Mesh m = test::cube_tets(3);
+  CollapseOptions o;
+  o.boundary = CollapseOptions::Free;
+  o.placement_cl_source = kBeyondV1;
+  Staged st(ctx, m, o, 10.0);
+  Topology t = build_topology(m);
+  int refused = 0, passed = 0, midpoint_would_pass = 0;
+  for (int32_t e = 0; e < t.num_edges(); ++e) {
+    int32_t a = t.edges[2 * e], b = t.edges[2 * e + 1];  // a < b: p0 is a's
+    int32_t d = st.edge(a, b);
+    if (st.reason[d] != kOk && st.reason[d] != kRefusedVolume) continue;
+    const geo::tc_d3 p0 = geo::tc_point(m.points.data(), a), p1 = geo::tc_point(m.points.data(), b);
+    const double vmin = volume_after(m, t, a, b, p1 + 0.75 * (p1 - p0));
+    EXPECT_EQ(st.reason[d] == kRefusedVolume, vmin < o.eps_v) << "edge " << a << "-" << b << " vmin " << vmin;
+    if (st.reason[d] == kOk) {
+      EXPECT_EQ(st.dir[d] & 4u, 4u) << "edge " << a << "-" << b;  // TCC_DIR_USER
+    }
+    refused += st.reason[d] == kRefusedVolume;
+    passed += st.reason[d] == kOk;
+    midpoint_would_pass += st.reason[d] == kRefusedVolume && volume_after(m, t, a, b, (p0 + p1) * 0.5) >= o.eps_v;
+  }
+  EXPECT_GT(passed, 0);
+  EXPECT_GT(refused, 0);
+  EXPECT_GT(midpoint_would_pass, 0);
+}
+
+TEST(CollapseUserFunctions, ThePlacementLeavesTheSurfaceToTheBoundaryModes) {
+  // Features mode: only edges with both end points off S take the user's placement; the
+  // others keep the built-in rules (a face vertex moves along its face, to the midpoint of an
+  // S-edge or onto its partner).
+  Context ctx;
+  Mesh m = test::cube_tets(3);
+  CollapseOptions o;
+  o.placement_cl_source = kBeyondV1;
+  Staged st(ctx, m, o, 10.0);
+  const std::vector<uint8_t> vflags = st.c.vflags.download_range(0, st.dm.nv);
+  int user = 0, builtin = 0;
+  for (uint32_t e = 0; e < st.c.ne; ++e) {
+    if (st.reason[e] != kOk) continue;
+    const bool off_s = vflags[st.edges[2 * e]] == 0 && vflags[st.edges[2 * e + 1]] == 0;
+    EXPECT_EQ((st.dir[e] & 4u) != 0, off_s) << "edge " << st.edges[2 * e] << "-" << st.edges[2 * e + 1];
+    user += off_s;
+    builtin += !off_s;
+  }
+  EXPECT_GT(user, 0);
+  EXPECT_GT(builtin, 0);
+}
+
+TEST(CollapseUserFunctions, ThePlacementAndTheFieldsFollowIt) {
+  // Strict mode with the placement "keep v0": every survivor ends at an input vertex's place
+  // (the boundary stays, interior edges go to v0), with that vertex's field value (the field is
+  // interpolated at the placement's parameter along the edge: 0 here). The built-in midpoint
+  // makes new places, the control.
+  Context ctx;
+  Mesh m = test::cube_tets(4);
+  Field f{"linear", 1, {}};
+  for (int64_t v = 0; v < m.num_vertices(); ++v)
+    f.values.push_back(m.points[3 * v] + 2 * m.points[3 * v + 1] + 3 * m.points[3 * v + 2]);
+  m.vertex_fields.push_back(f);
+  std::map<test::Point3, double> field_at;
+  for (int64_t v = 0; v < m.num_vertices(); ++v)
+    field_at[{m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]}] = f.values[size_t(v)];
+  CollapseOptions o;
+  o.boundary = CollapseOptions::Strict;
+  o.min_quality = 0;
+  o.target_length = 0.5;
+  {
+    Mesh control = m;
+    collapse(control, o, ctx);
+    int new_places = 0;
+    for (const test::Point3& p : test::vertex_positions(control)) new_places += !field_at.count(p);
+    EXPECT_GT(new_places, 0);
+  }
+  o.placement_cl_source = "double3 tc_user_placement(double3 p0, double3 p1, double f0, double f1) { return p0; }\n";
+  Mesh out = m;
+  CollapseReport r = collapse(out, o, ctx);
+  EXPECT_LT(r.tets_out, r.tets_in);
+  ASSERT_EQ(out.vertex_fields.size(), 1u);
+  for (int64_t v = 0; v < out.num_vertices(); ++v) {
+    const test::Point3 p{out.points[3 * v], out.points[3 * v + 1], out.points[3 * v + 2]};
+    auto it = field_at.find(p);
+    ASSERT_TRUE(it != field_at.end()) << "vertex " << v << " is at a new place";
+    EXPECT_EQ(out.vertex_fields[0].values[size_t(v)], it->second) << "vertex " << v;
+  }
+  CheckOptions co;
+  co.hausdorff = false;
+  EXPECT_TRUE(check_mesh(out, co, &m).valid);
+}
+
+TEST(CollapseUserFunctions, ThePredicateRefusesWhatItRefuses) {
+  // Only edges with both end points at x > 0.5 may collapse: every vertex at x <= 0.5 keeps
+  // its place, with both conflict detections; a predicate refusing everything collapses
+  // nothing.
+  Context ctx;
+  const Mesh m = test::cube_tets(4);
+  std::set<test::Point3> left;
+  for (const test::Point3& p : test::vertex_positions(m))
+    if (std::get<0>(p) <= 0.5) left.insert(p);
+  for (auto conflicts : {CollapseOptions::TwoPass, CollapseOptions::AtomicMin}) {
+    if (conflicts == CollapseOptions::AtomicMin && !ctx.info().int64_atomics_extended) continue;
+    SCOPED_TRACE(conflicts == CollapseOptions::TwoPass ? "two-pass" : "atomic-min");
+    CollapseOptions o;
+    o.conflicts = conflicts;
+    o.target_length = 0.5;
+    o.predicate_cl_source = "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) {\n"
+                            "  return p0.x > 0.5 && p1.x > 0.5;\n}\n";
+    Mesh out = m;
+    CollapseReport r = collapse(out, o, ctx);
+    EXPECT_LT(r.tets_out, r.tets_in);
+    const std::set<test::Point3> after = test::vertex_positions(out);
+    for (const test::Point3& p : left) EXPECT_TRUE(after.count(p)) << std::get<0>(p) << " " << std::get<1>(p);
+    o.predicate_cl_source = "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) { return 0; }\n";
+    Mesh none = m;
+    EXPECT_EQ(collapse(none, o, ctx).tets_out, m.num_tets());
+  }
+}
+
+TEST(CollapseUserFunctions, BadSourcesAndTheSequentialMethodAreRefused) {
+  Context ctx;
+  const Mesh m = test::cube_tets(2);
+  CollapseOptions o;
+  o.placement_cl_source = "double3 tc_user_placement(double3 p0) { return nonsense; }";
+  Mesh a = m;
+  EXPECT_THROW(collapse(a, o, ctx), DeviceError);
+  o.placement_cl_source.clear();
+  o.predicate_cl_source = "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) { return }";
+  Mesh b = m;
+  EXPECT_THROW(collapse(b, o, ctx), DeviceError);
+  o.predicate_cl_source = "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) { return 1; }\n";
+  o.method = CollapseOptions::Sequential;
+  Mesh c = m;
+  EXPECT_THROW(collapse(c, o, ctx), std::invalid_argument);
 }
