@@ -3,8 +3,11 @@
 
 #include <filesystem>
 #include <iterator>
+#include <map>
+#include <set>
 
 #include "test_support.hpp"
+#include "tetcollapse/io.hpp"
 
 namespace {
 
@@ -235,6 +238,49 @@ TEST(Cli, UserPlacementAndPredicateFiles) {
   // OpenCL C needs the parallel method
   EXPECT_EQ(run_command(cli() + " " + in + " " + result + " --method sequential --predicate-cl " + q(none), &out), 2);
   EXPECT_NE(out.find("--predicate-cl"), std::string::npos) << out;
+}
+
+TEST(Cli, TheExampleUserFunctionsDoWhatTheySay) {
+  // examples/user_functions/*.cl on a cube with the field f = x: each run is valid, the
+  // placement keeps the field's values (every survivor at an end point, with its value), the
+  // predicate keeps every vertex at z >= 0.5.
+  tc::test::TempDir dir;
+  std::string out;
+  tc::Mesh m = tc::test::cube_tets(4);
+  tc::Field f{"f", 1, {}};
+  for (int64_t v = 0; v < m.num_vertices(); ++v) f.values.push_back(m.points[3 * v]);
+  m.vertex_fields.push_back(f);
+  const std::string in = dir.file("cube.vtu"), result = dir.file("o.vtu");
+  tc::write_mesh(in, m);
+  const std::string ex = std::string(TC_SOURCE_DIR) + "/examples/user_functions/";
+  const std::string run = cli() + " " + q(in) + " " + q(result) + " -q --check ";
+  ASSERT_EQ(run_command(run + "--cost-cl " + q(ex + "field_cost.cl") + " --target-length 0.3", &out), 0) << out;
+  EXPECT_LT(tc::read_mesh(result).num_tets(), m.num_tets());
+
+  ASSERT_EQ(run_command(run + "--placement-cl " + q(ex + "keep_extremum.cl") + " --boundary free --min-quality 0",
+                        &out),
+            0)
+      << out;
+  const tc::Mesh kept = tc::read_mesh(result);
+  EXPECT_LT(kept.num_tets(), m.num_tets());
+  std::map<tc::test::Point3, double> value_at;
+  for (int64_t v = 0; v < m.num_vertices(); ++v)
+    value_at[{m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]}] = f.values[size_t(v)];
+  ASSERT_EQ(kept.vertex_fields.size(), 1u);
+  for (int64_t v = 0; v < kept.num_vertices(); ++v) {
+    auto it = value_at.find({kept.points[3 * v], kept.points[3 * v + 1], kept.points[3 * v + 2]});
+    ASSERT_TRUE(it != value_at.end()) << "vertex " << v << " at a new place";
+    EXPECT_EQ(kept.vertex_fields[0].values[size_t(v)], it->second);
+  }
+
+  ASSERT_EQ(run_command(run + "--predicate-cl " + q(ex + "below_plane.cl") + " --target-length 0.5", &out), 0) << out;
+  const tc::Mesh below = tc::read_mesh(result);
+  EXPECT_LT(below.num_tets(), m.num_tets());
+  const std::set<tc::test::Point3> after = tc::test::vertex_positions(below);
+  for (const tc::test::Point3& p : tc::test::vertex_positions(m))
+    if (std::get<2>(p) >= 0.5) {
+      EXPECT_TRUE(after.count(p)) << "z " << std::get<2>(p);
+    }
 }
 
 TEST(Cli, DeviceErrorsExitWithThree) {
