@@ -65,6 +65,11 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
                                  double eps_v, double q_min, __global const double* tet_quality) {
   /* --- volumes after the tentative collapse (first: cheaper, and it refuses more edges) --- */
   double3 p = tcc_placement(pts, vfield, vfield_stride, a, b, (uint)dir);
+#ifdef TCC_USER_PLACEMENT
+  /* a user placement may be no point at all (inf, nan: e.g. a division by a zero field
+   * difference) */
+  if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z)) return TCC_REFUSED_VOLUME;
+#endif
   double3 pa = tc_point(pts, a), pb = tc_point(pts, b);
   /* Quality guard (q_min > 0): the worst mean ratio among the tets that change shape may not
    * fall below min(its value before the collapse, q_min): a collapse never makes a good
@@ -97,6 +102,9 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
         c[3] = q.w == x ? p : tc_point(pts, q.w);
         double vol = tc_tet_volume(c[0], c[1], c[2], c[3]);
         if (!(vol >= eps_v)) return TCC_REFUSED_VOLUME;
+#ifdef TCC_USER_PLACEMENT
+        if (!(vol < INFINITY)) return TCC_REFUSED_VOLUME; /* a finite placement far enough overflows */
+#endif
         if (q_min > 0.0) {
           double qn = tc_tet_quality_v(c[0], c[1], c[2], c[3], vol);
           double qo = tet_quality[ts[j]]; /* tc_tet_quality of the tet now (tet_quality kernel) */

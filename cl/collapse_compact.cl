@@ -56,9 +56,8 @@ __kernel void vertex_write(uint nv, __global const int* vaff, __global const int
     if (d & TCC_DIR_USER) {
       const double3 p0 = tc_point(pts, v0), d01 = tc_point(pts, v1) - p0;
       const double len2 = tcc_dot(d01, d01);
-      const double s01 = len2 > 0.0 ? tcc_dot(p - p0, d01) / len2 : 0.5;
-      const double s0 = s01 < 0.0 ? 0.0 : s01 > 1.0 ? 1.0 : s01; /* the parameter of v1 */
-      s = (int)v == v0 ? s0 : 1.0 - s0; /* of the partner, seen from v */
+      const double s01 = len2 > 0.0 ? tcc_dot(p - p0, d01) / len2 : 0.5; /* the parameter of v1 */
+      s = (int)v == v0 ? s01 : 1.0 - s01; /* of the partner, seen from v (clamped below) */
     }
   }
   out_pts[3 * o] = p.x;
@@ -68,7 +67,7 @@ __kernel void vertex_write(uint nv, __global const int* vaff, __global const int
     double x = vfields[(size_t)v * ncomp + c];
     if (partner >= 0) {
       const double y = vfields[(size_t)partner * ncomp + c];
-      x = s == 0.5 ? 0.5 * (x + y) : x + s * (y - x);
+      x = s == 0.5 ? 0.5 * (x + y) : !(s > 0.0) ? x : s >= 1.0 ? y : x + s * (y - x);
     }
     out_vfields[(size_t)o * ncomp + c] = x;
   }

@@ -2,7 +2,9 @@
  *
  * The verdict of edge (a, b) depends only on ring(a) U ring(b): the tets, their vertices'
  * positions, labels and flags, and vflags of the common neighbours of a and b (a surviving
- * vertex keeps its S membership: collapses preserve the boundary's topology). A collapse of
+ * vertex keeps its S membership: collapses preserve the boundary's topology); with a user
+ * placement also on the vertex fields at a and b, which change only at the survivors of
+ * collapses, end points of the collapses themselves. A collapse of
  * (u, s) changes exactly the rings of the vertices of ring(u) U ring(s) = {u, s} U N(u) U N(s),
  * so an edge neither of whose end points is such a vertex keeps its verdict. Such an edge exists
  * in the previous mesh as (vold[a], vold[b]) (compaction keeps the order of the kept vertices).

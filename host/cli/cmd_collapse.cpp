@@ -218,7 +218,8 @@ void register_collapse(CLI::App& app, int& exit_code) {
   app.add_option("--placement-cl", c->placement_cl,
                  "OpenCL C file defining double3 tc_user_placement(double3 p0, double3 p1, double f0, double f1);\n"
                  "where the survivor goes instead of the midpoint, on edges with both ends off the boundary\n"
-                 "and interfaces (every edge with --boundary free); vertex fields are interpolated there");
+                 "and interfaces (every edge with --boundary free); vertex fields are interpolated there.\n"
+                 "Which end is p0 is the pipeline's choice: write it symmetric in the two ends");
   app.add_option("--predicate-cl", c->predicate_cl,
                  "OpenCL C file defining int tc_user_predicate(double3 p0, double3 p1, double f0, double f1);\n"
                  "0 refuses the collapse of the edge (besides the built-in checks)");

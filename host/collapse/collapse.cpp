@@ -246,7 +246,9 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
         s.after_pass2 = conflict_pass2(ctx, dm, conn, st);
       }
       for (int r = 1; r < options.selection_rounds && s.after_pass2 > 0; ++r) {
-        const uint32_t total = next_selection_round(ctx, dm, conn, st, p);
+        uint32_t tested = 0;
+        const uint32_t total = next_selection_round(ctx, dm, conn, st, p, tested);
+        s.tested += tested;
         if (total == s.after_pass2) break;  // nothing more
         s.after_pass2 = total;
       }

@@ -198,14 +198,15 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
   if (vertex_new) *vertex_new = std::move(spatial.vertex_new);
 }
 
-uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p) {
+uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                              uint32_t& tested) {
   remember_for_carry(ctx, dm, c, s);  // s.vdirty: the stars of the collapses chosen so far
   std::swap(s.fin, s.fin1);
   std::swap(s.dir, s.dir1);
   std::swap(s.vaff, s.vaff1);
   s.restrict_clean = true;
   s.verdict_ready = true;  // this iteration's verdicts still hold (same connectivity)
-  uint32_t passed_q = 0, tested = 0;
+  uint32_t passed_q = 0;
   lazy_admissible_pass1(ctx, dm, c, s, p, passed_q, tested);
   const uint32_t total = conflict_pass2(ctx, dm, c, s);  // counters[3] counts both rounds
   run(ctx, "collapse_verdicts.cl", "merge_rounds_edges", c.ne, "", U(c.ne), B(s.fin1), B(s.dir1), B(s.fin), B(s.dir));

@@ -180,8 +180,9 @@ void collapse_and_compact(Context& ctx, const StageParams& p, DeviceMesh& dm, De
 // points are neither end points of the collapses chosen so far nor their neighbours (their
 // stars are disjoint from those collapses, which change nothing the edges' tests look at) go
 // through the lazy filter and both conflict passes again; the result is merged (fin, dir,
-// vaff). Returns the total number of collapses chosen.
-uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p);
+// vaff). Returns the total number of collapses chosen; tested receives the round's tests.
+uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                              uint32_t& tested);
 
 // Verdict carrying around collapse_and_compact: remember_for_carry() before it (dirty vertices:
 // the end points of the final edges and their neighbours), note_compaction() right after it

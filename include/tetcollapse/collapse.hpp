@@ -52,9 +52,10 @@ struct IterationStats {
   // marked edge, but the link condition and the volume test only on the edges whose cheaper
   // rivals are all decided, which gives the same pass-1 result as testing every edge.
   int64_t passed_q = 0;           // marked edges passing the predicate Q
-  // Of those, link condition and volume test evaluated. When the surface guard refuses a
-  // collapse, the edges are selected again, testing only edges not tested before: marked and
-  // passed_q are counted before the first selection, tested adds up over the selections, and
+  // Of those, link condition and volume test evaluated (with the atomic-min conflicts: every
+  // marked edge). When the surface guard refuses a collapse, the edges are selected again (the
+  // lazy filter then tests only edges not tested before): marked and passed_q are counted
+  // before the first selection, tested adds up over the selections and selection rounds, and
   // admissible, after_pass1 and after_pass2 are the last selection's.
   int64_t tested = 0;
   int64_t admissible = 0;         // tested and passed (= after_pass1 with the lazy filter)
@@ -64,7 +65,8 @@ struct IterationStats {
   int64_t tets_after = 0, vertices_after = 0;
   // Seconds per stage (wall time, the queue finished after each stage), summed over the
   // iteration's selections. seconds_admissible holds the lazy filter together with conflict
-  // pass 1; seconds_pass1 is then 0. seconds_pass2 holds conflict pass 2 and the surface guard.
+  // pass 1; seconds_pass1 is then 0. seconds_pass2 holds conflict pass 2 (or the atomic-min
+  // conflicts), the further selection rounds and the surface guard.
   double seconds_connectivity = 0, seconds_cost = 0, seconds_admissible = 0, seconds_pass1 = 0,
          seconds_pass2 = 0, seconds_collapse = 0, seconds_total = 0;
   // An iteration of the host tail (CollapseOptions::host_tail): the sequential method's, greedy;
@@ -173,8 +175,9 @@ struct CollapseOptions {
 
   // Optional user placement, OpenCL C source defining
   //     double3 tc_user_placement(double3 p0, double3 p1, double f0, double f1);
-  // (p0, p1, f0, f1 as for the cost; p0 is the end point with the lower index): where the
-  // survivor goes, in place of the midpoint, when both end points are off S (every edge in free
+  // (p0, p1, f0, f1 as for the cost; which end point is p0 is the pipeline's choice, from its
+  // internal numbering, so write it symmetric in (p0, f0) and (p1, f1)): where the survivor
+  // goes, in place of the midpoint, when both end points are off S (every edge in free
   // mode). The boundary modes keep their rules for the vertices of S (a face vertex moves along
   // its face, etc.). The survivor's vertex fields are interpolated at the placement's parameter
   // along the edge (clamped to the edge). The volume test, the quality guard and the surface
@@ -185,6 +188,8 @@ struct CollapseOptions {
   //     int tc_user_predicate(double3 p0, double3 p1, double f0, double f1);
   // (arguments as for the cost): 0 refuses the collapse of the edge, as the predicate Q does;
   // evaluated with Q on every marked edge of every iteration.
+  // The three sources are compiled as one file each: an #include of a file of your own is not
+  // found (the kernels' own headers are), so keep each function self-contained.
   std::string predicate_cl_source;
 
   bool has_user_functions() const {

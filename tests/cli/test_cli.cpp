@@ -3,7 +3,6 @@
 
 #include <filesystem>
 #include <iterator>
-#include <map>
 #include <set>
 
 #include "test_support.hpp"
@@ -224,12 +223,23 @@ TEST(Cli, UserPlacementAndPredicateFiles) {
   ASSERT_EQ(run_command(cli() + " " + in + " " + result + " -q --predicate-cl " + q(none) + " --stats " + stats, &out), 0)
       << out;
   EXPECT_NE(tc::test::read_text(dir.file("s.json")).find("\"tets_out\":23925"), std::string::npos);
-  // a placement: a valid result, coarser
-  ASSERT_EQ(run_command(cli() + " " + in + " " + result + " -q --check --placement-cl " + q(keep) + " --stats " + stats,
+  // a placement (strict mode: only interior edges take it): valid, coarser, and every vertex at
+  // an input vertex's place, where the midpoint makes new places
+  const std::set<tc::test::Point3> places = tc::test::vertex_positions(tc::read_mesh(tc::test::project_mesh("bracket.msh")));
+  auto new_places = [&]() {
+    int n = 0;
+    for (const tc::test::Point3& p : tc::test::vertex_positions(tc::read_mesh(dir.file("o.vtu")))) n += !places.count(p);
+    return n;
+  };
+  ASSERT_EQ(run_command(cli() + " " + in + " " + result + " -q --check --boundary strict", &out), 0) << out;
+  EXPECT_GT(new_places(), 0);
+  ASSERT_EQ(run_command(cli() + " " + in + " " + result + " -q --check --boundary strict --placement-cl " + q(keep) +
+                            " --stats " + stats,
                         &out),
             0)
       << out;
   EXPECT_EQ(tc::test::read_text(dir.file("s.json")).find("\"tets_out\":23925"), std::string::npos);
+  EXPECT_EQ(new_places(), 0);
   // a missing file names it (usage error); a source that does not compile is a device error
   EXPECT_EQ(run_command(cli() + " " + in + " " + result + " --placement-cl " + q(dir.file("absent.cl")), &out), 2);
   EXPECT_NE(out.find("absent.cl"), std::string::npos) << out;
@@ -241,42 +251,44 @@ TEST(Cli, UserPlacementAndPredicateFiles) {
 }
 
 TEST(Cli, TheExampleUserFunctionsDoWhatTheySay) {
-  // examples/user_functions/*.cl on a cube with the field f = x: each run is valid, the
-  // placement keeps the field's values (every survivor at an end point, with its value), the
-  // predicate keeps every vertex at z >= 0.5.
+  // examples/user_functions/*.cl on a cube with the field f = x^2: each run is valid and differs
+  // from the run without it as the example says.
   tc::test::TempDir dir;
   std::string out;
   tc::Mesh m = tc::test::cube_tets(4);
   tc::Field f{"f", 1, {}};
-  for (int64_t v = 0; v < m.num_vertices(); ++v) f.values.push_back(m.points[3 * v]);
+  for (int64_t v = 0; v < m.num_vertices(); ++v) f.values.push_back(m.points[3 * v] * m.points[3 * v]);
   m.vertex_fields.push_back(f);
   const std::string in = dir.file("cube.vtu"), result = dir.file("o.vtu");
   tc::write_mesh(in, m);
   const std::string ex = std::string(TC_SOURCE_DIR) + "/examples/user_functions/";
   const std::string run = cli() + " " + q(in) + " " + q(result) + " -q --check ";
-  ASSERT_EQ(run_command(run + "--cost-cl " + q(ex + "field_cost.cl") + " --target-length 0.3", &out), 0) << out;
-  EXPECT_LT(tc::read_mesh(result).num_tets(), m.num_tets());
+  auto tets_after = [&](const std::string& options) {
+    EXPECT_EQ(run_command(run + options, &out), 0) << options << ": " << out;
+    return tc::read_mesh(result).num_tets();
+  };
+  // the cost: the length weighted up where f changes, so fewer edges are short enough
+  const int64_t plain = tets_after("--target-length 0.3");
+  EXPECT_LT(plain, m.num_tets());
+  EXPECT_GT(tets_after("--cost-cl " + q(ex + "field_cost.cl") + " --target-length 0.3"), plain);
 
-  ASSERT_EQ(run_command(run + "--placement-cl " + q(ex + "keep_extremum.cl") + " --boundary free --min-quality 0",
-                        &out),
-            0)
-      << out;
-  const tc::Mesh kept = tc::read_mesh(result);
-  EXPECT_LT(kept.num_tets(), m.num_tets());
-  std::map<tc::test::Point3, double> value_at;
-  for (int64_t v = 0; v < m.num_vertices(); ++v)
-    value_at[{m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]}] = f.values[size_t(v)];
-  ASSERT_EQ(kept.vertex_fields.size(), 1u);
-  for (int64_t v = 0; v < kept.num_vertices(); ++v) {
-    auto it = value_at.find({kept.points[3 * v], kept.points[3 * v + 1], kept.points[3 * v + 2]});
-    ASSERT_TRUE(it != value_at.end()) << "vertex " << v << " at a new place";
-    EXPECT_EQ(kept.vertex_fields[0].values[size_t(v)], it->second);
-  }
+  // the placement: every survivor keeps the larger value of f with its place (or the midpoint
+  // between equal values), so f = x^2 still holds at every vertex; the midpoint breaks it
+  auto x2_holds = [&](const tc::Mesh& r) {
+    int broken = 0;
+    for (int64_t v = 0; v < r.num_vertices(); ++v)
+      broken += r.vertex_fields.at(0).values[size_t(v)] != r.points[3 * v] * r.points[3 * v];
+    return broken == 0;
+  };
+  EXPECT_LT(tets_after("--boundary free --min-quality 0"), m.num_tets());
+  EXPECT_FALSE(x2_holds(tc::read_mesh(result)));
+  EXPECT_LT(tets_after("--placement-cl " + q(ex + "keep_maximum.cl") + " --boundary free --min-quality 0"),
+            m.num_tets());
+  EXPECT_TRUE(x2_holds(tc::read_mesh(result)));
 
-  ASSERT_EQ(run_command(run + "--predicate-cl " + q(ex + "below_plane.cl") + " --target-length 0.5", &out), 0) << out;
-  const tc::Mesh below = tc::read_mesh(result);
-  EXPECT_LT(below.num_tets(), m.num_tets());
-  const std::set<tc::test::Point3> after = tc::test::vertex_positions(below);
+  // the predicate: every vertex at z >= 0.5 stays
+  EXPECT_LT(tets_after("--predicate-cl " + q(ex + "below_plane.cl") + " --target-length 0.5"), m.num_tets());
+  const std::set<tc::test::Point3> after = tc::test::vertex_positions(tc::read_mesh(result));
   for (const tc::test::Point3& p : tc::test::vertex_positions(m))
     if (std::get<2>(p) >= 0.5) {
       EXPECT_TRUE(after.count(p)) << "z " << std::get<2>(p);

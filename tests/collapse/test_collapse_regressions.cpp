@@ -153,8 +153,8 @@ TEST(CollapseRegressions, FlatteningDoesNotPushTheSurfaceIntoAnotherBody) {
     tc::Context ctx;
     const tc::CollapseReport report = tc::collapse(out, opt, ctx);
     // The guard refused in iteration 0, which selected again: its stats count the tests of both
-    // selections (the refused edge was tested in the first, and an edge of the last selection
-    // was tested in one of them), and passed_q is the first's.
+    // selections (the refused edge was tested in the first, the second tests only edges left
+    // untested), and passed_q is the first's.
     ASSERT_FALSE(report.iterations.empty());
     const tc::IterationStats& s0 = report.iterations[0];
     EXPECT_EQ(s0.collapsed, 0);
