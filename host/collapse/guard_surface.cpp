@@ -64,8 +64,9 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   const cl::Buffer& labels = dm.labels[0].buffer();
   launch(ctx, p, "sguard_queries", c.ne, cl_uint(c.ne), c.edges.buffer(), s.fin.buffer(), s.dir.buffer(),
-         dm.points.buffer(), dm.vfields.buffer(), cl_uint(dm.vfield_comps), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
-         c.vflags.buffer(), qedge.buffer(), qbox.buffer(), qntri.buffer(), qcount.buffer());
+         dm.points.buffer(), dm.vfields.buffer(), cl_uint(dm.vfield_comps), dm.tets.buffer(), c.vt_off.buffer(),
+         c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels, c.vflags.buffer(), qedge.buffer(), qbox.buffer(),
+         qntri.buffer(), qcount.buffer());
   uint32_t nq = 0;
   qcount.download(&nq, 1);
   last_queries = nq;
@@ -84,8 +85,9 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   ensure_nonempty(tplane, ctx, size_t(ntri) * 5);
   ensure_nonempty(qrep, ctx, size_t(nq) * 2);
   launch(ctx, p, "sguard_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(), s.dir.buffer(),
-         dm.points.buffer(), dm.vfields.buffer(), cl_uint(dm.vfield_comps), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels,
-         tid.buffer(), tpos.buffer(), tbox.buffer(), tplane.buffer(), qrep.buffer());
+         dm.points.buffer(), dm.vfields.buffer(), cl_uint(dm.vfield_comps), dm.tets.buffer(), c.vt_off.buffer(),
+         c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels, tid.buffer(), tpos.buffer(), tbox.buffer(),
+         tplane.buffer(), qrep.buffer());
 
   // The grid: cells twice the median query box (most boxes span <= 2 cells per axis, the large
   // ones are entered in every cell they span), at most kMaxCellsPerAxis per axis.

@@ -54,6 +54,18 @@ uint32_t scan_offsets(Context& ctx, DeviceBuffer<uint32_t>& counts, DeviceBuffer
 
 const cl::Buffer& primary_labels(DeviceMesh& dm) { return dm.labels[0].buffer(); }
 
+// Kernel `name` of the stage file `file` compiled after the user's OpenCL C `user`, with the
+// -D options `defines`: the shared helpers (which declare the user functions), the user's
+// source, the file. The Context caches programs by (name, options): the program's name (`what`,
+// also in build errors) carries a hash of the source.
+cl::Kernel user_kernel(Context& ctx, const std::string& what, const std::string& file, const char* name,
+                       const std::string& user, const std::string& defines) {
+  const std::string src = "#include \"collapse_common.h\"\n" + user + "\n#include \"" + file + "\"\n";
+  cl::Program& prog =
+      ctx.build(what + " (" + file + " " + std::to_string(std::hash<std::string>{}(src)) + ")", src, defines);
+  return detail::cl_call(("clCreateKernel(" + std::string(name) + ")").c_str(), [&] { return cl::Kernel(prog, name); });
+}
+
 // run() for the kernels that see the user's placement or predicate (stage_kernel).
 void run_stage(Context& ctx, const StageParams& p, const std::string& file, const char* name, size_t n,
                const auto&... args) {
@@ -99,14 +111,7 @@ StageParams params_from(const CollapseOptions& o) {
 
 cl::Kernel stage_kernel(Context& ctx, const StageParams& p, const std::string& file, const char* name) {
   if (p.user_source.empty()) return ctx.kernel(file, name);
-  // the helpers (with the user functions' prototypes), the user's source, the stage's kernels;
-  // the Context caches programs by (name, options): the name carries a hash of the source
-  const std::string src = "#include \"collapse_common.h\"\n" + p.user_source + "\n#include \"" + file + "\"\n";
-  const std::string program =
-      file + " with user placement / predicate (" + std::to_string(std::hash<std::string>{}(src)) + ")";
-  cl::Program& prog = ctx.build(program, src, p.user_defines);
-  return detail::cl_call(("clCreateKernel(" + std::string(name) + ")").c_str(),
-                         [&] { return cl::Kernel(prog, name); });
+  return user_kernel(ctx, "user placement / predicate", file, name, p.user_source, p.user_defines);
 }
 
 void check_collapse_input(const Mesh& mesh) {
@@ -363,28 +368,15 @@ uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   s.counters.fill(0);
   ensure(s.cost, ctx, c.ne);
   ensure(s.marked, ctx, c.ne);
-  cl::Kernel k;
-  if (p.cost_source.empty()) {
-    k = ctx.kernel("collapse_cost.cl", "cost_and_mark");
-  } else {
-    // the user's function between the shared helpers and the kernel (see collapse_cost.cl)
-    const std::string src = "#include \"collapse_common.h\"\n#line 1 \"cost_cl_source\"\n" + p.cost_source +
-                            "\n#include \"collapse_cost.cl\"\n";
-    // Context caches programs by (name, options): the name carries a hash of the source
-    const std::string name = "user cost (cost_cl_source " + std::to_string(std::hash<std::string>{}(src)) + ")";
-    cl::Program& prog = ctx.build(name, src, "-DTCC_USER_COST");
-    k = detail::cl_call("clCreateKernel(cost_and_mark)", [&] { return cl::Kernel(prog, "cost_and_mark"); });
-  }
+  // with a user cost, its function comes before the kernel (see collapse_cost.cl)
+  cl::Kernel k = p.cost_source.empty()
+                     ? ctx.kernel("collapse_cost.cl", "cost_and_mark")
+                     : user_kernel(ctx, "user cost", "collapse_cost.cl", "cost_and_mark",
+                                   "#line 1 \"cost_cl_source\"\n" + p.cost_source, "-DTCC_USER_COST");
   const cl_int mask_mode = dm.has_mask ? p.mask_mode : 0;
   set_args(k, "cost_and_mark", U(c.ne), B(c.edges), B(dm.points), B(dm.vfields), U(dm.vfield_comps),
            I(dm.vfield_comps > 0 ? 1 : 0), B(dm.vmask), mask_mode, p.target, B(s.cost), B(s.marked), B(s.counters));
-  auto t0 = std::chrono::steady_clock::now();
-  ctx.launch(k, c.ne, "cost_and_mark");
-  if (kProfile) {
-    ctx.finish();
-    std::fprintf(stderr, "  %-28s n=%-9u %8.4f s\n", "cost_and_mark", c.ne,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
+  launch_profiled(ctx, k, "cost_and_mark", c.ne);
   return counter(s, 0);
 }
 
