@@ -54,15 +54,11 @@ inline int tcc_ring_has(__global const int* tets, __global const uint* vt_off, _
 /* Predicate Q (tcc_predicate_q): shared with the sequential CPU method. */
 #include "collapse_predicate.h"
 
-/* The link condition and the volume test of the edge (a, b), a < b, which passed Q with the
- * direction bits dir; returns TCC_OK or the refusal (TCC_REFUSED_LINK / TCC_REFUSED_VOLUME). */
-inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int dir, __global const int* tets,
-                                 __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
-                                 __global const uint* nb_off,
-                                 __global const int* nb, __global const int* nb_edge, __global const int* labels,
-                                 int use_labels, __global const double* pts, __global const double* vfield,
-                                 uint vfield_stride, __global const uchar* vflags, __global const uchar* eflags,
-                                 double eps_v, double q_min, __global const double* tet_quality) {
+/* The volume test (and the quality guard) of the edge (a, b), a < b, which passed Q with the
+ * direction bits dir: TCC_OK, TCC_REFUSED_VOLUME or TCC_REFUSED_QUALITY. */
+inline uchar tcc_volume_test(int a, int b, int dir, __global const int* tets, __global const uint* vt_off,
+                             __global const int* vt, __global const double* pts, __global const double* vfield,
+                             uint vfield_stride, double eps_v, double q_min, __global const double* tet_quality) {
   /* --- volumes after the tentative collapse (first: cheaper, and it refuses more edges) --- */
   double3 p = tcc_placement(pts, vfield, vfield_stride, a, b, (uint)dir);
 #ifdef TCC_USER_PLACEMENT
@@ -115,7 +111,15 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
     }
   }
   if (q_min > 0.0 && q_new < (q_old < q_min ? q_old : q_min)) return TCC_REFUSED_QUALITY;
+  return TCC_OK;
+}
 
+/* The link condition of the edge (a, b), a < b: TCC_OK or TCC_REFUSED_LINK. */
+inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global const int* tets,
+                           __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
+                           __global const uint* nb_off, __global const int* nb, __global const int* nb_edge,
+                           __global const int* labels, int use_labels, __global const uchar* vflags,
+                           __global const uchar* eflags) {
   /* --- link condition --- */
   /* cn: the common neighbours of a and b, with the edges (a, cn[k]) and (b, cn[k]) (one more
    * slot: the merge writes at ncn before it knows whether it keeps the entry); (pc, pd): the
@@ -236,6 +240,21 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
   return ok ? TCC_OK : TCC_REFUSED_LINK;
 }
 
+/* The volume test, then the link condition (tcc_volume_test, tcc_link_test); returns TCC_OK or
+ * the first refusal. */
+inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int dir, __global const int* tets,
+                                 __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
+                                 __global const uint* nb_off,
+                                 __global const int* nb, __global const int* nb_edge, __global const int* labels,
+                                 int use_labels, __global const double* pts, __global const double* vfield,
+                                 uint vfield_stride, __global const uchar* vflags, __global const uchar* eflags,
+                                 double eps_v, double q_min, __global const double* tet_quality) {
+  uchar r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tet_quality);
+  if (r != TCC_OK) return r;
+  return tcc_link_test(a, b, fa, fb, fe, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, vflags,
+                       eflags);
+}
+
 /* tet_quality[t] = tc_tet_quality of tet t (the quality guard's "before", once per iteration
  * instead of once per test that looks at t). With only_missing, the entries carried through
  * the compaction (tet_quality_carry) are kept and only those marked -1 are computed. */
@@ -335,7 +354,7 @@ inline uint tcc_lazy_init_edge(uint e, __global const int* edges, __global const
     return 0u;
   }
   uchar r = verdict[e];
-  if (r != TCC_VERDICT_UNKNOWN && r != TCC_OK) {
+  if (r != TCC_VERDICT_UNKNOWN && r != TCC_OK && r != TCC_VOLUME_OK) {
     reason[e] = r;
     return 1u;
   }
@@ -379,19 +398,48 @@ __kernel void lazy_init(uint ne, __global const int* edges, __global const uint*
 
 /* The turn of edge e in the lazy filter: its link and volume tests (or the verdict carried
  * from an earlier iteration), then IN (vaff of both end points; returns 1) or OUT (0). */
-inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
-                            TCC_TEST_PARAMS) {
-  int a = edges[2 * e], b = edges[2 * e + 1];
+/* The verdict of the link and volume tests of edge e = (a, b) in direction *dir (set here):
+ * the one kept from an earlier test (carried from an earlier iteration: the rings of a and b
+ * are unchanged since), else a new test, kept in verdict[] and counted in counters[4]. */
+inline uchar tcc_lazy_verdict(int e, int a, int b, int* dir_out, TCC_TEST_PARAMS) {
   uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
   int dir = tcc_user_dir(tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule), fa, fb, mode);
-  /* a verdict carried from an earlier iteration (the rings of a and b are unchanged since) */
+  *dir_out = dir;
   uchar r = verdict[e];
   if (r == TCC_VERDICT_UNKNOWN) {
     r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts,
                             vfield, vfield_stride, vflags, eflags, eps_v, q_min, tet_quality);
     verdict[e] = r;
     atomic_inc(&counters[4]);
+  } else if (r == TCC_VOLUME_OK) { /* the volume test passed earlier (tcc_lazy_volume) */
+    r = tcc_link_test(a, b, fa, fb, fe, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, vflags,
+                      eflags);
+    verdict[e] = r;
   }
+  return r;
+}
+
+/* The volume test alone (the cheaper part, and the one that refuses most edges), for an edge
+ * whose verdict may be needed only later: kept as TCC_VOLUME_OK when it passes (the link
+ * condition is then tested by tcc_lazy_verdict). Returns whether the edge is not refused. */
+inline int tcc_lazy_volume(int e, int a, int b, TCC_TEST_PARAMS) {
+  uchar r = verdict[e];
+  if (r == TCC_VERDICT_UNKNOWN) {
+    uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
+    int dir = tcc_user_dir(tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule), fa, fb, mode);
+    r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tet_quality);
+    if (r == TCC_OK) r = TCC_VOLUME_OK;
+    verdict[e] = r;
+    atomic_inc(&counters[4]);
+  }
+  return r == TCC_OK || r == TCC_VOLUME_OK;
+}
+
+inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
+                            TCC_TEST_PARAMS) {
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  int dir;
+  uchar r = tcc_lazy_verdict(e, a, b, &dir, TCC_TEST_ARGS);
   reason[e] = r;
   if (r == TCC_OK) {
     edge_dir[e] = (uchar)dir;
@@ -481,6 +529,22 @@ inline void tcc_p1_turn(int v, __global const int* edges, __global const int* sl
   if (verdict[m] == TCC_VERDICT_UNKNOWN) atomic_inc(untested);
 }
 
+/* The vertex part of a round run in one work-group (lazy_p1_loop, greedy_loop): the slots of
+ * the nd listed vertices anew, then the edges now first at both end points to the next turn
+ * list; a barrier after each. */
+inline void tcc_p1_vertex_part(uint nd, __global const uint* dlist, __global const uint* nb_off,
+                               __global const int* nb_edge, __global const uchar* state,
+                               __global const double* order, __global int* slot, __global const int* edges,
+                               __global uint* tnext, __global uint* cnext, volatile __global uint* queued, uint round,
+                               __global const uchar* verdict, __global uint* untested) {
+  const uint lid = get_local_id(0), ls = get_local_size(0);
+  for (uint i = lid; i < nd; i += ls) tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, order, slot);
+  barrier(CLK_GLOBAL_MEM_FENCE);
+  for (uint i = lid; i < nd; i += ls)
+    tcc_p1_turn((int)dlist[i], edges, slot, tnext, cnext, queued, round + 1, verdict, untested);
+  barrier(CLK_GLOBAL_MEM_FENCE);
+}
+
 /* Per-round kernels: cnt[0], cnt[1] count the two turn lists, cnt[2] the vertex list, cnt[3]
  * the edges of the new turn list that will be tested (no carried verdict). */
 __kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const int* edges, __global uchar* state,
@@ -551,12 +615,8 @@ __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __glo
     for (uint i = lid; i < n; i += ls)
       tcc_p1_decide((int)tl[i], edges, state, vaff, slot, dlist, cnt + 2, TCC_TEST_ARGS);
     barrier(CLK_GLOBAL_MEM_FENCE);
-    const uint nd = cnt[2];
-    for (uint i = lid; i < nd; i += ls) tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, cost, slot);
-    barrier(CLK_GLOBAL_MEM_FENCE);
-    for (uint i = lid; i < nd; i += ls)
-      tcc_p1_turn((int)dlist[i], edges, slot, tnext, cnext, queued, round + 1, verdict, cnt + 3);
-    barrier(CLK_GLOBAL_MEM_FENCE);
+    tcc_p1_vertex_part(cnt[2], dlist, nb_off, nb_edge, state, cost, slot, edges, tnext, cnext, queued, round, verdict,
+                       cnt + 3);
     n = *cnext;
     const uint untested = cnt[3];
     barrier(CLK_GLOBAL_MEM_FENCE);
@@ -577,4 +637,200 @@ __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __glo
     }
     barrier(CLK_GLOBAL_MEM_FENCE);
   }
+}
+
+/* ---- The greedy selection (tc::CollapseOptions::Greedy) ----
+ *
+ * One selection in place of the lazy pass 1 and conflict pass 2: the greedy independent set, in
+ * priority order (prio, then index), of the candidates of lazy_init under the conflicts of both
+ * passes at once. Two edges conflict when they touch a common tet, i.e. when an end point of
+ * one is an end point or a neighbour of an end point of the other (pass 1's conflicts, a shared
+ * end point, are a part of these). Edge e = (a, b) is taken when it passes the tests and comes
+ * before every undecided candidate within reach (an end point in N[a] or N[b], N[x] = x and its
+ * neighbours); taking it makes every undecided edge within reach OUT. As in the conflict passes
+ * (collapse_conflict.cl), a decision depends only on final decisions of edges before it, so the
+ * result is the one of taking the edges one after another in priority order, whatever the
+ * order of the work items.
+ *
+ * The two-pass detection keeps a set of the same kind, but chooses it among pass 1's winners
+ * only (an edge that lost pass 1 to an edge that then lost pass 2 is not taken), and tests every
+ * pass-1 winner although most of them lose pass 2. W1's first iteration: two-pass 57,736 tests,
+ * 42,055 pass-1 winners, 8,843 collapses; greedy 30,915 tests (the volume part only for most),
+ * 10,095 collapses.
+ *
+ * Driven, as lazy pass 1, by the vertices where something was decided: slot[x] is the first
+ * undecided candidate at x (lazy_init's claims, then tcc_p1_recompute), and an edge first at
+ * both end points is in the turn list. A round:
+ *   greedy_decide  each turn-list edge: the volume test (tcc_lazy_volume; a refusal is OUT at
+ *                  once, which frees the way for the edges after it without waiting for its
+ *                  turn); then the slots over N(a) and N(b): one holding an edge before e
+ *                  (blocker[e]) makes e wait, and e is looked at again only once that edge is
+ *                  decided; else e is first within reach: the link condition (tcc_lazy_decide),
+ *                  IN (listed for greedy_block) or OUT. A waiting edge goes to the next turn
+ *                  list. Edges deciding in one round are pairwise free of conflicts (each comes
+ *                  first within reach of the other), so their writes do not race;
+ *   greedy_block   every undecided edge within reach of an edge taken this round is OUT, and
+ *                  the vertices whose slot it held are listed (vstamp: once per round);
+ *   lazy_p1_recompute and lazy_p1_turns (above) over the listed vertices: their slots anew, and
+ *                  the edges now first at both end points go to the next turn list.
+ * Slots change only in lazy_p1_recompute, states in greedy_decide (of its own edges) and
+ * greedy_block, so every read within a kernel sees the values of the round's start; blocker[]
+ * is only a hint of when to look again. Once the turn list is short the rounds run in one
+ * work-group (greedy_loop).
+ *
+ * cnt[]: [0], [1] the two turn lists, [2] the vertex list, [3] (lazy_p1_turns: turn-list edges
+ * without a verdict, unused here), [4] the edges taken this round. */
+
+/* The priority with levels > 0: the cost in `levels` steps per target length and, within a
+ * step, an order that is a bijective hash of the index. In the exact (cost, index) order the
+ * turns follow chains of slowly growing cost and W1's first iteration takes ~200 rounds; in 64
+ * steps ~25, and it takes as many edges within 2% (a simulation of the greedy without the tests:
+ * 10,843 exact, 10,626 in 64 steps, 10,292 in 16). Unmarked edges keep their cost. */
+__kernel void greedy_priority(uint ne, __global const double* cost, __global const uint* marked, double target,
+                              double levels, __global double* prio) {
+  uint e = get_global_id(0);
+  if (e >= ne) return;
+  double c = cost[e];
+  prio[e] = marked[e] ? floor(c / target * levels) + (double)(e * 2654435761u) * (1.0 / 4294967296.0) : c;
+}
+
+inline void tcc_greedy_list_vertex(int v, volatile __global uint* vstamp, uint round, __global uint* dlist,
+                                   __global uint* dn) {
+  if (atomic_xchg(vstamp + v, round) != round) dlist[atomic_inc(dn)] = (uint)v;
+}
+
+inline void tcc_greedy_decide(int e, __global const int* edges, __global const double* prio,
+                              __global const int* slot, __global int* blocker, __global uint* tnext,
+                              __global uint* tn, volatile __global uint* queued, uint round, __global uint* inlist,
+                              __global uint* in_n, volatile __global uint* vstamp, __global uint* dlist,
+                              __global uint* dn, __global uchar* state, __global int* vaff, TCC_TEST_PARAMS) {
+  if (state[e] != TCC_UNDECIDED) return; /* OUT by greedy_block */
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  int f = blocker[e];
+  int wait = f >= 0 && state[f] == TCC_UNDECIDED;
+  if (!wait) {
+    if (tcc_lazy_volume(e, a, b, TCC_TEST_ARGS)) {
+      f = -1; /* the first slot over N(a) and N(b) holding an edge before e, if any */
+      for (int s = 0; s < 2 && f < 0; ++s) {
+        int x = s == 0 ? a : b;
+        for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) {
+          int g = slot[nb[j]];
+          if (g >= 0 && g != e && tcc_before(prio, g, e)) {
+            f = g;
+            break;
+          }
+        }
+      }
+      blocker[e] = f;
+      wait = f >= 0;
+    }
+    if (!wait) {
+      if (tcc_lazy_decide(e, edges, state, vaff, TCC_TEST_ARGS)) {
+        inlist[atomic_inc(in_n)] = (uint)e;
+      } else { /* refused: a and b need their next edge */
+        tcc_greedy_list_vertex(a, vstamp, round, dlist, dn);
+        tcc_greedy_list_vertex(b, vstamp, round, dlist, dn);
+      }
+      return;
+    }
+  }
+  if (atomic_xchg(queued + e, round + 1) != round + 1) tnext[atomic_inc(tn)] = (uint)e;
+}
+
+__kernel void greedy_decide(uint n, uint cur, __global const uint* tlist, __global uint* tnext, __global uint* cnt,
+                            __global const int* edges, __global const double* prio, __global const int* slot,
+                            __global int* blocker, volatile __global uint* queued, uint round, __global uint* inlist,
+                            volatile __global uint* vstamp, __global uint* dlist, __global uchar* state,
+                            __global int* vaff, TCC_TEST_PARAMS) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  tcc_greedy_decide((int)tlist[i], edges, prio, slot, blocker, tnext, cnt + (1 - cur), queued, round, inlist, cnt + 4,
+                    vstamp, dlist, cnt + 2, state, vaff, TCC_TEST_ARGS);
+}
+
+/* The edge e taken: every undecided edge with an end point in N[a] or N[b] is OUT; the vertices
+ * whose slot held an edge made OUT are listed. */
+inline void tcc_greedy_block(int e, __global const int* edges, __global const uint* nb_off, __global const int* nb,
+                             __global const int* nb_edge, __global const int* slot, volatile __global uint* vstamp,
+                             uint round, __global uint* dlist, __global uint* dn, __global uchar* state) {
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  for (int s = 0; s < 2; ++s) {
+    int x = s == 0 ? a : b;
+    for (uint k = nb_off[x]; k <= nb_off[x + 1]; ++k) { /* N(x), then x */
+      int z = k == nb_off[x + 1] ? x : nb[k];
+      if (slot[z] >= 0) tcc_greedy_list_vertex(z, vstamp, round, dlist, dn);
+      for (uint j = nb_off[z]; j < nb_off[z + 1]; ++j) {
+        int g = nb_edge[j];
+        if (state[g] != TCC_UNDECIDED) continue;
+        state[g] = TCC_OUT; /* two taken edges may both do this: the same write */
+        int u = nb[j];
+        if (slot[u] == g) tcc_greedy_list_vertex(u, vstamp, round, dlist, dn);
+      }
+    }
+  }
+}
+
+__kernel void greedy_block(__global const uint* inlist, __global uint* cnt, __global const int* edges,
+                           __global const uint* nb_off, __global const int* nb, __global const int* nb_edge,
+                           __global const int* slot, volatile __global uint* vstamp, uint round, __global uint* dlist,
+                           __global uchar* state) {
+  uint i = get_global_id(0);
+  if (i >= cnt[4]) return;
+  tcc_greedy_block((int)inlist[i], edges, nb_off, nb, nb_edge, slot, vstamp, round, dlist, cnt + 2, state);
+}
+
+/* The remaining rounds in one work-group, once the turn list is short (a round then costs
+ * barriers instead of four launches and two read-backs). Entry: the n edges of turn list `cur`
+ * (t0 or t1) are round `round`'s; cnt[] is 0. When a new turn list is longer than max_n, the
+ * loop stops and leaves resume[0..2] = (its length, its list, its round) for the host's
+ * per-round kernels; resume[0] stays 0 when every round is done. */
+__kernel void greedy_loop(uint n, int cur, uint round, __global uint* t0, __global uint* t1, __global uint* cnt,
+                          __global const int* edges, __global const double* prio, __global int* slot,
+                          __global int* blocker, volatile __global uint* queued, __global uint* inlist,
+                          volatile __global uint* vstamp, __global uint* dlist, __global uchar* state,
+                          __global int* vaff, uint max_n, __global uint* resume, TCC_TEST_PARAMS) {
+  const uint lid = get_local_id(0), ls = get_local_size(0);
+  while (n > 0) {
+    __global uint* tl = cur ? t1 : t0;
+    __global uint* tnext = cur ? t0 : t1;
+    __global uint* cnext = cnt + (1 - cur);
+    for (uint i = lid; i < n; i += ls)
+      tcc_greedy_decide((int)tl[i], edges, prio, slot, blocker, tnext, cnext, queued, round, inlist, cnt + 4, vstamp,
+                        dlist, cnt + 2, state, vaff, TCC_TEST_ARGS);
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    const uint nin = cnt[4];
+    for (uint i = lid; i < nin; i += ls)
+      tcc_greedy_block((int)inlist[i], edges, nb_off, nb, nb_edge, slot, vstamp, round, dlist, cnt + 2, state);
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    tcc_p1_vertex_part(cnt[2], dlist, nb_off, nb_edge, state, prio, slot, edges, tnext, cnext, queued, round, verdict,
+                       cnt + 3);
+    n = *cnext;
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    cur = 1 - cur;
+    ++round;
+    if (n > max_n) { /* the same value in every work item: a uniform exit */
+      if (lid == 0) {
+        resume[0] = n;
+        resume[1] = (uint)cur;
+        resume[2] = round;
+      }
+      return;
+    }
+    if (lid == 0) cnt[0] = cnt[1] = cnt[2] = cnt[3] = cnt[4] = 0;
+    barrier(CLK_GLOBAL_MEM_FENCE);
+  }
+}
+
+/* After the greedy selection: p1 = fin = IN, counted in counters[2] and counters[3]. */
+__kernel void greedy_finish(uint ne, __global const uchar* state, __global uint* p1, __global uint* fin,
+                            __global uint* counters) {
+  __local uint group_in;
+  uint e = get_global_id(0);
+  uint in = e < ne && state[e] == TCC_IN;
+  if (e < ne) {
+    p1[e] = in;
+    fin[e] = in;
+  }
+  tcc_group_count(in, &group_in, &counters[2]);
+  if (get_local_id(0) == 0 && group_in) atomic_add(&counters[3], group_in);
 }

@@ -36,6 +36,7 @@ METHOD_ARGS = {
     "parallel": [],
     "sequential": ["--method", "sequential"],
     "atomic-min": ["--conflicts", "atomic-min"],
+    "two-pass": ["--conflicts", "two-pass"],
 }
 TIMEOUT_S = 900
 

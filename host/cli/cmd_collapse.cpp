@@ -26,7 +26,7 @@ struct CollapseCli {
   OutputOptions output;
   CollapseOptions opt;
   double target_length = 0, target_factor = 0;
-  std::string boundary = "features", method = "parallel", conflicts = "two-pass";
+  std::string boundary = "features", method = "parallel", conflicts = "greedy";
   std::string region, sizing_field, labels, cost_cl, placement_cl, predicate_cl, device, stats;
   bool check = false, quiet = false, no_labels = false, no_spatial_order = false;
 };
@@ -231,9 +231,16 @@ void register_collapse(CLI::App& app, int& exit_code) {
                "Sequential method: skip (until the next iteration) an edge whose star an earlier\n"
                "collapse of the iteration changed, as the paper's baseline; default: re-check it");
   app.add_option("--conflicts", c->conflicts,
-                 "Conflict detection of the parallel method: two-pass (default, the paper's) or\n"
-                 "atomic-min (Gautron and Kenzel 2023; needs 64-bit atomics on the device)")
-      ->check(CLI::IsMember({"two-pass", "atomic-min"}));
+                 "Conflict detection of the parallel method: greedy (default: one selection under both\n"
+                 "of the paper's conflict rules, the edges taken in cost order), two-pass (the paper's\n"
+                 "pass 1 over edges, then pass 2 over tets) or atomic-min (Gautron and Kenzel 2023;\n"
+                 "needs 64-bit atomics on the device)")
+      ->check(CLI::IsMember({"greedy", "two-pass", "atomic-min"}));
+  app.add_option("--priority-levels", c->opt.priority_levels,
+                 "Greedy conflicts: edges are ordered by their cost in steps of target / N, and within a\n"
+                 "step in a fixed pseudo-random order (default 64; 0: exact cost order, many more\n"
+                 "parallel rounds)")
+      ->check(CLI::NonNegativeNumber);
   app.add_flag("--no-spatial-order", c->no_spatial_order,
                "Parallel method: keep the input's numbering on the device (default: vertices along a\n"
                "Morton curve, tets by their smallest vertex, for memory locality; the output then\n"
@@ -272,7 +279,9 @@ void register_collapse(CLI::App& app, int& exit_code) {
     opt.use_labels = !c->no_labels;
     opt.spatial_order = !c->no_spatial_order;
     opt.method = c->method == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
-    opt.conflicts = c->conflicts == "atomic-min" ? CollapseOptions::AtomicMin : CollapseOptions::TwoPass;
+    opt.conflicts = c->conflicts == "atomic-min" ? CollapseOptions::AtomicMin
+                    : c->conflicts == "two-pass" ? CollapseOptions::TwoPass
+                                                 : CollapseOptions::Greedy;
     if (opt.method == CollapseOptions::Sequential && !c->device.empty())
       throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
     if (opt.method == CollapseOptions::Sequential)

@@ -109,7 +109,7 @@ double host_tail_fraction(const CollapseOptions& o, const DeviceInfo& device) {
 // host_tail_min_iterations more iterations (a tail that dies out fast, r ~0.6, is cheaper on
 // the device than the host's fixed cost). Counts only: the choice is deterministic.
 bool host_tail_due(const CollapseOptions& o, double fraction, const std::vector<IterationStats>& its) {
-  if (!(fraction > 0) || o.conflicts != CollapseOptions::TwoPass || o.eps_c > 1 || o.has_user_functions() ||
+  if (!(fraction > 0) || o.conflicts == CollapseOptions::AtomicMin || o.eps_c > 1 || o.has_user_functions() ||
       its.size() < 2)
     return false;
   const IterationStats& s = its.back();
@@ -158,6 +158,8 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   if (options.selection_rounds < 1) throw std::invalid_argument("selection_rounds must be >= 1");
   if (options.selection_rounds > 1 && options.conflicts != CollapseOptions::TwoPass)
     throw std::invalid_argument("selection_rounds > 1 needs the two-pass conflict detection");
+  if (!(options.priority_levels >= 0) || !std::isfinite(options.priority_levels))
+    throw std::invalid_argument("priority_levels must be finite and >= 0");
   if (!options.cost_cl_source.empty() && !(options.target_length > 0))
     throw std::invalid_argument("a user cost (cost_cl_source) needs an explicit target_length > 0");
   if (!(options.target_length > 0) && !(options.target_factor > 0))
@@ -234,6 +236,15 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
         s.seconds_admissible += t4 - t_sel;
         t_sel = t4;
         s.after_pass2 = s.after_pass1 = conflicts_atomic_min(ctx, dm, conn, st);
+      } else if (options.conflicts == CollapseOptions::Greedy) {
+        // lazy filter and both passes' conflicts in one selection
+        uint32_t passed_q = 0, tested = 0;
+        s.after_pass2 = s.after_pass1 = s.admissible = greedy_selection(ctx, dm, conn, st, p, passed_q, tested);
+        if (first) s.passed_q = passed_q;
+        s.tested += tested;
+        const double t4 = now();
+        s.seconds_admissible += t4 - t_sel;
+        t_sel = t4;
       } else {
         uint32_t passed_q = 0, tested = 0;
         s.after_pass1 = lazy_admissible_pass1(ctx, dm, conn, st, p, passed_q, tested);

@@ -95,6 +95,7 @@ StageParams params_from(const CollapseOptions& o) {
   p.eps_r = o.eps_r;
   p.eps_v = o.eps_v;
   p.min_quality = o.min_quality;
+  p.priority_levels = o.priority_levels;
   p.mask_mode = o.vertex_mask.empty() ? 0 : o.mask_either ? 2 : 1;
   p.cost_source = o.cost_cl_source;
   // (#line: the compiler's messages give the line in the user's source, under its option's name)
@@ -593,8 +594,12 @@ uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
   return counter(s, 2);
 }
 
-uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
-                               uint32_t& passed_q, uint32_t& tested) {
+namespace {
+// The start shared by the lazy filter and the greedy selection: buffers, the verdicts, lazy_init
+// (candidates, Q, carried refusals, the first claims in s.slot[0] in the order of `order`), and
+// the test's arguments of each kernel of `tests` (from the given argument index on).
+void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                const DeviceBuffer<double>& order, std::initializer_list<std::pair<cl::Kernel*, cl_uint>> tests) {
   const std::string A = "collapse_admissible.cl";
   ensure(s.dir, ctx, c.ne);
   ensure(s.reason, ctx, c.ne);
@@ -615,15 +620,22 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   run_stage(ctx, p, A, "lazy_init", c.ne, U(c.ne), B(c.edges), B(s.marked), B(c.vflags), B(c.vclass), B(c.eflags),
             mode, paper_rule, B(dm.points), B(dm.vfields), U(dm.vfield_comps), B(s.state), B(s.dir), B(s.reason),
             B(s.cand), B(s.counters), cl_int(restrict_clean ? 1 : 0), restrict_clean ? B(s.vdirty) : B(c.vflags),
-            B(s.verdict), B(s.cost), B(s.slot[0]));
-  // the test's arguments, the same for the per-round kernel and the one-work-group loop
-  cl::Kernel decide = stage_kernel(ctx, p, A, "lazy_p1_decide"), loop = stage_kernel(ctx, p, A, "lazy_p1_loop");
+            B(s.verdict), B(order), B(s.slot[0]));
   const cl::Buffer& quality = tet_qualities(ctx, dm, c, s, p);
-  for (auto [k, first] : {std::pair<cl::Kernel*, cl_uint>{&decide, 8}, {&loop, 15}})
-    set_args_from(*k, first, "lazy_p1_decide", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb),
+  for (auto [k, first] : tests)
+    set_args_from(*k, first, "lazy filter test", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb),
                   B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(dm.vfields), U(dm.vfield_comps),
                   B(c.vflags), B(c.vclass), B(c.eflags), mode, paper_rule, p.eps_v, p.min_quality, quality, B(s.dir),
                   B(s.reason), B(s.counters), B(s.verdict));
+}
+}  // namespace
+
+uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                               uint32_t& passed_q, uint32_t& tested) {
+  const std::string A = "collapse_admissible.cl";
+  // the test's arguments, the same for the per-round kernel and the one-work-group loop
+  cl::Kernel decide = stage_kernel(ctx, p, A, "lazy_p1_decide"), loop = stage_kernel(ctx, p, A, "lazy_p1_loop");
+  lazy_start(ctx, dm, c, s, p, s.cost, {{&decide, 8}, {&loop, 15}});
   lazy_p1_rounds(ctx, s, c, decide, loop, p);
   run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1),
       B(s.vaff), B(s.counters));
@@ -632,6 +644,89 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   passed_q = cnt[5];
   tested = cnt[4];
   return cnt[2];
+}
+
+uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                          uint32_t& passed_q, uint32_t& tested) {
+  const std::string A = "collapse_admissible.cl";
+  cl::Kernel decide = stage_kernel(ctx, p, A, "greedy_decide"), loop = stage_kernel(ctx, p, A, "greedy_loop");
+  // the priority first: lazy_init claims the first slots in its order
+  const DeviceBuffer<double>* prio = &s.cost;
+  if (p.priority_levels > 0) {
+    ensure(s.prio, ctx, c.ne);
+    run(ctx, A, "greedy_priority", c.ne, "", U(c.ne), B(s.cost), B(s.marked), p.target, p.priority_levels,
+        B(s.prio));
+    prio = &s.prio;
+  }
+  lazy_start(ctx, dm, c, s, p, *prio, {{&decide, 16}, {&loop, 18}});
+  ensure(s.fin, ctx, c.ne);
+  ensure(s.blocker, ctx, c.ne);
+  ensure(s.queued, ctx, c.ne);
+  ensure(s.vstamp, ctx, dm.nv);
+  ensure(s.inlist, ctx, c.ne);
+  ensure(s.dlist, ctx, std::max<size_t>(dm.nv, 1));  // a vertex is listed at most once per round
+  ensure(s.work[0], ctx, c.ne);
+  ensure(s.work[1], ctx, c.ne);
+  ensure(s.work_n, ctx, 5);
+  ensure(s.resume, ctx, 3);
+  s.blocker.fill(-1);
+  s.queued.fill(0xffffffffu);
+  s.vstamp.fill(0xffffffffu);
+  s.work_n.fill(0);
+  run(ctx, A, "lazy_p1_first_turns", c.ne, "", U(c.ne), B(s.cand), B(c.edges), B(s.slot[0]), B(s.work[0]), B(s.work_n),
+      B(s.verdict));
+  uint32_t nt = 0;
+  s.work_n.download(&nt, 1);
+  cl::Kernel block = ctx.kernel(A, "greedy_block"), recompute = ctx.kernel(A, "lazy_p1_recompute"),
+             turns = ctx.kernel(A, "lazy_p1_turns");
+  int cur = 0;  // the turn list of this round
+  for (cl_uint round = 0; nt > 0; ++round) {
+    auto t0 = std::chrono::steady_clock::now();
+    s.work_n.fill(0);
+    const bool one_group = nt <= p.greedy_loop_size;
+    if (one_group) {
+      s.resume.fill(0);
+      set_args(loop, "greedy_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
+               B(*prio), B(s.slot[0]), B(s.blocker), B(s.queued), B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state),
+               B(s.vaff), U(p.greedy_loop_exit), B(s.resume));
+      ctx.launch(loop, ctx.group_size_for(loop), "greedy_loop");
+      uint32_t r[3];
+      s.resume.download(r, 3);
+      nt = r[0];  // 0: every round done; else the loop stopped before a long turn list
+      cur = int(r[1]);
+      round = r[2] - 1;
+    } else {
+      set_args_from(decide, 0, "greedy_decide", U(nt), cl_uint(cur), B(s.work[cur]), B(s.work[1 - cur]),
+                    B(s.work_n), B(c.edges), B(*prio), B(s.slot[0]), B(s.blocker), B(s.queued), round, B(s.inlist),
+                    B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff));
+      ctx.launch(decide, nt, "greedy_decide");
+      set_args(block, "greedy_block", B(s.inlist), B(s.work_n), B(c.edges), B(c.nb_off), B(c.nb), B(c.nb_edge),
+               B(s.slot[0]), B(s.vstamp), round, B(s.dlist), B(s.state));
+      ctx.launch(block, nt, "greedy_block");  // over the round's taken edges (cnt[4] <= nt)
+      uint32_t nd = 0;
+      s.work_n.download(&nd, 1, 2);
+      set_args(recompute, "lazy_p1_recompute", U(nd), B(s.dlist), B(c.nb_off), B(c.nb_edge), B(s.state), B(*prio),
+               B(s.slot[0]));
+      ctx.launch(recompute, nd, "lazy_p1_recompute");
+      set_args(turns, "lazy_p1_turns", U(nd), B(s.dlist), B(c.edges), B(s.slot[0]), B(s.work[1 - cur]), B(s.work_n),
+               cl_uint(1 - cur), B(s.queued), round + 1, B(s.verdict));
+      ctx.launch(turns, nd, "lazy_p1_turns");
+      s.work_n.download(&nt, 1, size_t(1 - cur));
+      cur = 1 - cur;
+    }
+    if (kProfile) {
+      ctx.finish();
+      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s%s\n", "greedy_round", nt,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                   one_group ? " (one work-group)" : "");
+    }
+  }
+  run(ctx, A, "greedy_finish", c.ne, "", U(c.ne), B(s.state), B(s.p1), B(s.fin), B(s.counters));
+  uint32_t cnt[6];
+  s.counters.download(cnt, 6);
+  passed_q = cnt[5];
+  tested = cnt[4];
+  return cnt[3];
 }
 
 uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s, uint32_t loop_size) {

@@ -62,6 +62,11 @@ struct EdgeState {
   DeviceBuffer<uint32_t> queued, dlist, resume;  // lazy pass 1: turn-list stamps, vertex list, loop exit
   DeviceBuffer<uint8_t> dir, reason;
   DeviceBuffer<int32_t> vaff;       // per vertex
+  // greedy selection (greedy_selection): the priority (levels > 0), per edge the edge it waits
+  // for, per vertex the round it was last listed, the edges taken in a round
+  DeviceBuffer<double> prio;
+  DeviceBuffer<int32_t> blocker;
+  DeviceBuffer<uint32_t> vstamp, inlist;
   // marked, admissible, pass1, pass2, tested (lazy), passed Q (lazy)
   DeviceBuffer<uint32_t> counters;
   // Verdicts of the link and volume tests kept across iterations (collapse_verdicts.cl):
@@ -133,6 +138,12 @@ struct StageParams {
   // (conflict_pass2's loop_size) once at most 2048 candidates wait. Results do not depend on
   // them (tests set them to 0 and to the maximum).
   uint32_t loop_tests = 128, loop_turns = 4096, loop_exit_tests = 512;
+  // Greedy selection: the priority in steps of target / priority_levels (0: the exact cost),
+  // CollapseOptions::priority_levels; its rounds run in one work-group (greedy_loop) once the
+  // turn list holds at most greedy_loop_size edges, back to per-round kernels when one holds
+  // more than greedy_loop_exit. Results do not depend on the last two.
+  double priority_levels = 64;
+  uint32_t greedy_loop_size = 512, greedy_loop_exit = 2048;
 };
 StageParams params_from(const CollapseOptions& o);
 
@@ -167,6 +178,14 @@ uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
 uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                                uint32_t& passed_q, uint32_t& tested);
 uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, uint32_t loop_size = 2048);
+// The greedy selection (cl/collapse_admissible.cl, greedy_*), in place of
+// lazy_admissible_pass1 and conflict_pass2: the edges that taking the candidates one after
+// another in priority order would take, skipping those that fail the tests or touch a tet of
+// an edge taken before. Each edge is tested when its turn comes. Outputs as conflict_pass2
+// (fin, p1 = fin, vaff, dir); returns the number taken; passed_q and tested as
+// lazy_admissible_pass1 (tested: the edges whose volume test ran).
+uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                          uint32_t& passed_q, uint32_t& tested);
 // Atomic-min conflict detection (host/collapse/conflict_atomic.cpp) over the admissible edges
 // of admissible(): replaces both conflict passes, with the same outputs as conflict_pass2.
 // Returns the number of edges to collapse.
