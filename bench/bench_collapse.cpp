@@ -3,8 +3,11 @@
 //
 //   bench_collapse [MESH] [--runs N] [--json FILE] [--wg N] [--max-iterations N]
 //                  [--eps-c N[,N...]] [--min-quality Q[,Q...]] [--rounds N] [--host-tail F]
+//                  [--conflicts greedy|two-pass|atomic-min[,...]]
 // Defaults: eps_c 0 and 700, min_quality 0 (the paper: no quality guard) and 0.1 (the library's
-// default); every combination is run.
+// default), the library's default conflict detection (greedy); every combination is run, the
+// conflict detections one after another for each run index (so that they share the machine's
+// load).
 // Prints a table (median of N runs of collapse(), iterations, collapses per iteration, time per
 // stage summed over the iterations of the median run, tets in/out) and the same as JSON.
 #include <algorithm>
@@ -26,6 +29,7 @@ namespace {
 struct Result {
   int64_t eps_c = 0;
   double min_quality = 0;
+  std::string conflicts;
   std::vector<double> walls;
   CollapseReport report;  // of the median run
 };
@@ -42,6 +46,22 @@ std::vector<double> parse_list(const char* s) {
   return out;
 }
 
+std::vector<std::string> parse_names(const char* s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ',')) out.push_back(item);
+  return out;
+}
+
+bool conflicts_from(const std::string& name, CollapseOptions::Conflicts& c) {
+  if (name == "greedy") c = CollapseOptions::Greedy;
+  else if (name == "two-pass") c = CollapseOptions::TwoPass;
+  else if (name == "atomic-min") c = CollapseOptions::AtomicMin;
+  else return false;
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -53,6 +73,7 @@ int main(int argc, char** argv) {
   int rounds = CollapseOptions{}.selection_rounds;
   double host_tail = CollapseOptions{}.host_tail;
   std::vector<double> eps_cs = {0, 700}, qualities = {0, CollapseOptions{}.min_quality};
+  std::vector<std::string> conflicts = {"greedy"};
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--json") && i + 1 < argc) json_path = argv[++i];
@@ -62,7 +83,15 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--host-tail") && i + 1 < argc) host_tail = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--eps-c") && i + 1 < argc) eps_cs = parse_list(argv[++i]);
     else if (!std::strcmp(argv[i], "--min-quality") && i + 1 < argc) qualities = parse_list(argv[++i]);
+    else if (!std::strcmp(argv[i], "--conflicts") && i + 1 < argc) conflicts = parse_names(argv[++i]);
     else path = argv[i];
+  }
+  for (const std::string& c : conflicts) {
+    CollapseOptions::Conflicts x;
+    if (!conflicts_from(c, x)) {
+      std::fprintf(stderr, "bench_collapse: unknown --conflicts %s (greedy, two-pass, atomic-min)\n", c.c_str());
+      return 2;
+    }
   }
   Mesh input;
   auto t0 = std::chrono::steady_clock::now();
@@ -88,29 +117,35 @@ int main(int argc, char** argv) {
   for (double q : qualities)
   for (double ec : eps_cs) {
     const int64_t eps_c = int64_t(ec);
-    Result r;
-    r.eps_c = eps_c;
-    r.min_quality = q;
-    std::vector<std::pair<double, CollapseReport>> all;
-    for (int i = 0; i < runs; ++i) {
-      Mesh m = input;
-      CollapseOptions o;
-      o.target_factor = 2;
-      o.eps_c = eps_c;
-      o.min_quality = q;
-      o.selection_rounds = rounds;
-      o.host_tail = host_tail;
-      o.max_iterations = max_iterations;
-      auto t = std::chrono::steady_clock::now();
-      CollapseReport rep = collapse(m, o, ctx);
-      double wall = seconds_since(t);
-      r.walls.push_back(wall);
-      all.emplace_back(wall, rep);
+    std::vector<Result> rs(conflicts.size());
+    std::vector<std::vector<std::pair<double, CollapseReport>>> all(conflicts.size());
+    for (int i = 0; i < runs; ++i)
+      for (size_t k = 0; k < conflicts.size(); ++k) {  // interleaved: the same load for each
+        Mesh m = input;
+        CollapseOptions o;
+        o.target_factor = 2;
+        o.eps_c = eps_c;
+        o.min_quality = q;
+        o.selection_rounds = rounds;
+        o.host_tail = host_tail;
+        o.max_iterations = max_iterations;
+        conflicts_from(conflicts[k], o.conflicts);
+        auto t = std::chrono::steady_clock::now();
+        CollapseReport rep = collapse(m, o, ctx);
+        double wall = seconds_since(t);
+        rs[k].walls.push_back(wall);
+        all[k].emplace_back(wall, rep);
+      }
+    for (size_t k = 0; k < conflicts.size(); ++k) {
+      Result& r = rs[k];
+      r.eps_c = eps_c;
+      r.min_quality = q;
+      r.conflicts = conflicts[k];
+      std::sort(all[k].begin(), all[k].end(), [](auto& a, auto& b) { return a.first < b.first; });
+      r.report = all[k][all[k].size() / 2].second;
+      std::sort(r.walls.begin(), r.walls.end());
+      results.push_back(r);
     }
-    std::sort(all.begin(), all.end(), [](auto& a, auto& b) { return a.first < b.first; });
-    r.report = all[all.size() / 2].second;
-    std::sort(r.walls.begin(), r.walls.end());
-    results.push_back(r);
   }
 
   std::ostringstream js;
@@ -131,9 +166,8 @@ int main(int argc, char** argv) {
     const char* names[6] = {"connectivity", "cost", "admissible", "pass1", "pass2", "collapse"};
     int dom = int(std::max_element(st, st + 6) - st);
     double median = r.walls[r.walls.size() / 2];
-    std::printf("\n== eps_c = %lld, min_quality %g: target %.6g (2 x median %.6g)\n", (long long)r.eps_c,
-                r.min_quality, rep.target_length,
-                rep.median_edge_length);
+    std::printf("\n== eps_c = %lld, min_quality %g, conflicts %s: target %.6g (2 x median %.6g)\n",
+                (long long)r.eps_c, r.min_quality, r.conflicts.c_str(), rep.target_length, rep.median_edge_length);
     std::printf("wall time of collapse(): median %.3f s (min %.3f, max %.3f) over %d runs; upload %.3f s, download %.3f s\n",
                 median, r.walls.front(), r.walls.back(), runs, rep.seconds_upload, rep.seconds_download);
     std::printf("tets %lld -> %lld, vertices %lld -> %lld, %zu iterations\n", (long long)rep.tets_in,
@@ -151,7 +185,7 @@ int main(int argc, char** argv) {
     std::printf("\ndominant stage: %s (%.0f%% of the iterations' time)\n", names[dom],
                 100 * st[dom] / std::max(1e-12, st[0] + st[1] + st[2] + st[3] + st[4] + st[5]));
 
-    js << (w ? ", " : "") << "{\"eps_c\": " << r.eps_c << ", \"min_quality\": " << r.min_quality << ", \"seconds_median\": " << median << ", \"seconds_runs\": [";
+    js << (w ? ", " : "") << "{\"eps_c\": " << r.eps_c << ", \"min_quality\": " << r.min_quality << ", \"conflicts\": \"" << r.conflicts << "\", \"seconds_median\": " << median << ", \"seconds_runs\": [";
     for (size_t i = 0; i < r.walls.size(); ++i) js << (i ? ", " : "") << r.walls[i];
     js << "], \"target_length\": " << rep.target_length << ", \"tets_out\": " << rep.tets_out
        << ", \"vertices_out\": " << rep.vertices_out << ", \"iterations\": " << rep.iterations.size()
