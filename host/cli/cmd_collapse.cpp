@@ -26,6 +26,7 @@ struct CollapseCli {
   OutputOptions output;
   CollapseOptions opt;
   double target_length = 0, target_factor = 0;
+  double priority_levels = -1;  // not given
   std::string boundary = "features", method = "parallel", conflicts = "greedy";
   std::string region, sizing_field, labels, cost_cl, placement_cl, predicate_cl, device, stats;
   bool check = false, quiet = false, no_labels = false, no_spatial_order = false;
@@ -236,7 +237,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
                  "pass 1 over edges, then pass 2 over tets) or atomic-min (Gautron and Kenzel 2023;\n"
                  "needs 64-bit atomics on the device)")
       ->check(CLI::IsMember({"greedy", "two-pass", "atomic-min"}));
-  app.add_option("--priority-levels", c->opt.priority_levels,
+  app.add_option("--priority-levels", c->priority_levels,
                  "Greedy conflicts: edges are ordered by their cost in steps of target / N, and within a\n"
                  "step in a fixed pseudo-random order (default 64; 0: exact cost order, many more\n"
                  "parallel rounds)")
@@ -282,6 +283,11 @@ void register_collapse(CLI::App& app, int& exit_code) {
     opt.conflicts = c->conflicts == "atomic-min" ? CollapseOptions::AtomicMin
                     : c->conflicts == "two-pass" ? CollapseOptions::TwoPass
                                                  : CollapseOptions::Greedy;
+    if (c->priority_levels >= 0) {
+      if (opt.method == CollapseOptions::Sequential || opt.conflicts != CollapseOptions::Greedy)
+        throw CLI::ValidationError("--priority-levels", "applies to the greedy conflict detection only (--conflicts greedy)");
+      opt.priority_levels = c->priority_levels;
+    }
     if (opt.method == CollapseOptions::Sequential && !c->device.empty())
       throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
     if (opt.method == CollapseOptions::Sequential)

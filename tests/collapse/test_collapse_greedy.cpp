@@ -287,8 +287,11 @@ TEST(CollapseGreedy, CommandLine) {
     const std::string name = opts.find("two-pass") != std::string::npos ? "two-pass" : "greedy";
     EXPECT_NE(json.find("\"conflicts\":\"" + name + "\""), std::string::npos) << json.substr(0, 400);
   }
-  EXPECT_NE(test::run_command(base + " --priority-levels -1", &log), 0);
-  EXPECT_NE(log.find("priority-levels"), std::string::npos) << log;
+  for (const std::string bad : {" --priority-levels -1", " --priority-levels 8 --conflicts two-pass",
+                                 " --priority-levels 8 --method sequential"}) {
+    EXPECT_NE(test::run_command(base + bad, &log), 0) << bad;
+    EXPECT_NE(log.find("priority-levels"), std::string::npos) << log;
+  }
   test::run_command(TC_CLI + std::string(" --help"), &log);
   EXPECT_NE(log.find("--priority-levels"), std::string::npos);
   EXPECT_NE(log.find("greedy"), std::string::npos);
