@@ -664,19 +664,22 @@ __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __glo
  *   greedy_decide  each turn-list edge: the volume test (tcc_lazy_volume; a refusal is OUT at
  *                  once, which frees the way for the edges after it without waiting for its
  *                  turn); then the slots over N(a) and N(b): one holding an edge before e
- *                  (blocker[e]) makes e wait, and e is looked at again only once that edge is
- *                  decided; else e is first within reach: the link condition (tcc_lazy_decide),
- *                  IN (listed for greedy_block) or OUT. A waiting edge goes to the next turn
- *                  list. Edges deciding in one round are pairwise free of conflicts (each comes
- *                  first within reach of the other), so their writes do not race;
+ *                  (blocker[e]) makes e wait, and while that edge is undecided the next rounds
+ *                  only check its state (no scan); else e is first within reach: the link
+ *                  condition (tcc_lazy_decide), IN (listed for greedy_block) or OUT. A waiting
+ *                  edge goes to the next turn list. Edges deciding in one round are pairwise
+ *                  free of conflicts (each comes first within reach of the other), so their
+ *                  writes do not race;
  *   greedy_block   every undecided edge within reach of an edge taken this round is OUT, and
  *                  the vertices whose slot it held are listed (vstamp: once per round);
  *   lazy_p1_recompute and lazy_p1_turns (above) over the listed vertices: their slots anew, and
  *                  the edges now first at both end points go to the next turn list.
- * Slots change only in lazy_p1_recompute, states in greedy_decide (of its own edges) and
- * greedy_block, so every read within a kernel sees the values of the round's start; blocker[]
- * is only a hint of when to look again. Once the turn list is short the rounds run in one
- * work-group (greedy_loop).
+ * Slots change only in lazy_p1_recompute, so every kernel reads the round's slots. States
+ * change in greedy_decide (of its own edges) and greedy_block; the two reads of another edge's
+ * state in the same kernel are benign: greedy_decide's of its blocker (decided or not, the
+ * unchanged slots make e wait in this round either way) and greedy_block's (two taken edges
+ * write the same OUT). Decisions and counts do not depend on the order of the work items.
+ * Once the turn list is short the rounds run in one work-group (greedy_loop).
  *
  * cnt[]: [0], [1] the two turn lists, [2] the vertex list, [3] (lazy_p1_turns: turn-list edges
  * without a verdict, unused here), [4] the edges taken this round. */

@@ -70,7 +70,8 @@ struct EdgeState {
   // marked, admissible, pass1, pass2, tested (lazy), passed Q (lazy)
   DeviceBuffer<uint32_t> counters;
   // Verdicts of the link and volume tests kept across iterations (collapse_verdicts.cl):
-  // verdict[e] is the reason of a test of e (TCC_OK or a refusal) or TCC_VERDICT_UNKNOWN.
+  // verdict[e] is the reason of a test of e (TCC_OK or a refusal), kVolumeOk (the greedy
+  // selection's volume test passed, the link condition not yet run) or TCC_VERDICT_UNKNOWN.
   // Carried to the next iteration for the edges whose end points' rings did not change.
   DeviceBuffer<uint8_t> verdict;
   bool verdict_ready = false;
@@ -116,7 +117,8 @@ enum Reason : uint8_t {
   kOk = 0, kNotMarked = 1, kRefusedQ = 2, kRefusedLink = 3, kRefusedVolume = 4, kRefusedQuality = 6,
   kUntested = 5,  // lazy filter: passed Q, never tested because a cheaper rival won (an edge
                   // with a refusal carried from the previous iteration keeps that reason)
-  kRefusedSurface = 7  // the surface guard (guard_surface.hpp)
+  kRefusedSurface = 7,  // the surface guard (guard_surface.hpp)
+  kVolumeOk = 8         // in verdict[] only (TCC_VOLUME_OK): the volume test passed, the link not yet run
 };
 
 struct StageParams {

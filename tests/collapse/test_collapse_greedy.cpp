@@ -83,7 +83,8 @@ struct GreedyStage {
   uint32_t ne = 0, taken = 0, tested = 0;
   std::vector<int32_t> edges;
   std::vector<uint32_t> adm, fin;
-  std::vector<uint8_t> reason;  // of admissible()
+  std::vector<uint8_t> reason;        // of admissible(): every marked edge's full test
+  std::vector<uint8_t> greedy_reason; // of the last selection
   std::vector<double> cost, prio;
   std::vector<uint32_t> marked;
 
@@ -105,8 +106,10 @@ struct GreedyStage {
   void select(Context& ctx, const StageParams& p, bool keep_verdicts = false) {
     uint32_t passed_q = 0;
     s.verdict_ready = keep_verdicts;  // else every verdict unknown: tested again
+    s.counters.fill(0u);              // as before each selection of a run
     taken = greedy_selection(ctx, dm, c, s, p, passed_q, tested);
     fin = s.fin.download_range(0, ne);
+    greedy_reason = s.reason.download_range(0, ne);
     prio = p.priority_levels > 0 ? s.prio.download_range(0, ne) : cost;
   }
 };
@@ -141,8 +144,10 @@ std::vector<uint32_t> host_greedy(const GreedyStage& st, uint32_t nv) {
 
 }  // namespace
 
-// The device takes exactly the host's edges, whether its rounds run as separate launches or in
-// one work-group (the loop thresholds at both extremes), with 64 steps and in the exact order.
+// The device takes exactly the host's edges, with 64 steps and in the exact order; and the same
+// edges with the same counts (tested, taken) and refusals whether its rounds run as separate
+// launches or in one work-group (the loop thresholds at both extremes), for every work-group
+// size.
 TEST(CollapseGreedy, TakesWhatTakingTheEdgesInOrderWouldTake) {
   Context ctx;
   int64_t link_refusals = 0, volume_refusals = 0;
@@ -157,22 +162,43 @@ TEST(CollapseGreedy, TakesWhatTakingTheEdgesInOrderWouldTake) {
       EXPECT_GT(n_expect, 0u);
       EXPECT_EQ(st.taken, n_expect);
       EXPECT_EQ(st.fin, expect);
-      // the volume test runs on at least every taken edge
+      // every taken edge was tested; far fewer than the candidates were
+      const int64_t candidates = std::count_if(st.reason.begin(), st.reason.end(),
+                                               [](uint8_t r) { return r != kNotMarked && r != kRefusedQ; });
       EXPECT_GE(st.tested, st.taken);
-      link_refusals += std::count(st.reason.begin(), st.reason.end(), uint8_t(kRefusedLink));
-      volume_refusals += std::count(st.reason.begin(), st.reason.end(), uint8_t(kRefusedVolume));
-      for (auto [size, exit] : {std::pair<uint32_t, uint32_t>{0, 0}, {UINT32_MAX, UINT32_MAX}, {4, 8}}) {
-        StageParams q = p;
-        q.greedy_loop_size = size;
-        q.greedy_loop_exit = exit;
-        q.target = in.target;
-        st.select(ctx, q);
-        EXPECT_EQ(st.fin, expect) << "loop size " << size << ", exit " << exit;
+      EXPECT_LT(st.tested, candidates);
+      // the selection's own refusals (each also a refusal of the full test)
+      for (uint32_t e = 0; e < st.ne; ++e) {
+        const uint8_t r = st.greedy_reason[e];
+        if (r == kRefusedLink || r == kRefusedVolume) {
+          EXPECT_EQ(r, st.reason[e]) << "edge " << e;
+        }
+        link_refusals += r == kRefusedLink;
+        volume_refusals += r == kRefusedVolume;
       }
+      const uint32_t taken = st.taken, tested = st.tested;
+      const std::vector<uint8_t> reasons = st.greedy_reason;
+      for (size_t wg : {0, 1, 16})
+        for (auto [size, exit] : {std::pair<uint32_t, uint32_t>{0, 0}, {UINT32_MAX, UINT32_MAX}, {4, 8}}) {
+          ctx.set_work_group_size(wg);
+          StageParams q = p;
+          q.greedy_loop_size = size;
+          q.greedy_loop_exit = exit;
+          q.target = in.target;
+          st.select(ctx, q);
+          const std::string what =
+              "work-group size " + std::to_string(wg) + ", loop size " + std::to_string(size) + ", exit " + std::to_string(exit);
+          EXPECT_EQ(st.fin, expect) << what;
+          EXPECT_EQ(st.taken, taken) << what;
+          EXPECT_EQ(st.tested, tested) << what;
+          EXPECT_EQ(st.greedy_reason, reasons) << what;
+        }
+      ctx.set_work_group_size(0);
     }
   }
-  // both kinds of refusal occur (the link condition runs apart from the volume test)
-  EXPECT_GT(link_refusals, 50);
+  // both kinds of refusal happen in the selection itself: the link condition runs apart from
+  // (after) the volume test
+  EXPECT_GT(link_refusals, 10);
   EXPECT_GT(volume_refusals, 50);
 }
 
@@ -183,7 +209,7 @@ TEST(CollapseGreedy, TakesWhatTakingTheEdgesInOrderWouldTake) {
 // be taken. The result is the host's greedy without the dropped edges.
 TEST(CollapseGreedy, SelectingAgainKeepsTheVerdicts) {
   Context ctx;
-  int64_t dropped_all = 0, tested_first = 0, tested_again = 0;
+  int64_t dropped_all = 0, tested_first = 0, tested_again = 0, taken_volume_ok = 0;
   for (const Input& in : inputs()) {
     SCOPED_TRACE(in.name);
     StageParams p = in.params;
@@ -191,7 +217,7 @@ TEST(CollapseGreedy, SelectingAgainKeepsTheVerdicts) {
     GreedyStage st(ctx, in.mesh, p, in.target);
     std::vector<uint32_t> marked = st.marked;
     std::vector<uint8_t> verdict = st.s.verdict.download_range(0, st.ne);
-    const int64_t volume_ok = std::count(verdict.begin(), verdict.end(), uint8_t(8));  // TCC_VOLUME_OK
+    const int64_t volume_ok = std::count(verdict.begin(), verdict.end(), uint8_t(kVolumeOk));
     int64_t dropped = 0, k = 0;
     for (uint32_t e = 0; e < st.ne; ++e)
       if (st.fin[e] && k++ % 3 == 0) {
@@ -202,11 +228,11 @@ TEST(CollapseGreedy, SelectingAgainKeepsTheVerdicts) {
       }
     st.s.marked.upload(marked);
     st.s.verdict.upload(verdict);
-    st.s.counters.fill(0u);  // as the guard does before selecting again
     const uint32_t tested_before = st.tested;
     st.select(ctx, p, true);
     const std::vector<uint32_t> expect = host_greedy(st, st.dm.nv);
     EXPECT_EQ(st.fin, expect);
+    for (uint32_t e = 0; e < st.ne; ++e) taken_volume_ok += st.fin[e] && verdict[e] == kVolumeOk;
     EXPECT_EQ(st.taken, std::accumulate(expect.begin(), expect.end(), 0u));
     EXPECT_LE(st.tested, tested_before);  // kept verdicts are not tested again
     tested_first += tested_before;
@@ -215,6 +241,7 @@ TEST(CollapseGreedy, SelectingAgainKeepsTheVerdicts) {
   }
   EXPECT_GT(dropped_all, 20);
   EXPECT_LT(tested_again, tested_first / 2);
+  EXPECT_GT(taken_volume_ok, 10);  // kept TCC_VOLUME_OK verdicts, now taken
 }
 
 // The priority is the documented formula: the cost in steps of target / levels, then the hash of
@@ -236,8 +263,9 @@ TEST(CollapseGreedy, PriorityIsCostStepThenHash) {
   }
 }
 
-// Whole runs: valid, the boundary's topology kept, deterministic, and against the paper's two
-// passes on the same input: fewer iterations on the bracket (each takes more).
+// Whole runs: valid, the boundary's topology kept, the same mesh and per-iteration counts at
+// another work-group size, and against the paper's two passes on the same input: fewer
+// iterations on the bracket (each takes more).
 TEST(CollapseGreedy, WholeRunsValidAndNeedFewerIterationsThanTwoPass) {
   Context ctx;
   const Mesh in = read_mesh(test::project_mesh("bracket.msh"));
@@ -247,9 +275,16 @@ TEST(CollapseGreedy, WholeRunsValidAndNeedFewerIterationsThanTwoPass) {
   ASSERT_EQ(o.conflicts, CollapseOptions::Greedy);  // the default
   Mesh g = in, again = in, t = in;
   const CollapseReport rg = collapse(g, o, ctx);
-  collapse(again, o, ctx);
+  ctx.set_work_group_size(16);
+  const CollapseReport ra = collapse(again, o, ctx);
+  ctx.set_work_group_size(0);
   EXPECT_EQ(g.points, again.points);
   EXPECT_EQ(g.tets, again.tets);
+  ASSERT_EQ(rg.iterations.size(), ra.iterations.size());
+  for (size_t i = 0; i < rg.iterations.size(); ++i) {
+    EXPECT_EQ(rg.iterations[i].tested, ra.iterations[i].tested) << "iteration " << i;
+    EXPECT_EQ(rg.iterations[i].collapsed, ra.iterations[i].collapsed) << "iteration " << i;
+  }
   CheckOptions co;
   co.hausdorff = false;
   const CheckReport cg = check_mesh(g, co, &in);
