@@ -146,10 +146,11 @@ struct CollapseOptions {
   // Reuse work across iterations: verdicts of the link and volume tests of edges whose rings
   // did not change. Same result either way (a test compares both); false recomputes everything.
   bool reuse_across_iterations = true;
-  // Selection rounds per iteration: after the conflict passes, edges whose stars are disjoint
-  // from those of the collapses chosen so far are selected again in the same connectivity
-  // (same rules). 1 is the paper's algorithm and the default: on W1 (bench/README.md) a second
-  // round collapses ~9% more per early iteration but needs more iterations in all (72 vs 68).
+  // Selection rounds per iteration (two-pass conflicts only; the greedy selection leaves no such
+  // edge): after the conflict passes, edges whose stars are disjoint from those of the
+  // collapses chosen so far are selected again in the same connectivity (same rules). 1 is the
+  // paper's algorithm and the default: on W1 (bench/README.md) a second round collapses ~9% more
+  // per early iteration but needs more iterations in all (72 vs 68).
   int selection_rounds = 1;
   // Parallel method: renumber vertices along a Morton curve and tets by their smallest new vertex
   // before the run (memory locality of the stages: W1 about 20% faster with TetGen's numbering).
