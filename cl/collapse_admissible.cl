@@ -396,37 +396,20 @@ __kernel void lazy_init(uint ne, __global const int* edges, __global const uint*
   tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vfield, vfield_stride, vflags,     \
       vclass, eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict
 
-/* The turn of edge e in the lazy filter: its link and volume tests (or the verdict carried
- * from an earlier iteration), then IN (vaff of both end points; returns 1) or OUT (0). */
-/* The verdict of the link and volume tests of edge e = (a, b) in direction *dir (set here):
- * the one kept from an earlier test (carried from an earlier iteration: the rings of a and b
- * are unchanged since), else a new test, kept in verdict[] and counted in counters[4]. */
-inline uchar tcc_lazy_verdict(int e, int a, int b, int* dir_out, TCC_TEST_PARAMS) {
-  uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
-  int dir = tcc_user_dir(tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule), fa, fb, mode);
-  *dir_out = dir;
-  uchar r = verdict[e];
-  if (r == TCC_VERDICT_UNKNOWN) {
-    r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts,
-                            vfield, vfield_stride, vflags, eflags, eps_v, q_min, tet_quality);
-    verdict[e] = r;
-    atomic_inc(&counters[4]);
-  } else if (r == TCC_VOLUME_OK) { /* the volume test passed earlier (tcc_lazy_volume) */
-    r = tcc_link_test(a, b, fa, fb, fe, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, vflags,
-                      eflags);
-    verdict[e] = r;
-  }
-  return r;
+/* Q's direction bits of the candidate e = (a, b), with the user's placement (tcc_user_dir). */
+inline int tcc_lazy_dir(int e, int a, int b, TCC_TEST_PARAMS) {
+  uint fa = vflags[a], fb = vflags[b];
+  return tcc_user_dir(tcc_predicate_q(a, b, fa, fb, eflags[e], vclass[a], vclass[b], mode, paper_rule), fa, fb, mode);
 }
 
-/* The volume test alone (the cheaper part, and the one that refuses most edges), for an edge
- * whose verdict may be needed only later: kept as TCC_VOLUME_OK when it passes (the link
- * condition is then tested by tcc_lazy_verdict). Returns whether the edge is not refused. */
-inline int tcc_lazy_volume(int e, int a, int b, TCC_TEST_PARAMS) {
+/* The volume test alone (the cheaper part, and the one that refuses most edges) of e = (a, b)
+ * in direction dir, unless a verdict is kept (carried from an earlier iteration: the rings of
+ * a and b are unchanged since): a new test is counted in counters[4] and kept in verdict[],
+ * as TCC_VOLUME_OK when it passes (the link condition is then still to run). Returns whether
+ * the edge is not refused. */
+inline int tcc_lazy_volume(int e, int a, int b, int dir, TCC_TEST_PARAMS) {
   uchar r = verdict[e];
   if (r == TCC_VERDICT_UNKNOWN) {
-    uint fa = vflags[a], fb = vflags[b], fe = eflags[e];
-    int dir = tcc_user_dir(tcc_predicate_q(a, b, fa, fb, fe, vclass[a], vclass[b], mode, paper_rule), fa, fb, mode);
     r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tet_quality);
     if (r == TCC_OK) r = TCC_VOLUME_OK;
     verdict[e] = r;
@@ -435,11 +418,22 @@ inline int tcc_lazy_volume(int e, int a, int b, TCC_TEST_PARAMS) {
   return r == TCC_OK || r == TCC_VOLUME_OK;
 }
 
+/* The verdict of the link and volume tests of e = (a, b) in direction dir: the volume test
+ * (tcc_lazy_volume), then the link condition where it passed, the result kept in verdict[]. */
+inline uchar tcc_lazy_verdict(int e, int a, int b, int dir, TCC_TEST_PARAMS) {
+  if (tcc_lazy_volume(e, a, b, dir, TCC_TEST_ARGS) && verdict[e] == TCC_VOLUME_OK)
+    verdict[e] = tcc_link_test(a, b, vflags[a], vflags[b], eflags[e], tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge,
+                               labels, use_labels, vflags, eflags);
+  return verdict[e];
+}
+
+/* The turn of edge e in the lazy filter: its link and volume tests (or the verdict kept),
+ * then IN (vaff of both end points; returns 1) or OUT (0). */
 inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* state, __global int* vaff,
                             TCC_TEST_PARAMS) {
   int a = edges[2 * e], b = edges[2 * e + 1];
-  int dir;
-  uchar r = tcc_lazy_verdict(e, a, b, &dir, TCC_TEST_ARGS);
+  int dir = tcc_lazy_dir(e, a, b, TCC_TEST_ARGS);
+  uchar r = tcc_lazy_verdict(e, a, b, dir, TCC_TEST_ARGS);
   reason[e] = r;
   if (r == TCC_OK) {
     edge_dir[e] = (uchar)dir;
@@ -712,7 +706,7 @@ inline void tcc_greedy_decide(int e, __global const int* edges, __global const d
   int f = blocker[e];
   int wait = f >= 0 && state[f] == TCC_UNDECIDED;
   if (!wait) {
-    if (tcc_lazy_volume(e, a, b, TCC_TEST_ARGS)) {
+    if (tcc_lazy_volume(e, a, b, tcc_lazy_dir(e, a, b, TCC_TEST_ARGS), TCC_TEST_ARGS)) {
       f = -1; /* the first slot over N(a) and N(b) holding an edge before e, if any */
       for (int s = 0; s < 2 && f < 0; ++s) {
         int x = s == 0 ? a : b;

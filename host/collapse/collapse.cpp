@@ -228,32 +228,29 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     // (a selection tests only edges no earlier one tested), the other counts are the last's.
     double t_sel = t2;
     for (bool first = true;; first = false) {
+      // the admissible filter: every marked edge tested (atomic-min), or lazily within the greedy
+      // selection or within pass 1
       if (options.conflicts == CollapseOptions::AtomicMin) {
-        // every marked edge tested, then one conflict stage
         s.admissible = admissible(ctx, dm, conn, st, p);
         s.tested = s.marked;
-        const double t4 = now();
-        s.seconds_admissible += t4 - t_sel;
-        t_sel = t4;
-        s.after_pass2 = s.after_pass1 = conflicts_atomic_min(ctx, dm, conn, st);
-      } else if (options.conflicts == CollapseOptions::Greedy) {
-        // lazy filter and both passes' conflicts in one selection
-        uint32_t passed_q = 0, tested = 0;
-        s.after_pass2 = s.after_pass1 = s.admissible = greedy_selection(ctx, dm, conn, st, p, passed_q, tested);
-        if (first) s.passed_q = passed_q;
-        s.tested += tested;
-        const double t4 = now();
-        s.seconds_admissible += t4 - t_sel;
-        t_sel = t4;
       } else {
         uint32_t passed_q = 0, tested = 0;
-        s.after_pass1 = lazy_admissible_pass1(ctx, dm, conn, st, p, passed_q, tested);
-        s.admissible = s.after_pass1;
+        s.admissible = options.conflicts == CollapseOptions::Greedy
+                           ? greedy_selection(ctx, dm, conn, st, p, passed_q, tested)
+                           : lazy_admissible_pass1(ctx, dm, conn, st, p, passed_q, tested);
         if (first) s.passed_q = passed_q;
         s.tested += tested;
-        const double t4 = now();
-        s.seconds_admissible += t4 - t_sel;
-        t_sel = t4;
+      }
+      const double t4 = now();
+      s.seconds_admissible += t4 - t_sel;
+      t_sel = t4;
+      // the conflict detection (the greedy selection's is done)
+      if (options.conflicts == CollapseOptions::AtomicMin) {
+        s.after_pass2 = s.after_pass1 = conflicts_atomic_min(ctx, dm, conn, st);
+      } else if (options.conflicts == CollapseOptions::Greedy) {
+        s.after_pass2 = s.after_pass1 = s.admissible;
+      } else {
+        s.after_pass1 = s.admissible;
         s.after_pass2 = conflict_pass2(ctx, dm, conn, st);
       }
       for (int r = 1; r < options.selection_rounds && s.after_pass2 > 0; ++r) {

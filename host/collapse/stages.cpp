@@ -507,6 +507,23 @@ void pass1_rounds(Context& ctx, cl::Kernel& decide, EdgeState& s, const Connecti
 }  // namespace
 
 namespace {
+// The vertex part of a per-round step of the lazy filter and of the greedy selection, after its
+// decisions (cl/collapse_admissible.cl): the slots of the cnt[2] listed vertices (s.dlist) anew
+// in the order `order`, then the edges now first at both end points to turn list 1 - cur
+// (counted in s.work_n[1 - cur]; s.work_n[3]: those without a verdict). `recompute` and `turns`
+// are the kernels lazy_p1_recompute and lazy_p1_turns, made once by the caller.
+void vertex_part(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kernel& recompute, cl::Kernel& turns,
+                 const DeviceBuffer<double>& order, int cur, cl_uint round) {
+  uint32_t nd = 0;
+  s.work_n.download(&nd, 1, 2);
+  set_args(recompute, "lazy_p1_recompute", U(nd), B(s.dlist), B(c.nb_off), B(c.nb_edge), B(s.state), B(order),
+           B(s.slot[0]));
+  ctx.launch(recompute, nd, "lazy_p1_recompute");
+  set_args(turns, "lazy_p1_turns", U(nd), B(s.dlist), B(c.edges), B(s.slot[0]), B(s.work[1 - cur]), B(s.work_n),
+           cl_uint(1 - cur), B(s.queued), round + 1, B(s.verdict));
+  ctx.launch(turns, nd, "lazy_p1_turns");
+}
+
 // Pass 1 of the lazy filter over the candidates (s.cand[e] != 0 for e < ne; lazy_init made them
 // and their first claims in s.slot[0]; cl/collapse_admissible.cl, lazy_p1_*): rounds over the
 // turn list until it is empty. `decide` and `loop` have the test's arguments set. s.vaff must
@@ -555,14 +572,7 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kerne
       set_args(decide, "lazy_p1_decide", U(nt), B(s.work[cur]), B(c.edges), B(s.state), B(s.vaff), B(s.slot[0]),
                B(s.dlist), B(s.work_n));
       ctx.launch(decide, nt, "lazy_p1_decide");
-      uint32_t nd = 0;
-      s.work_n.download(&nd, 1, 2);
-      set_args(recompute, "lazy_p1_recompute", U(nd), B(s.dlist), B(c.nb_off), B(c.nb_edge), B(s.state), B(s.cost),
-               B(s.slot[0]));
-      ctx.launch(recompute, nd, "lazy_p1_recompute");
-      set_args(turns, "lazy_p1_turns", U(nd), B(s.dlist), B(c.edges), B(s.slot[0]), B(s.work[1 - cur]), B(s.work_n),
-               cl_uint(1 - cur), B(s.queued), round + 1, B(s.verdict));
-      ctx.launch(turns, nd, "lazy_p1_turns");
+      vertex_part(ctx, s, c, recompute, turns, s.cost, cur, round);
       s.work_n.download(cnt, 4);
       nt = cnt[1 - cur];
       nu = cnt[3];
@@ -703,14 +713,7 @@ uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
       set_args(block, "greedy_block", B(s.inlist), B(s.work_n), B(c.edges), B(c.nb_off), B(c.nb), B(c.nb_edge),
                B(s.slot[0]), B(s.vstamp), round, B(s.dlist), B(s.state));
       ctx.launch(block, nt, "greedy_block");  // over the round's taken edges (cnt[4] <= nt)
-      uint32_t nd = 0;
-      s.work_n.download(&nd, 1, 2);
-      set_args(recompute, "lazy_p1_recompute", U(nd), B(s.dlist), B(c.nb_off), B(c.nb_edge), B(s.state), B(*prio),
-               B(s.slot[0]));
-      ctx.launch(recompute, nd, "lazy_p1_recompute");
-      set_args(turns, "lazy_p1_turns", U(nd), B(s.dlist), B(c.edges), B(s.slot[0]), B(s.work[1 - cur]), B(s.work_n),
-               cl_uint(1 - cur), B(s.queued), round + 1, B(s.verdict));
-      ctx.launch(turns, nd, "lazy_p1_turns");
+      vertex_part(ctx, s, c, recompute, turns, *prio, cur, round);
       s.work_n.download(&nt, 1, size_t(1 - cur));
       cur = 1 - cur;
     }
