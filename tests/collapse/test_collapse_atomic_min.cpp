@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "collapse/stages.hpp"
+#include "stage_inputs.hpp"
 #include "tetcollapse/check.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/io.hpp"
@@ -54,12 +55,7 @@ struct AtomicStage {
   std::vector<std::vector<int32_t>> ring;  // tets of each vertex, from the mesh
 
   AtomicStage(Context& ctx, const Mesh& m, StageParams p, double target) {
-    p.target = target;
-    CollapseOptions o;
-    upload_mesh(ctx, m, o, dm);
-    build_connectivity(ctx, dm, c, p);
-    cost_and_mark(ctx, dm, c, s, p);
-    admissible(ctx, dm, c, s, p);
+    test::run_to_admissible(ctx, m, p, target, dm, c, s);
     n = conflicts_atomic_min(ctx, dm, c, s);
     ne = c.ne;
     edges = c.edges.download_range(0, 2 * size_t(ne));
@@ -120,42 +116,13 @@ Mesh jittered_cube(int n) {
   return m;
 }
 
-struct Input {
-  std::string name;
-  Mesh mesh;
-  StageParams params;
-  double target;
-};
+using Input = test::StageInput;
 
-// The stage inputs: a cube (many equal costs: ties by index), a signed user cost (negative and
-// positive keys), a cost of +-0.0 everywhere (pure index order), the project's bracket and two
-// shared meshes when present; the target is twice the median edge length.
+// The stage inputs (stage_inputs.hpp) and a jittered cube (distinct costs); two shared meshes.
 std::vector<Input> stage_inputs() {
-  std::vector<Input> in;
-  StageParams p = params_from(CollapseOptions{});
-  Mesh cube = make_cube_mesh(6);
-  in.push_back({"cube", cube, p, 2 * median_edge_length(cube)});
-  Mesh jittered = jittered_cube(6);
-  in.push_back({"jittered cube", jittered, p, 2 * median_edge_length(jittered)});
-  StageParams signed_cost = p;
-  signed_cost.cost_source =
-      "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return p0.x + p1.x + 0.3 * p0.y - 1.0; }";
-  in.push_back({"cube, signed cost", cube, signed_cost, 0.5});
-  StageParams zero_cost = p;
-  zero_cost.cost_source =
-      "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return (p1.x - p0.x - p1.y + p0.y) * 0.0; }";
-  in.push_back({"cube, cost +-0", cube, zero_cost, 1.0});
-  Mesh bracket = read_mesh(test::project_mesh("bracket.msh"));
-  in.push_back({"bracket", bracket, p, 2 * median_edge_length(bracket)});
-  for (const char* name : {"polyfem_screw.msh", "libigl_octopus-low.mesh"}) {
-    std::string path = test::shared_mesh(name);
-    if (path.empty()) {
-      std::printf("skipping %s: absent\n", name);
-      continue;
-    }
-    Mesh m = read_mesh(path);
-    in.push_back({name, m, p, 2 * median_edge_length(m)});
-  }
+  std::vector<Input> in = test::conflict_stage_inputs({"polyfem_screw.msh", "libigl_octopus-low.mesh"});
+  const Mesh jittered = jittered_cube(6);
+  in.push_back({"jittered cube", jittered, params_from(CollapseOptions{}), 2 * median_edge_length(jittered)});
   return in;
 }
 

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "collapse/stages.hpp"
+#include "stage_inputs.hpp"
 #include "tetcollapse/check.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/io.hpp"
@@ -23,29 +24,14 @@ using namespace tc::collapse_detail;
 
 namespace {
 
-struct Input {
-  std::string name;
-  Mesh mesh;
-  StageParams params;
-  double target;
-};
+using Input = test::StageInput;
 
-// A cube (many equal costs), a user cost of +-0 everywhere (the order is the hash alone), a
-// signed user cost, cubes with tets taken away (odd links: refusals by the link condition), the
-// project's bracket (boundary, refusals) and a shared mesh when present.
+// The stage inputs (stage_inputs.hpp: cubes with equal, signed and +-0 costs, the bracket, a
+// shared mesh), and cubes with tets taken away (odd links: refusals by the link condition) and
+// the bracket in strict mode.
 std::vector<Input> inputs() {
-  std::vector<Input> in;
-  StageParams p = params_from(CollapseOptions{});
-  Mesh cube = make_cube_mesh(6);
-  in.push_back({"cube", cube, p, 2 * median_edge_length(cube)});
-  StageParams zero_cost = p;
-  zero_cost.cost_source =
-      "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return (p1.x - p0.x) * 0.0; }";
-  in.push_back({"cube, cost +-0", cube, zero_cost, 1.0});
-  StageParams signed_cost = p;
-  signed_cost.cost_source =
-      "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return p0.x + p1.x + 0.3 * p0.y - 1.0; }";
-  in.push_back({"cube, signed cost", cube, signed_cost, 0.5});
+  std::vector<Input> in = test::conflict_stage_inputs({"polyfem_screw.msh"});
+  const StageParams p = params_from(CollapseOptions{});
   for (uint32_t seed = 1; seed <= 3; ++seed) {
     uint32_t r = seed * 2654435761u;
     const Mesh holes = test::sub_mesh(test::cube_tets(3), [&](int64_t) {
@@ -59,18 +45,10 @@ std::vector<Input> inputs() {
                     2 * median_edge_length(holes)});
     }
   }
-  Mesh bracket = read_mesh(test::project_mesh("bracket.msh"));
-  in.push_back({"bracket", bracket, p, 2 * median_edge_length(bracket)});
+  const Mesh bracket = read_mesh(test::project_mesh("bracket.msh"));
   StageParams strict = p;
   strict.mode = 0;
   in.push_back({"bracket, strict", bracket, strict, 2 * median_edge_length(bracket)});
-  std::string path = test::shared_mesh("polyfem_screw.msh");
-  if (path.empty()) {
-    std::printf("skipping polyfem_screw.msh: absent\n");
-  } else {
-    Mesh m = read_mesh(path);
-    in.push_back({"polyfem_screw.msh", m, p, 2 * median_edge_length(m)});
-  }
   return in;
 }
 
@@ -89,12 +67,7 @@ struct GreedyStage {
   std::vector<uint32_t> marked;
 
   GreedyStage(Context& ctx, const Mesh& m, StageParams p, double target) {
-    p.target = target;
-    CollapseOptions o;
-    upload_mesh(ctx, m, o, dm);
-    build_connectivity(ctx, dm, c, p);
-    cost_and_mark(ctx, dm, c, s, p);
-    admissible(ctx, dm, c, s, p);
+    test::run_to_admissible(ctx, m, p, target, dm, c, s);
     ne = c.ne;
     edges = c.edges.download_range(0, 2 * size_t(ne));
     adm = s.adm.download_range(0, ne);
