@@ -375,30 +375,21 @@ __kernel void conn_vertex_flags(uint nv, __global const uint* bits, __global uch
   vflags[v] = (uchar)bits[v];
 }
 
-/* Edge flags: S membership (boundary / interface) and the ridge rule of tc::build_topology:
- * an S-edge is a ridge when it has a number of S-faces other than two, when its two S-faces do
- * not traverse it in opposite directions, or when 1 - dot(n1, n2) > eps_r. */
-__kernel void conn_edge_flags(uint ne, __global const int* edges, __global const int* tets,
-                              __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
-                              __global const int* labels, int use_labels, __global const double* pts, double eps_r,
-                              __global const uchar* vflags, __global uchar* eflags, int carry,
-                              __global const uchar* ndirty, __global const int* vold,
-                              __global const uint* prev_nb_off, __global const int* prev_nb,
-                              __global const int* prev_nb_edge, __global const uchar* prev_eflags) {
-  uint e = get_global_id(0);
-  if (e >= ne) return;
-  int a = edges[2 * e], b = edges[2 * e + 1];
-  if (!vflags[a] || !vflags[b]) { /* an S-edge joins two S vertices (most edges: checked first) */
-    eflags[e] = 0;
-    return;
-  }
-  if (carry && !ndirty[a]) { /* ring(a), which decides the flags, is unchanged */
-    int eo = tcc_edge_id(prev_nb_off, prev_nb, prev_nb_edge, vold[a], vold[b]);
-    if (eo >= 0) {
-      eflags[e] = prev_eflags[eo];
-      return;
-    }
-  }
+/* The ridge rule of tc::build_topology for an S-edge (a, b) with ns owned S-faces through it, the
+ * first two of them oriented a -> b or not (fwd0, fwd1) with unit normals n0, n1: a ridge when
+ * ns != 2, when the two faces traverse the edge in the same direction, or when
+ * 1 - dot(n0, n1) > eps_r. Symmetric in a and b (swapping them flips both directions). */
+inline int tcc_ridge_rule(int ns, int fwd0, int fwd1, double3 n0, double3 n1, double eps_r) {
+  if (ns != 2) return 1;
+  if (fwd0 == fwd1) return 1;
+  return 1.0 - tcc_dot(n0, n1) > eps_r;
+}
+
+/* Edge flags of (a, b) from ring(a): S membership (boundary / interface: the kinds of the
+ * owned S-faces through the edge) and TCC_RIDGE by tcc_ridge_rule. */
+inline uchar tcc_edge_flags_of(int a, int b, __global const int* tets, __global const uint* vt_off,
+                               __global const int* vt, __global const int* tet_nbr, __global const int* labels,
+                               int use_labels, __global const double* pts, double eps_r) {
   uint flags = 0;
   int ns = 0;
   int ft[2], ff[2];
@@ -422,65 +413,83 @@ __kernel void conn_edge_flags(uint ne, __global const int* edges, __global const
     }
   }
   if (ns > 0) {
-    int ridge = 0;
-    if (ns != 2) {
-      ridge = 1;
-    } else {
-      int dir[2];
-      for (int k = 0; k < 2; ++k) {
-        __global const int* q = tets + 4 * ft[k];
-        int f0 = q[TC_TET_FACES[ff[k]][0]], f1 = q[TC_TET_FACES[ff[k]][1]], f2 = q[TC_TET_FACES[ff[k]][2]];
-        dir[k] = (f0 == a && f1 == b) || (f1 == a && f2 == b) || (f2 == a && f0 == b);
-      }
-      if (dir[0] == dir[1]) {
-        ridge = 1;
-      } else {
-        double3 n0 = tcc_face_normal(pts, tets, ft[0], ff[0]);
-        double3 n1 = tcc_face_normal(pts, tets, ft[1], ff[1]);
-        ridge = 1.0 - tcc_dot(n0, n1) > eps_r;
-      }
+    int dir[2] = {0, 0};
+    double3 n[2] = {(double3)(0.0), (double3)(0.0)};
+    for (int k = 0; k < 2 && k < ns; ++k) {
+      __global const int* q = tets + 4 * ft[k];
+      int f0 = q[TC_TET_FACES[ff[k]][0]], f1 = q[TC_TET_FACES[ff[k]][1]], f2 = q[TC_TET_FACES[ff[k]][2]];
+      dir[k] = (f0 == a && f1 == b) || (f1 == a && f2 == b) || (f2 == a && f0 == b);
+      n[k] = tcc_face_normal(pts, tets, ft[k], ff[k]);
     }
-    if (ridge) flags |= TCC_RIDGE;
+    if (tcc_ridge_rule(ns, dir[0], dir[1], n[0], n[1], eps_r)) flags |= TCC_RIDGE;
   }
-  eflags[e] = (uchar)flags;
+  return (uchar)flags;
 }
 
 #ifndef TCC_MAX_VERTEX_SFACES
 #define TCC_MAX_VERTEX_SFACES 64
 #endif
 
-/* Vertex flags and class with tc::build_topology's rules (see include/tetcollapse/topology.hpp):
- * ridge when exactly two ridge edges; face when no ridge edge, all normals within eps_f and the
- * S-faces form one closed fan; corner otherwise. More than TCC_MAX_VERTEX_SFACES S-faces at a
- * vertex (never seen in practice) classify it as corner, which only protects it more. */
-__kernel void conn_vertex_class(uint nv, __global const int* tets, __global const uint* vt_off,
-                                __global const int* vt, __global const int* tet_nbr, __global const int* labels,
-                                int use_labels,
-                                __global const double* pts, __global const uint* nb_off,
-                                __global const int* nb_edge, __global const uchar* eflags, double eps_f,
-                                __global const uchar* vflags, __global uchar* vclass, int carry,
-                                __global const uchar* ndirty, __global const int* vold,
-                                __global const uchar* prev_vclass) {
+/* Edge flags and vertex classes, per vertex v: the flags of the edges v owns (v < u) and the class
+ * of v, from the owned S-faces through v, gathered once (rather than a ring scan per edge).
+ *   Edge flags: S membership (boundary / interface) and the ridge rule of tc::build_topology
+ *   (tcc_ridge_rule). An S-edge joins two S vertices (most edges are not: 0 at once); the
+ *   S-faces through (v, u) are those of v's faces that have u as a vertex.
+ *   Class, with tc::build_topology's rules (see include/tetcollapse/topology.hpp): ridge when
+ *   exactly two ridge edges; face when no ridge edge, all normals within eps_f and the S-faces
+ *   form one closed fan; corner otherwise. The ridge edges at v are those to the vertices of its
+ *   S-faces (the rule is symmetric: v's work item decides the edges it does not own the same way
+ *   as their owners do).
+ * More than TCC_MAX_VERTEX_SFACES S-faces at a vertex (never seen in practice) classify it as
+ * corner, which only protects it more, and its edges' flags come from ring scans
+ * (tcc_edge_flags_of). With carry, a vertex whose ring is unchanged (ndirty == 0) keeps its
+ * class and its edges' flags (found in the previous N(v)). */
+__kernel void conn_surface_flags(uint nv, __global const int* tets, __global const uint* vt_off,
+                                 __global const int* vt, __global const int* tet_nbr, __global const int* labels,
+                                 int use_labels, __global const double* pts, double eps_r, double eps_f,
+                                 __global const uint* nb_off, __global const int* nb, __global const uint* edge_off,
+                                 __global const uchar* vflags, __global uchar* eflags, __global uchar* vclass,
+                                 int carry, __global const uchar* ndirty, __global const int* vold,
+                                 __global const uint* prev_nb_off, __global const int* prev_nb,
+                                 __global const int* prev_nb_edge, __global const uchar* prev_eflags,
+                                 __global const uchar* prev_vclass) {
   uint v = get_global_id(0);
   if (v >= nv) return;
-  if (carry && !ndirty[v]) { /* ring(v) unchanged */
-    vclass[v] = prev_vclass[vold[v]];
+  const uint e0 = edge_off[v], up = edge_off[v + 1] - e0;
+  __global const int* upper = nb + (nb_off[v + 1] - up); /* N(v) above v, in edge order */
+  const int on_s = vflags[v] != 0;
+  if (carry && !ndirty[v]) { /* ring(v), which decides the class and the owned edges' flags, is unchanged */
+    const int o = vold[v];
+    vclass[v] = prev_vclass[o];
+    for (uint i = 0; i < up; ++i) {
+      const int u = upper[i];
+      uchar fl = 0;
+      if (on_s && vflags[u]) {
+        const int eo = tcc_edge_id(prev_nb_off, prev_nb, prev_nb_edge, o, vold[u]);
+        fl = eo >= 0 ? prev_eflags[eo] : tcc_edge_flags_of((int)v, u, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, eps_r);
+      }
+      eflags[e0 + i] = fl;
+    }
     return;
   }
-  if (!vflags[v]) {
+  if (!on_s) {
+    for (uint i = 0; i < up; ++i) eflags[e0 + i] = 0;
     vclass[v] = TCC_INTERIOR;
     return;
   }
+  /* the owned S-faces through v: kind, the vertices after and before v along the face's
+   * orientation, unit normal */
   double3 normal[TCC_MAX_VERTEX_SFACES];
   int after[TCC_MAX_VERTEX_SFACES], before[TCC_MAX_VERTEX_SFACES];
+  uchar kind[TCC_MAX_VERTEX_SFACES];
   int fn = 0, overflow = 0;
   for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
     int t = vt[i];
     int lv = tcc_local(tets, t, (int)v);
     for (int f = 0; f < 4; ++f) {
       if (f == lv) continue;
-      uint on_s;
-      uint own = tcc_owned_sface(tet_nbr, labels, use_labels, t, f, &on_s);
+      uint s_kind;
+      uint own = tcc_owned_sface(tet_nbr, labels, use_labels, t, f, &s_kind);
       if (!own) continue;
       if (fn == TCC_MAX_VERTEX_SFACES) {
         overflow = 1;
@@ -491,53 +500,92 @@ __kernel void conn_vertex_class(uint nv, __global const int* tets, __global cons
       int p = w[0] == (int)v ? 0 : w[1] == (int)v ? 1 : 2;
       after[fn] = w[(p + 1) % 3];
       before[fn] = w[(p + 2) % 3];
+      kind[fn] = (uchar)own;
       normal[fn] = tcc_face_normal(pts, tets, t, f);
       ++fn;
     }
   }
+  if (overflow) {
+    for (uint i = 0; i < up; ++i) {
+      const int u = upper[i];
+      eflags[e0 + i] = vflags[u] ? tcc_edge_flags_of((int)v, u, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, eps_r) : 0;
+    }
+    vclass[v] = TCC_CORNER;
+    return;
+  }
+  /* (v, u) through v's S-faces: flags, and whether it is a ridge */
+#define TCC_SF_EDGE(U, FLAGS, RIDGE)                                                             \
+  {                                                                                              \
+    int ns_ = 0, k0_ = 0, k1_ = 0;                                                               \
+    for (int j_ = 0; j_ < fn; ++j_)                                                              \
+      if (after[j_] == (U) || before[j_] == (U)) {                                               \
+        (FLAGS) |= kind[j_];                                                                     \
+        if (ns_ == 0) k0_ = j_;                                                                  \
+        else if (ns_ == 1) k1_ = j_;                                                             \
+        ++ns_;                                                                                   \
+      }                                                                                          \
+    (RIDGE) = ns_ > 0 && tcc_ridge_rule(ns_, after[k0_] == (U), after[k1_] == (U), normal[k0_], normal[k1_], eps_r); \
+  }
+  for (uint i = 0; i < up; ++i) {
+    const int u = upper[i];
+    uint fl = 0;
+    int ridge = 0;
+    if (vflags[u]) TCC_SF_EDGE(u, fl, ridge);
+    eflags[e0 + i] = (uchar)(fl | (ridge ? TCC_RIDGE : 0u));
+  }
+  if (fn == 0) {
+    vclass[v] = TCC_INTERIOR;
+    return;
+  }
+  /* the ridge edges at v: each vertex of v's S-faces once */
+  int ridges = 0;
+  for (int j = 0; j < fn; ++j)
+    for (int side = 0; side < 2; ++side) {
+      const int u = side == 0 ? after[j] : before[j];
+      int seen = side == 1 && after[j] == u;
+      for (int k = 0; k < j && !seen; ++k) seen = after[k] == u || before[k] == u;
+      if (seen) continue;
+      uint fl = 0;
+      int ridge = 0;
+      TCC_SF_EDGE(u, fl, ridge);
+      ridges += ridge;
+    }
+#undef TCC_SF_EDGE
   uchar cls;
-  if (fn == 0 && !overflow) {
-    cls = TCC_INTERIOR;
-  } else if (overflow) {
+  if (ridges == 2) {
+    cls = TCC_RIDGEV;
+  } else if (ridges != 0) {
     cls = TCC_CORNER;
   } else {
-    int ridges = 0;
-    for (uint i = nb_off[v]; i < nb_off[v + 1]; ++i) ridges += (eflags[nb_edge[i]] & TCC_RIDGE) ? 1 : 0;
-    if (ridges == 2) {
-      cls = TCC_RIDGEV;
-    } else if (ridges != 0) {
-      cls = TCC_CORNER;
-    } else {
-      cls = TCC_FACE;
-      for (int i = 0; i < fn && cls == TCC_FACE; ++i)
-        for (int j = i + 1; j < fn; ++j)
-          if (1.0 - tcc_dot(normal[i], normal[j]) > eps_f) {
-            cls = TCC_CORNER;
-            break;
-          }
-      if (cls == TCC_FACE) {
-        /* one closed fan: following before -> the unique face whose `after` equals it runs
-         * through all fn faces and closes (the walk's result does not depend on the start) */
-        int cur = 0;
-        for (int step = 1; step <= fn; ++step) {
-          int want = before[cur], next = -1, found = 0;
-          for (int j = 0; j < fn; ++j)
-            if (after[j] == want) {
-              next = j;
-              ++found;
-            }
-          if (found != 1) {
-            cls = TCC_CORNER;
-            break;
-          }
-          cur = next;
-          if (cur == 0 && step != fn) {
-            cls = TCC_CORNER;
-            break;
-          }
+    cls = TCC_FACE;
+    for (int i = 0; i < fn && cls == TCC_FACE; ++i)
+      for (int j = i + 1; j < fn; ++j)
+        if (1.0 - tcc_dot(normal[i], normal[j]) > eps_f) {
+          cls = TCC_CORNER;
+          break;
         }
-        if (cls == TCC_FACE && cur != 0) cls = TCC_CORNER;
+    if (cls == TCC_FACE) {
+      /* one closed fan: following before -> the unique face whose `after` equals it runs
+       * through all fn faces and closes (the walk's result does not depend on the start) */
+      int cur = 0;
+      for (int step = 1; step <= fn; ++step) {
+        int want = before[cur], next = -1, found = 0;
+        for (int j = 0; j < fn; ++j)
+          if (after[j] == want) {
+            next = j;
+            ++found;
+          }
+        if (found != 1) {
+          cls = TCC_CORNER;
+          break;
+        }
+        cur = next;
+        if (cur == 0 && step != fn) {
+          cls = TCC_CORNER;
+          break;
+        }
       }
+      if (cls == TCC_FACE && cur != 0) cls = TCC_CORNER;
     }
   }
   vclass[v] = cls;

@@ -201,7 +201,7 @@ uint8_t SeqMesh::triangle_kind(int32_t x, int32_t y, int32_t z) const {
   return 0;
 }
 
-// --- flags and classes (conn_edge_flags, conn_vertex_flags*, conn_vertex_class) ---
+// --- flags and classes (conn_vertex_flags*, conn_surface_flags) ---
 
 uint8_t SeqMesh::edge_flags(int32_t a, int32_t b, bool with_ridge) {
   if (!vflags_[a] || !vflags_[b]) return 0;  // an S-edge joins two S vertices
@@ -320,7 +320,7 @@ void SeqMesh::classify(int32_t v, uint8_t& flags_out, uint8_t& cls_out) {
     cls_out = TCC_CORNER;
     return;
   }
-  // ridge edges at v: the edges (v, u) of its owned S-faces that conn_edge_flags calls ridges
+  // ridge edges at v: the edges (v, u) of its owned S-faces that conn_surface_flags calls ridges (as it counts them)
   us_.clear();
   for (const SFace& s : sfaces_) {
     us_.push_back(s.after);
@@ -358,7 +358,7 @@ void SeqMesh::classify(int32_t v, uint8_t& flags_out, uint8_t& cls_out) {
           break;
         }
     if (cls == TCC_FACE) {
-      // one closed fan, walked as conn_vertex_class does (the result does not depend on the start)
+      // one closed fan, walked as conn_surface_flags does (the result does not depend on the start)
       int cur = 0;
       for (int step = 1; step <= fn; ++step) {
         int32_t want = sfaces_[cur].before;

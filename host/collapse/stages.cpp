@@ -349,11 +349,9 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   run(ctx, F, "conn_vertex_flags_faces", nt, "", U(nt), B(dm.tets), B(c.tet_nbr), primary_labels(dm), use_labels,
       B(c.up_count), B(c.owns_s));
   run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(c.up_count), B(c.vflags));
-  run(ctx, F, "conn_edge_flags", c.ne, "", U(c.ne), B(c.edges), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr),
-      primary_labels(dm), use_labels, B(dm.points), p.eps_r, B(c.vflags), B(c.eflags), ci, nd, vo, pno, pnb, pne, pef);
-  run(ctx, F, "conn_vertex_class", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
-      use_labels, B(dm.points), B(c.nb_off), B(c.nb_edge), B(c.eflags), p.eps_f, B(c.vflags), B(c.vclass), ci, nd, vo,
-      pvc);
+  run(ctx, F, "conn_surface_flags", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
+      use_labels, B(dm.points), p.eps_r, p.eps_f, B(c.nb_off), B(c.nb), B(c.edge_off), B(c.vflags), B(c.eflags),
+      B(c.vclass), ci, nd, vo, pno, pnb, pne, pef, pvc);
 }
 
 namespace {
