@@ -351,22 +351,24 @@ __kernel void conn_tet_neighbours(uint n, __global const int* tets, __global con
  * the S kind of each of its faces into the face's vertices (few faces are on S, so the atomics
  * are rare; OR is order-independent), then the bits become vflags. Per tet rather than per
  * vertex ring: each face is looked at from 2 tets instead of from 3 vertices x 2 tets.
- * owns_s[t]: whether t owns an S face (tcc_owned_sface), for the surface guard. */
+ * owns_s[t]: whether t owns an S face (tcc_owned_sface), and smask[t] which (bit f: the face
+ * opposite local vertex f), for the surface guard. */
 __kernel void conn_vertex_flags_faces(uint nt, __global const int* tets, __global const int* tet_nbr,
                                       __global const int* labels, int use_labels, __global uint* bits,
-                                      __global uint* owns_s) {
+                                      __global uint* owns_s, __global uchar* smask) {
   uint t = get_global_id(0);
   if (t >= nt) return;
   __global const int* q = tets + 4 * t;
   uint owns = 0;
   for (int f = 0; f < 4; ++f) {
     uint on_s;
-    owns |= tcc_owned_sface(tet_nbr, labels, use_labels, (int)t, f, &on_s);
+    if (tcc_owned_sface(tet_nbr, labels, use_labels, (int)t, f, &on_s)) owns |= 1u << f;
     if (!on_s) continue;
     for (int j = 0; j < 4; ++j)
       if (j != f) atomic_or(&bits[q[j]], on_s);
   }
   owns_s[t] = owns != 0; /* the tets the surface guard looks at */
+  smask[t] = (uchar)owns;
 }
 
 __kernel void conn_vertex_flags(uint nv, __global const uint* bits, __global uchar* vflags) {

@@ -257,10 +257,38 @@ inline int tcc_sg_owner_cell(double3 alo, double3 ahi, int i0, int j0, int k0, _
         }                                                                                                    \
   }
 
-/* Every current S face against the queries whose box it overlaps. */
-__kernel void sguard_surface(uint n, __global const uint* stets, __global const double* pts,
-                             __global const int* tets, __global const int* tet_nbr, __global const int* labels,
-                             int use_labels, __global const int* qrep, __global const double* qbox,
+/* The grid cell of every vertex, packed (i | j << 10 | k << 20; at most 1024 cells per axis): a
+ * face's cells per axis run from the smallest to the largest of its vertices' (tcc_sg_cell does
+ * not decrease with the coordinate), so sguard_surface finds the faces near no query from these
+ * alone, without their points. */
+__kernel void sguard_vertex_cells(uint nv, __global const double* pts, double ox, double oy, double oz, double ih,
+                                  int gx, int gy, int gz, __global uint* vcell) {
+  uint v = get_global_id(0);
+  if (v >= nv) return;
+  double3 p = tc_point(pts, v);
+  vcell[v] = (uint)tcc_sg_cell(p.x, ox, ih, gx) | (uint)tcc_sg_cell(p.y, oy, ih, gy) << 10 |
+             (uint)tcc_sg_cell(p.z, oz, ih, gz) << 20;
+}
+
+/* Is a query entered in a cell of the box of cells spanned by the packed cells a, b, c? */
+inline int tcc_sg_cells_used(uint a, uint b, uint c, int gx, int gy, __global const uint* cell_off) {
+  const uint m = 0x3ffu;
+  const int i0 = min(min(a & m, b & m), c & m), i1 = max(max(a & m, b & m), c & m);
+  const int j0 = min(min((a >> 10) & m, (b >> 10) & m), (c >> 10) & m), j1 = max(max((a >> 10) & m, (b >> 10) & m), (c >> 10) & m);
+  const int k0 = min(min(a >> 20, b >> 20), c >> 20), k1 = max(max(a >> 20, b >> 20), c >> 20);
+  for (int ck = k0; ck <= k1; ++ck)
+    for (int cj = j0; cj <= j1; ++cj) {
+      const uint row = ((uint)ck * (uint)gy + (uint)cj) * (uint)gx;
+      if (cell_off[row + (uint)i0] != cell_off[row + (uint)i1 + 1]) return 1;
+    }
+  return 0;
+}
+
+/* Every current S face (smask: the faces a tet owns on S) against the queries whose box it
+ * overlaps; a face in cells without queries (vcell) is passed over before its points are read. */
+__kernel void sguard_surface(uint n, __global const uint* stets, __global const uchar* smask,
+                             __global const uint* vcell, __global const double* pts,
+                             __global const int* tets, __global const int* qrep, __global const double* qbox,
                              __global const uint* qoff, __global const int* tid, __global const double* tpos,
                              __global const double* tbox, __global const double* tplane, double ox, double oy, double oz,
                              double ih, int gx, int gy, int gz, __global const uint* cell_off,
@@ -269,15 +297,14 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
   if (g >= n) return;
   const uint t = stets[g];
   __global const int* tq = tets + 4 * t;
+  const uint mask = smask[t];
   for (int f = 0; f < 4; ++f) {
-    uint on_s;
-    if (!tcc_owned_sface(tet_nbr, labels, use_labels, (int)t, f, &on_s)) continue;
+    if (!(mask & (1u << f))) continue;
     int fid[3];
+    for (int k = 0; k < 3; ++k) fid[k] = tq[TC_TET_FACES[f][k]];
+    if (!tcc_sg_cells_used(vcell[fid[0]], vcell[fid[1]], vcell[fid[2]], gx, gy, cell_off)) continue;
     double3 fpos[3];
-    for (int k = 0; k < 3; ++k) {
-      fid[k] = tq[TC_TET_FACES[f][k]];
-      fpos[k] = tc_point(pts, fid[k]);
-    }
+    for (int k = 0; k < 3; ++k) fpos[k] = tc_point(pts, fid[k]);
     double3 lo = fmin(fmin(fpos[0], fpos[1]), fpos[2]), hi = fmax(fmax(fpos[0], fpos[1]), fpos[2]);
     int has_plane = 0; /* the face's plane, computed at its first triangle test */
     tc_sg_plane fplane;

@@ -49,6 +49,7 @@ int cell_of(double v, double org, double ih, int n) {
 // At most this many cells per axis: the grid is over the union of the query boxes, which
 // may be spread over the whole mesh.
 constexpr int kMaxCellsPerAxis = 48;
+static_assert(kMaxCellsPerAxis + 1 < 1024, "sguard_vertex_cells packs a cell in 10 bits per axis");
 
 }  // namespace
 
@@ -148,8 +149,11 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
     n_stets = dev::compact_indices(ctx, c.owns_s, stets, dm.nt);
     stets_generation = c.generation;
   }
-  launch(ctx, p, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), dm.points.buffer(), dm.tets.buffer(),
-         c.tet_nbr.buffer(), labels, use_labels, qrep.buffer(), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
+  ensure_nonempty(vcell, ctx, dm.nv);
+  launch(ctx, p, "sguard_vertex_cells", dm.nv, cl_uint(dm.nv), dm.points.buffer(), cl_double(lo[0]), cl_double(lo[1]),
+         cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), vcell.buffer());
+  launch(ctx, p, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), c.smask.buffer(), vcell.buffer(),
+         dm.points.buffer(), dm.tets.buffer(), qrep.buffer(), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
          tbox.buffer(), tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
          cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer());
   launch(ctx, p, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),

@@ -344,10 +344,11 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   }
   c.up_count.fill(0);  // scratch reuse (its scan is done): S bits per vertex
   ensure(c.owns_s, ctx, nt);
+  ensure(c.smask, ctx, nt);
   static std::atomic<uint64_t> generations{0};  // unique across Connectivity objects
   c.generation = ++generations;
   run(ctx, F, "conn_vertex_flags_faces", nt, "", U(nt), B(dm.tets), B(c.tet_nbr), primary_labels(dm), use_labels,
-      B(c.up_count), B(c.owns_s));
+      B(c.up_count), B(c.owns_s), B(c.smask));
   run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(c.up_count), B(c.vflags));
   run(ctx, F, "conn_surface_flags", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
       use_labels, B(dm.points), p.eps_r, p.eps_f, B(c.nb_off), B(c.nb), B(c.edge_off), B(c.vflags), B(c.eflags),

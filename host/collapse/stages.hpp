@@ -38,6 +38,7 @@ struct Connectivity {
   DeviceBuffer<int32_t> tet_nbr;   // 4 per tet: tet across each face (collapse_common.h)
   DeviceBuffer<uint8_t> vflags, vclass, eflags;  // see collapse_common.h
   DeviceBuffer<uint32_t> owns_s;   // per tet: 1 when it owns an S face (the surface guard's tets)
+  DeviceBuffer<uint8_t> smask;     // per tet: which faces it owns on S (bit f: the face opposite local vertex f)
   uint64_t generation = 0;         // new (process-wide unique) at every build_connectivity
   // scratch
   DeviceBuffer<uint32_t> count, cursor, up_count;
