@@ -49,6 +49,7 @@ inline void tcc_group_count(uint flag, volatile __local uint* lc, __global uint*
 #define TCC_REFUSED_QUALITY 6 /* 5 is the host's "untested" */
 #define TCC_UNTESTED 5 /* lazy filter: marked, passed Q, never tested (a cheaper rival won) */
 #define TCC_VERDICT_UNKNOWN 0xff /* collapse_verdicts.cl: no test result kept for the edge */
+#define TCC_REFUSED_SURFACE 7 /* by the surface guard (collapse_guard.cl) */
 #define TCC_VOLUME_OK 8 /* verdict only: the volume test passed, the link condition is untested */
 
 /* Per-edge states of the conflict passes and of the lazy admissible filter. */

@@ -386,10 +386,8 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
   })
 }
 
-/* Refusal reason of the guard, kept as the edge's verdict (collapse_verdicts.cl) so that the
- * edge is not chosen again while its rings do not change. */
-#define TCC_REFUSED_SURFACE 7
-
+/* The guard's refusal is kept as the edge's verdict (TCC_REFUSED_SURFACE, collapse_verdicts.cl)
+ * so that the edge is not chosen again while its rings do not change. */
 /* A query with a hit is unmarked (selected again without it) and its verdict set (when the
  * verdict buffer is there); counts them. */
 __kernel void sguard_drop(uint nq, __global const int* qedge, __global const uint* qbad, __global uint* marked,

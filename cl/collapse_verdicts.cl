@@ -71,3 +71,16 @@ __kernel void merge_rounds_vertices(uint nv, __global const int* vaff1, __global
   if (v >= nv || vaff1[v] < 0) return;
   vaff[v] = vaff1[v];
 }
+
+/* The host tail's touched flags (collapse/sequential_run.hpp, TailSeed), per vertex of the
+ * current mesh after carry_verdicts: its ring changed in the last iteration (ndirty), or an edge
+ * at it keeps the surface guard's refusal (the guard looks beyond the star, so such an edge is
+ * tested again). */
+__kernel void tail_touched(uint nv, __global const uchar* ndirty, __global const uint* nb_off,
+                           __global const int* nb_edge, __global const uchar* verdict, __global uchar* touched) {
+  uint v = get_global_id(0);
+  if (v >= nv) return;
+  uchar t = ndirty[v];
+  for (uint j = nb_off[v]; j < nb_off[v + 1] && !t; ++j) t = verdict[nb_edge[j]] == TCC_REFUSED_SURFACE;
+  touched[v] = t;
+}

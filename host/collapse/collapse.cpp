@@ -2,8 +2,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <numeric>
 #include <stdexcept>
+#include <string>
 
 #include "collapse/guard_surface.hpp"
 #include "collapse/sequential_run.hpp"
@@ -123,7 +125,7 @@ bool host_tail_due(const CollapseOptions& o, double fraction, const std::vector<
 // triangles and edges already remapped), with the run's target and volume threshold and the
 // current mask. Its iterations continue the report's.
 void finish_on_host(Mesh& mesh, const CollapseOptions& options, const collapse_detail::StageParams& p,
-                    std::vector<uint8_t> mask, CollapseReport& report) {
+                    std::vector<uint8_t> mask, const sequential_detail::TailSeed* seed, CollapseReport& report) {
   const int done = int(report.iterations.size());
   CollapseOptions o = options;
   o.method = CollapseOptions::Sequential;
@@ -141,13 +143,38 @@ void finish_on_host(Mesh& mesh, const CollapseOptions& options, const collapse_d
   o.progress = [&](const IterationStats& s) {
     if (options.progress) options.progress(continued(s));
   };
-  sequential_detail::SequentialRun run(mesh, o);
+  sequential_detail::SequentialRun run(mesh, o, seed);
   run.set_greedy(true);
   while (run.step()) {
   }
   const CollapseReport r = run.finish();
   for (const IterationStats& t : r.iterations) report.iterations.push_back(continued(t));
   report.seconds_total += r.seconds_total;
+}
+
+// TETCOLLAPSE_HOST_TAIL_SEED=0 hands the host tail the mesh alone (a switch for the tests, which
+// compare both ways: the same output).
+bool tail_seed_enabled() {
+  const char* e = std::getenv("TETCOLLAPSE_HOST_TAIL_SEED");
+  return !(e && std::string(e) == "0");
+}
+
+// The host tail's seed (sequential_run.hpp) for the current mesh: its connectivity (carried
+// through the last compaction, as the next iteration would build it), the flags and classes,
+// and the touched flags (tail_touched) where the last iteration's selection was greedy and the
+// verdicts are carried; else every vertex counts as touched.
+void tail_seed(Context& ctx, DeviceMesh& dm, Connectivity& conn, EdgeState& st, const StageParams& p,
+               const CollapseOptions& options, sequential_detail::TailSeed& seed) {
+  const bool reuse = options.reuse_across_iterations;
+  build_connectivity(ctx, dm, conn, p, reuse ? &st : nullptr);
+  seed.vflags = conn.vflags.download_range(0, dm.nv);
+  seed.vclass = conn.vclass.download_range(0, dm.nv);
+  if (reuse && options.conflicts == CollapseOptions::Greedy) {
+    carry_verdicts(ctx, dm, conn, st);
+    seed.touched = tail_touched(ctx, dm, conn, st);
+  } else {
+    seed.touched.assign(dm.nv, 1);
+  }
 }
 
 }  // namespace
@@ -196,6 +223,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   EdgeState st;
   SurfaceGuard guard;
   bool host_tail = false;
+  sequential_detail::TailSeed seed;
   const double tail_fraction = host_tail_fraction(options, ctx.info());
   p.target = options.target_length;
   const double t_loop = now();
@@ -286,6 +314,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     if (s.collapsed < std::max<int64_t>(options.eps_c, 1)) break;
     if (host_tail_due(options, tail_fraction, report.iterations)) {
       host_tail = true;
+      if (tail_seed_enabled()) tail_seed(ctx, dm, conn, st, p, options, seed);
       break;
     }
   }
@@ -302,7 +331,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   std::vector<uint8_t> mask;
   if (host_tail && dm.has_mask) mask = dm.vmask.download_range(0, dm.nv);
   report.seconds_download = now() - t_down;
-  if (host_tail) finish_on_host(mesh, options, p, std::move(mask), report);
+  if (host_tail) finish_on_host(mesh, options, p, std::move(mask), seed.vflags.empty() ? nullptr : &seed, report);
   report.vertices_out = mesh.num_vertices();
   report.tets_out = mesh.num_tets();
   return report;

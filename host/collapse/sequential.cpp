@@ -88,12 +88,12 @@ SeqParams seq_params_from(const CollapseOptions& o) {
   return p;
 }
 
-SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options)
+SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const TailSeed* seed)
     : mesh_(mesh),
       o_(options),
       t_start_(std::chrono::steady_clock::now()),
       params_(checked_params(mesh, options)),
-      sm_(mesh, params_) {
+      sm_(mesh, params_, seed ? &seed->vflags : nullptr, seed ? &seed->vclass : nullptr) {
   report_.device = "cpu-sequential";
   report_.vertices_in = mesh.num_vertices();
   report_.tets_in = mesh.num_tets();
@@ -103,7 +103,13 @@ SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options)
     origin_.resize(size_t(mesh.num_vertices()));
     for (size_t i = 0; i < origin_.size(); ++i) origin_[i] = int32_t(i);
   }
-  touched_.assign(size_t(sm_.num_vertices()), 0);
+  touched_.assign(size_t(sm_.num_vertices()), 0);  // 0: touched "in the iteration before the first"
+  if (seed && o_.reuse_across_iterations) {
+    if (seed->touched.size() != touched_.size())
+      throw std::invalid_argument("SequentialRun: the seed's touched flags need one entry per vertex");
+    // untouched: a value no iteration's prev or cur (it_, it_ + 1) takes
+    for (size_t v = 0; v < touched_.size(); ++v) touched_[v] = seed->touched[v] ? 0u : 0xffffffffu;
+  }
   target_ = options.target_length;
 }
 

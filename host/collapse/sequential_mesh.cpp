@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <string>
 
 #include "collapse/stages.hpp"  // collapse_detail::Reason
@@ -59,7 +60,8 @@ bool runs(const int32_t* q, int f, int32_t x, int32_t y) {
 
 }  // namespace
 
-SeqMesh::SeqMesh(Mesh& mesh, const SeqParams& params)
+SeqMesh::SeqMesh(Mesh& mesh, const SeqParams& params, const std::vector<uint8_t>* vflags,
+                 const std::vector<uint8_t>* vclass)
     : mesh_(mesh), points_(&mesh.points), tets_(&mesh.tets), p_(params) {
   collapse_detail::check_collapse_input(mesh);  // the same refusals as the device pipeline
   const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
@@ -80,9 +82,16 @@ SeqMesh::SeqMesh(Mesh& mesh, const SeqParams& params)
   fwd_.assign(nv_, -1);
   mark_.assign(nv_, 0);
   lmark_.assign(nv_, 0);
+  rebuild_rings();
+  if (vflags && vclass) {
+    if (vflags->size() != size_t(nv_) || vclass->size() != size_t(nv_))
+      throw std::invalid_argument("SeqMesh: the given vertex flags and classes need one entry per vertex");
+    vflags_ = *vflags;
+    vclass_ = *vclass;
+    return;
+  }
   vflags_.assign(nv_, 0);
   vclass_.assign(nv_, TCC_INTERIOR);
-  rebuild_rings();
   for (int32_t v = 0; v < nv_; ++v) classify(v, vflags_[v], vclass_[v]);
 }
 
@@ -568,9 +577,11 @@ int32_t SeqMesh::collapse(int32_t a, int32_t b, uint8_t dir) {
   }
   // the tets of the edge disappear, the other tets of ring(r) move to s
   rr_.assign(ring(r), ring(r) + rlen_[r]);
+  gone_.clear();
   for (int32_t t : rr_) {
     int32_t* q = tets_->data() + 4 * size_t(t);
     if (has(q, s)) {
+      gone_.insert(gone_.end(), q, q + 4);
       talive_[t] = 0;
       --alive_t_;
       for (int k = 0; k < 4; ++k)
@@ -594,11 +605,34 @@ int32_t SeqMesh::collapse(int32_t a, int32_t b, uint8_t dir) {
         double& x = f.values[size_t(s) * f.components + c];
         x = 0.5 * (x + f.values[size_t(r) * f.components + c]);
       }
-  // faces of S change only through s, and only when r or s is on S; a vertex off S stays off
-  // S (see the header), so only s and the touched vertices on S are classified again
-  if (on_s)
-    for (int32_t u : touched_)
-      if (valive_[u] && (vflags_[u] || u == s)) classify(u, vflags_[u], vclass_[u]);
+  // Faces of S change only through s, and only when r or s is on S; a vertex off S stays off
+  // S (see the header). A touched vertex u's class depends on its S-faces and their vertices'
+  // positions: those faces change (are renamed to s, moved with s, glued) only where they hold s
+  // now, or belonged to a removed tet. So s is classified again, then the vertices of its S-faces
+  // (classify(s) lists them in sfaces_) and the vertices on S of the removed tets; every other
+  // touched vertex keeps its class (verify_classes() checks it in the tests). When s's list
+  // overflows, every touched vertex on S.
+  if (on_s) {
+    classify(s, vflags_[s], vclass_[s]);
+    if (sfaces_.size() >= kMaxVertexSFaces) {
+      for (int32_t u : touched_)
+        if (valive_[u] && vflags_[u] && u != s) classify(u, vflags_[u], vclass_[u]);
+    } else {
+      reclass_.clear();
+      for (const SFace& f : sfaces_) {
+        reclass_.push_back(f.after);
+        reclass_.push_back(f.before);
+      }
+      reclass_.insert(reclass_.end(), gone_.begin(), gone_.end());
+      const uint32_t st2 = next_stamp();
+      mark_[s] = st2;
+      for (int32_t u : reclass_)
+        if (mark_[u] != st2) {
+          mark_[u] = st2;
+          if (valive_[u] && vflags_[u]) classify(u, vflags_[u], vclass_[u]);
+        }
+    }
+  }
   // the S faces that changed (moved, renamed, or owned by another tet now) all contain s
   if (on_s && guard_on_) {
     const int32_t* rs = ring(s);

@@ -54,8 +54,12 @@ struct Verdict {
 class SeqMesh {
  public:
   // Works on `mesh` in place (points, tets, labels, fields). Throws tc::InputError for a mesh
-  // the method cannot take (as the device pipeline's upload does).
-  SeqMesh(Mesh& mesh, const SeqParams& params);
+  // the method cannot take (as the device pipeline's upload does). With vflags and vclass (one
+  // per vertex, both or neither), the flags and classes are taken from them instead of being
+  // computed: the parallel method's host tail hands over the device's, made by the same rules
+  // (verify_classes() recomputes them).
+  SeqMesh(Mesh& mesh, const SeqParams& params, const std::vector<uint8_t>* vflags = nullptr,
+          const std::vector<uint8_t>* vclass = nullptr);
 
   int32_t num_vertices() const { return nv_; }  // slots, dead ones included until compact()
   int32_t num_tets() const { return nt_; }
@@ -167,7 +171,7 @@ class SeqMesh {
   // scratch, reused: no allocation per check or collapse once warm
   std::vector<uint32_t> mark_, lmark_;
   uint32_t stamp_ = 0;
-  std::vector<int32_t> cn_, pc_, pd_, rr_, touched_, tab_;
+  std::vector<int32_t> cn_, pc_, pd_, rr_, touched_, tab_, gone_, reclass_;
   std::vector<FaceAt> faces_;
   // surface guard: cells of the grid -> S faces (4 t + f) registered there, possibly stale
   // (a dead tet, a face no longer on S, or one registered again after it moved): checked on use

@@ -50,10 +50,22 @@ namespace tc::sequential_detail {
 
 SeqParams seq_params_from(const CollapseOptions& o);
 
+// What the parallel method hands its host tail (collapse.cpp) besides the mesh, all per vertex
+// of the current mesh: the flags and classes (the device's, made by the same rules: SeqMesh
+// does not compute them again), and whether the star changed in the device's last iteration
+// (touched; also the end points of an edge the surface guard refused). An edge whose end points
+// are both untouched was not admissible then (the greedy selection takes or blocks, within
+// reach, every admissible candidate) and its star, cost, flags and classes are the same now,
+// so with reuse_across_iterations the first iteration skips its tests, as it skips those of
+// its own earlier iterations' untouched edges.
+struct TailSeed {
+  std::vector<uint8_t> vflags, vclass, touched;
+};
+
 class SequentialRun {
  public:
   // Validates the options (std::invalid_argument) and the mesh (tc::InputError).
-  SequentialRun(Mesh& mesh, const CollapseOptions& options);
+  SequentialRun(Mesh& mesh, const CollapseOptions& options, const TailSeed* seed = nullptr);
 
   // Runs one iteration; false when there is nothing more to do (the stop rule was met, or
   // max_iterations reached, or no tets), without running one.

@@ -257,6 +257,13 @@ void carry_verdicts(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s) {
   s.has_prev = false;
 }
 
+std::vector<uint8_t> tail_touched(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
+  DeviceBuffer<uint8_t> touched(ctx, std::max<size_t>(dm.nv, 1));
+  run(ctx, "collapse_verdicts.cl", "tail_touched", dm.nv, "", U(dm.nv), B(s.ndirty), B(c.nb_off), B(c.nb_edge),
+      B(s.verdict), B(touched));
+  return touched.download_range(0, dm.nv);
+}
+
 void download_mesh(const DeviceMesh& dm, Mesh& mesh) {
   mesh.points = dm.points.download_range(0, size_t(dm.nv) * 3);
   mesh.tets = dm.tets.download_range(0, size_t(dm.nt) * 4);

@@ -213,6 +213,10 @@ uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, Edg
 void remember_for_carry(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
 void note_compaction(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
 void carry_verdicts(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
+// After carry_verdicts: per vertex, whether its ring changed in the last iteration or an edge at
+// it keeps the surface guard's refusal (cl/collapse_verdicts.cl tail_touched; the host tail's
+// TailSeed::touched).
+std::vector<uint8_t> tail_touched(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
 
 void download_mesh(const DeviceMesh& dm, Mesh& mesh);
 

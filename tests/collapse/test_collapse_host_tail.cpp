@@ -3,9 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <set>
+#include <string>
 #include <utility>
+#include <vector>
 
+#include "collapse/sequential_mesh.hpp"
+#include "collapse/sequential_run.hpp"
+#include "collapse/stages.hpp"
 #include "tetcollapse/check.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/io.hpp"
@@ -205,4 +211,95 @@ TEST(CollapseHostTail, MaskAndTrianglesCarried) {
   ASSERT_EQ(m.tris.size(), 3 * m.tri_tags.size());
   EXPECT_GT(m.tri_tags.size(), 0u);
   EXPECT_TRUE(test::triangles_off_surface(m).empty()) << "triangles that are not boundary faces of the result";
+}
+
+// The host tail starts from the device's flags and classes and skips the tests of edges whose
+// end points the last device iteration left untouched (TailSeed, collapse/sequential_run.hpp):
+// the same result as starting from the mesh alone (TETCOLLAPSE_HOST_TAIL_SEED=0), with fewer
+// tests in the first host iteration after a greedy selection, and as many after the two passes
+// (no touched flags: their pass 2 may drop the winner that blocked an admissible edge).
+TEST(CollapseHostTail, SeedFromTheDeviceChangesNothing) {
+  Context ctx;
+  std::vector<std::pair<std::string, Mesh>> inputs{{"bracket", bracket_with_attributes()}};
+  const std::string shared = test::shared_mesh("gen_gmsh_Angled_43k.msh");
+  if (!shared.empty()) inputs.emplace_back("Angled 43k", read_mesh(shared));
+  else std::printf("Angled 43k absent: the bracket alone\n");
+  for (const auto& [name, in] : inputs)
+    for (CollapseOptions::Conflicts conflicts : {CollapseOptions::Greedy, CollapseOptions::TwoPass}) {
+      SCOPED_TRACE(name + (conflicts == CollapseOptions::Greedy ? ", greedy" : ", two-pass"));
+      CollapseOptions o = tail_early();
+      o.conflicts = conflicts;
+      o.min_quality = 0;
+      Mesh seeded = in, alone = in;
+      const CollapseReport rs = collapse(seeded, o, ctx);
+      CollapseReport ra;
+      {
+        test::EnvVar off("TETCOLLAPSE_HOST_TAIL_SEED", "0");
+        ra = collapse(alone, o, ctx);
+      }
+      ASSERT_GE(count_on_host(rs), 1) << "the tail did not run";
+      EXPECT_EQ(seeded.points, alone.points);
+      EXPECT_EQ(seeded.tets, alone.tets);
+      EXPECT_EQ(seeded.tet_labels.size() > 0 ? seeded.tet_labels[0].values : std::vector<int32_t>{},
+                alone.tet_labels.size() > 0 ? alone.tet_labels[0].values : std::vector<int32_t>{});
+      ASSERT_EQ(rs.iterations.size(), ra.iterations.size());
+      const size_t first_host = rs.iterations.size() - size_t(count_on_host(rs));
+      for (size_t i = 0; i < rs.iterations.size(); ++i) EXPECT_EQ(rs.iterations[i].collapsed, ra.iterations[i].collapsed);
+      EXPECT_EQ(rs.iterations[first_host].passed_q, ra.iterations[first_host].passed_q);
+      if (conflicts == CollapseOptions::Greedy)
+        EXPECT_LT(rs.iterations[first_host].tested, ra.iterations[first_host].tested);
+      else
+        EXPECT_EQ(rs.iterations[first_host].tested, ra.iterations[first_host].tested);
+    }
+}
+
+// tail_touched (cl/collapse_verdicts.cl): a vertex counts as touched when its ring changed
+// (ndirty) or when an edge at it keeps the surface guard's refusal, which looks beyond the star.
+TEST(CollapseHostTail, TouchedFlagsFromDirtyVerticesAndGuardRefusals) {
+  using namespace collapse_detail;
+  Context ctx;
+  const Mesh m = test::cube_tets(3);
+  CollapseOptions o;
+  DeviceMesh dm;
+  upload_mesh(ctx, m, o, dm);
+  Connectivity c;
+  build_connectivity(ctx, dm, c, params_from(o));
+  ASSERT_GT(c.ne, 10u);
+  EdgeState s;
+  std::vector<uint8_t> ndirty(dm.nv, 0), verdict(c.ne, 0xff);
+  ndirty[1] = 1;
+  const uint32_t refused = c.ne / 2;
+  verdict[refused] = kRefusedSurface;
+  verdict[refused / 2] = kRefusedVolume;  // a refusal of the star: not touched for it
+  s.ndirty = DeviceBuffer<uint8_t>(ctx, ndirty);
+  s.verdict = DeviceBuffer<uint8_t>(ctx, verdict);
+  const std::vector<uint8_t> touched = tail_touched(ctx, dm, c, s);
+  const std::vector<int32_t> edges = c.edges.download_range(0, 2 * size_t(c.ne));
+  ASSERT_EQ(touched.size(), size_t(dm.nv));
+  for (int32_t v = 0; v < int32_t(dm.nv); ++v) {
+    const bool expected = v == 1 || v == edges[2 * refused] || v == edges[2 * refused + 1];
+    EXPECT_EQ(touched[v] != 0, expected) << "vertex " << v;
+  }
+}
+
+// SeqMesh takes the device's flags and classes as they are (the host tail's seed): they must be
+// what it computes itself (verify_classes recomputes them from the mesh). Sizes are checked.
+TEST(CollapseHostTail, SeededClassesAreTheHostsOwn) {
+  using namespace collapse_detail;
+  Context ctx;
+  Mesh m = bracket_with_attributes();
+  CollapseOptions o;
+  DeviceMesh dm;
+  upload_mesh(ctx, m, o, dm, nullptr);  // the input's numbering
+  Connectivity c;
+  build_connectivity(ctx, dm, c, params_from(o));
+  const std::vector<uint8_t> vf = c.vflags.download_range(0, dm.nv), vc = c.vclass.download_range(0, dm.nv);
+  sequential_detail::SeqMesh seeded(m, sequential_detail::seq_params_from(o), &vf, &vc);
+  EXPECT_EQ(seeded.verify_classes(), 0);
+  int ridges_or_corners = 0;
+  for (int32_t v = 0; v < seeded.num_vertices(); ++v) ridges_or_corners += seeded.vclass(v) >= 2 ? 1 : 0;
+  EXPECT_GT(ridges_or_corners, 0);
+  const std::vector<uint8_t> short_list(vf.begin(), vf.end() - 1);
+  EXPECT_THROW(sequential_detail::SeqMesh(m, sequential_detail::seq_params_from(o), &short_list, &vc),
+               std::invalid_argument);
 }
