@@ -450,8 +450,8 @@ __kernel void conn_surface_flags(uint nv, __global const int* tets, __global con
                                  __global const int* vt, __global const int* tet_nbr, __global const int* labels,
                                  int use_labels, __global const double* pts, double eps_r, double eps_f,
                                  __global const uint* nb_off, __global const int* nb, __global const uint* edge_off,
-                                 __global const uchar* vflags, __global uchar* eflags, __global uchar* vclass,
-                                 int carry, __global const uchar* ndirty, __global const int* vold,
+                                 __global const uchar* vflags, __global const uchar* smask, __global uchar* eflags,
+                                 __global uchar* vclass, int carry, __global const uchar* ndirty, __global const int* vold,
                                  __global const uint* prev_nb_off, __global const int* prev_nb,
                                  __global const int* prev_nb_edge, __global const uchar* prev_eflags,
                                  __global const uchar* prev_vclass) {
@@ -487,12 +487,13 @@ __kernel void conn_surface_flags(uint nv, __global const int* tets, __global con
   int fn = 0, overflow = 0;
   for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
     int t = vt[i];
+    const uint mask = smask[t]; /* the faces t owns on S (conn_vertex_flags_faces) */
+    if (!mask) continue;
     int lv = tcc_local(tets, t, (int)v);
     for (int f = 0; f < 4; ++f) {
-      if (f == lv) continue;
-      uint s_kind;
-      uint own = tcc_owned_sface(tet_nbr, labels, use_labels, t, f, &s_kind);
-      if (!own) continue;
+      if (f == lv || !(mask & (1u << f))) continue;
+      /* owned: on the boundary, or the lower-labelled side of an interface (tcc_owned_sface) */
+      const uint own = tet_nbr[4 * t + f] < 0 ? TCC_BOUNDARY : TCC_INTERFACE;
       if (fn == TCC_MAX_VERTEX_SFACES) {
         overflow = 1;
         continue;

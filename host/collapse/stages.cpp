@@ -358,8 +358,8 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
       B(c.up_count), B(c.owns_s), B(c.smask));
   run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(c.up_count), B(c.vflags));
   run(ctx, F, "conn_surface_flags", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
-      use_labels, B(dm.points), p.eps_r, p.eps_f, B(c.nb_off), B(c.nb), B(c.edge_off), B(c.vflags), B(c.eflags),
-      B(c.vclass), ci, nd, vo, pno, pnb, pne, pef, pvc);
+      use_labels, B(dm.points), p.eps_r, p.eps_f, B(c.nb_off), B(c.nb), B(c.edge_off), B(c.vflags), B(c.smask),
+      B(c.eflags), B(c.vclass), ci, nd, vo, pno, pnb, pne, pef, pvc);
 }
 
 namespace {
