@@ -539,18 +539,13 @@ inline void tcc_p1_vertex_part(uint nd, __global const uint* dlist, __global con
   barrier(CLK_GLOBAL_MEM_FENCE);
 }
 
-/* Per-round kernels: cnt[0], cnt[1] count the two turn lists, cnt[2] the vertex list, cnt[3]
- * the edges of the new turn list that will be tested (no carried verdict). */
-__kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const int* edges, __global uchar* state,
-                             __global int* vaff, __global const int* slot, __global uint* dlist, __global uint* cnt,
-                             TCC_TEST_PARAMS) {
-  uint i = get_global_id(0);
-  if (i >= n) return;
 #ifdef TCC_PREFETCH_OK
-  /* CPU devices (the host sets TCC_PREFETCH) run a work-group's items one after another: start
-   * the memory traffic of the next items' tests, whose first loop otherwise waits for each of
-   * its tets in turn (W1: the test's share of the CPU samples 23% -> 21%): three items ahead
-   * the rings' lists, two ahead the rings' tets. */
+/* CPU devices (the host sets TCC_PREFETCH) run a work-group's items one after another: start the
+ * memory traffic of the next items' tests, whose first loop otherwise waits for each of its tets
+ * in turn (W1, lazy pass 1: the test's share of the CPU samples 23% -> 21%): three items ahead
+ * the rings' lists, two ahead the rings' tets. */
+inline void tcc_prefetch_test(uint i, uint n, __global const uint* tlist, __global const int* edges,
+                              __global const uint* vt_off, __global const int* vt, __global const int* tets) {
   if (i + 3 < n) {
     int e3 = (int)tlist[i + 3];
     for (int s = 0; s < 2; ++s) __builtin_prefetch(vt + vt_off[edges[2 * e3 + s]]);
@@ -562,6 +557,18 @@ __kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const 
       for (uint k = vt_off[x]; k < vt_off[x + 1]; ++k) __builtin_prefetch(tets + 4 * vt[k]);
     }
   }
+}
+#endif
+
+/* Per-round kernels: cnt[0], cnt[1] count the two turn lists, cnt[2] the vertex list, cnt[3]
+ * the edges of the new turn list that will be tested (no carried verdict). */
+__kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const int* edges, __global uchar* state,
+                             __global int* vaff, __global const int* slot, __global uint* dlist, __global uint* cnt,
+                             TCC_TEST_PARAMS) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+#ifdef TCC_PREFETCH_OK
+  tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets);
 #endif
   tcc_p1_decide((int)tlist[i], edges, state, vaff, slot, dlist, cnt + 2, TCC_TEST_ARGS);
 }
@@ -741,6 +748,9 @@ __kernel void greedy_decide(uint n, uint cur, __global const uint* tlist, __glob
                             __global int* vaff, TCC_TEST_PARAMS) {
   uint i = get_global_id(0);
   if (i >= n) return;
+#ifdef TCC_PREFETCH_OK
+  tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets);
+#endif
   tcc_greedy_decide((int)tlist[i], edges, prio, slot, blocker, tnext, cnt + (1 - cur), queued, round, inlist, cnt + 4,
                     vstamp, dlist, cnt + 2, state, vaff, TCC_TEST_ARGS);
 }
