@@ -230,15 +230,28 @@ __kernel void conn_write_neighbours(uint nv, __global const uint* vt_off, __glob
   }
 }
 
-/* Edge ids of the entries u < v of N(v): edge (u, v) is owned by u. */
+/* Edge ids of the entries u < v of N(v): edge (u, v) is owned by u, and is the edge of v's rank
+ * among the entries of N(u) above u. With carry, when v and u are clean (rings unchanged since
+ * the previous iteration, collapse_verdicts.cl), N(v) and N(u) are the previous ones renumbered
+ * in order: u is at the same place in N(v), v has the same rank in N(u), which the previous edge
+ * id gives without a scan. */
 __kernel void conn_lower_edges(uint nv, __global const uint* nb_off, __global const int* nb,
-                               __global const uint* edge_off, __global int* nb_edge) {
+                               __global const uint* edge_off, __global int* nb_edge, int carry,
+                               __global const uchar* ndirty, __global const int* vold,
+                               __global const uint* prev_nb_off, __global const uint* prev_edge_off,
+                               __global const int* prev_nb_edge) {
   uint v = get_global_id(0);
   if (v >= nv) return;
   uint b = nb_off[v], m = nb_off[v + 1] - b;
   uint lower = m - (edge_off[v + 1] - edge_off[v]);
+  const int clean = carry && !ndirty[v];
+  const uint pb = clean ? prev_nb_off[vold[v]] : 0u;
   for (uint i = 0; i < lower; ++i) {
     int u = nb[b + i];
+    if (clean && !ndirty[u]) {
+      nb_edge[b + i] = (int)(edge_off[u] + ((uint)prev_nb_edge[pb + i] - prev_edge_off[vold[u]]));
+      continue;
+    }
     /* position of v among the upper part of N(u) */
     uint ub = nb_off[u + 1] - (edge_off[u + 1] - edge_off[u]);
     uint lo = ub;

@@ -239,6 +239,7 @@ void note_compaction(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s
   ensure(s.told, ctx, dm.nt);
   run(ctx, "collapse_verdicts.cl", "verdict_tet_old", s.prev_nt, "", U(s.prev_nt), B(s.tkeep), B(s.tnew), B(s.told));
   std::swap(s.prev_nb_off, c.nb_off);
+  std::swap(s.prev_edge_off, c.edge_off);
   std::swap(s.prev_nb, c.nb);
   std::swap(s.prev_nb_edge, c.nb_edge);
   std::swap(s.prev_tet_nbr, c.tet_nbr);
@@ -323,7 +324,8 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   ensure(c.edges, ctx, size_t(c.ne) * 2);
   run(ctx, F, "conn_write_neighbours", nv, "", U(nv), B(c.vt_off), B(c.scratch), B(c.nb_off), B(c.edge_off), B(c.nb),
       B(c.nb_edge), B(c.edges));
-  run(ctx, F, "conn_lower_edges", nv, "", U(nv), B(c.nb_off), B(c.nb), B(c.edge_off), B(c.nb_edge));
+  run(ctx, F, "conn_lower_edges", nv, "", U(nv), B(c.nb_off), B(c.nb), B(c.edge_off), B(c.nb_edge), ci, nd, vo, pno,
+      cy ? B(carry->prev_edge_off) : B(c.count), cy ? B(carry->prev_nb_edge) : B(c.count));
   ensure(c.eflags, ctx, c.ne);
   ensure(c.vflags, ctx, nv);
   ensure(c.vclass, ctx, nv);

@@ -92,7 +92,7 @@ struct EdgeState {
   DeviceBuffer<int32_t> vmap;                  // previous vertex -> current (collapse_and_compact)
   DeviceBuffer<int32_t> told;                  // current tet -> previous tet
   DeviceBuffer<uint32_t> tkeep, tnew;          // previous tet: kept, new index (collapse_and_compact)
-  DeviceBuffer<uint32_t> prev_nb_off;
+  DeviceBuffer<uint32_t> prev_nb_off, prev_edge_off;
   DeviceBuffer<int32_t> prev_nb, prev_nb_edge, prev_tet_nbr;
   DeviceBuffer<uint8_t> prev_vclass, prev_eflags;
   // Connectivity carried through the compaction (collapse_update.cl): requested by

@@ -272,6 +272,8 @@ TEST(CollapseConnectivity, CarriedAfterCollapsesEqualsFreshBuild) {
       EXPECT_EQ(c.vt_off.download_range(0, size_t(dm.nv) + 1), fresh.vt_off.download_range(0, size_t(dm.nv) + 1));
       EXPECT_EQ(c.vt.download_range(0, 4 * size_t(dm.nt)), fresh.vt.download_range(0, 4 * size_t(dm.nt)));
       EXPECT_EQ(c.nb.download_range(0, 2 * size_t(c.ne)), fresh.nb.download_range(0, 2 * size_t(c.ne)));
+      EXPECT_EQ(c.nb_edge.download_range(0, 2 * size_t(c.ne)), fresh.nb_edge.download_range(0, 2 * size_t(c.ne)));
+      EXPECT_EQ(c.eflags.download_range(0, c.ne), fresh.eflags.download_range(0, c.ne));
       EXPECT_EQ(c.edges.download_range(0, 2 * size_t(c.ne)), fresh.edges.download_range(0, 2 * size_t(c.ne)));
       EXPECT_EQ(c.tet_nbr.download_range(0, 4 * size_t(dm.nt)), fresh.tet_nbr.download_range(0, 4 * size_t(dm.nt)));
       EXPECT_EQ(c.vflags.download_range(0, dm.nv), fresh.vflags.download_range(0, dm.nv));
