@@ -171,8 +171,8 @@ struct CollapseOptions {
   // 0: every iteration on the device. Decided by counts only: the output stays deterministic.
   static constexpr double kHostTailCpu = 0.002;
   double host_tail = -1;
-  // The host's fixed cost (its dynamic mesh, the first tests of every marked edge, the final
-  // compaction) is worth about this many device iterations of the same mesh on a CPU device: a
+  // The host's fixed cost (its dynamic mesh, the edge list, the first tests of the marked edges
+  // the last device iteration touched, the final compaction) is worth about this many device iterations of the same mesh on a CPU device: a
   // tail that dies out faster stays on the device (e.g. the shared Block 250k in strict mode).
   double host_tail_min_iterations = 24;
 
