@@ -160,15 +160,16 @@ bool tail_seed_enabled() {
 }
 
 // The host tail's seed (sequential_run.hpp) for the current mesh: its connectivity (carried
-// through the last compaction, as the next iteration would build it), the flags and classes,
-// and the touched flags (tail_touched) where the last iteration's selection was greedy and the
-// verdicts are carried; else every vertex counts as touched.
+// through the last compaction, as the next iteration would build it), the tet neighbours, the
+// flags and classes, and the touched flags (tail_touched) where the last iteration's selection
+// was greedy and the verdicts are carried; else every vertex counts as touched.
 void tail_seed(Context& ctx, DeviceMesh& dm, Connectivity& conn, EdgeState& st, const StageParams& p,
                const CollapseOptions& options, sequential_detail::TailSeed& seed) {
   const bool reuse = options.reuse_across_iterations;
   build_connectivity(ctx, dm, conn, p, reuse ? &st : nullptr);
   seed.vflags = conn.vflags.download_range(0, dm.nv);
   seed.vclass = conn.vclass.download_range(0, dm.nv);
+  seed.tet_nbr = conn.tet_nbr.download_range(0, 4 * size_t(dm.nt));
   if (reuse && options.conflicts == CollapseOptions::Greedy) {
     carry_verdicts(ctx, dm, conn, st);
     seed.touched = tail_touched(ctx, dm, conn, st);

@@ -93,7 +93,8 @@ SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const T
       o_(options),
       t_start_(std::chrono::steady_clock::now()),
       params_(checked_params(mesh, options)),
-      sm_(mesh, params_, seed ? &seed->vflags : nullptr, seed ? &seed->vclass : nullptr) {
+      sm_(mesh, params_, seed ? &seed->vflags : nullptr, seed ? &seed->vclass : nullptr,
+          seed && !seed->tet_nbr.empty() ? &seed->tet_nbr : nullptr) {
   report_.device = "cpu-sequential";
   report_.vertices_in = mesh.num_vertices();
   report_.tets_in = mesh.num_tets();

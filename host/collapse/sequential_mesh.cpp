@@ -61,7 +61,7 @@ bool runs(const int32_t* q, int f, int32_t x, int32_t y) {
 }  // namespace
 
 SeqMesh::SeqMesh(Mesh& mesh, const SeqParams& params, const std::vector<uint8_t>* vflags,
-                 const std::vector<uint8_t>* vclass)
+                 const std::vector<uint8_t>* vclass, const std::vector<int32_t>* tet_nbr)
     : mesh_(mesh), points_(&mesh.points), tets_(&mesh.tets), p_(params) {
   collapse_detail::check_collapse_input(mesh);  // the same refusals as the device pipeline
   const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
@@ -83,6 +83,13 @@ SeqMesh::SeqMesh(Mesh& mesh, const SeqParams& params, const std::vector<uint8_t>
   mark_.assign(nv_, 0);
   lmark_.assign(nv_, 0);
   rebuild_rings();
+  if (tet_nbr) {
+    if (tet_nbr->size() != 4 * size_t(nt_))
+      throw std::invalid_argument("SeqMesh: the given tet neighbours need four entries per tet");
+    nbr_ = *tet_nbr;
+  } else {
+    build_nbr();
+  }
   if (vflags && vclass) {
     if (vflags->size() != size_t(nv_) || vclass->size() != size_t(nv_))
       throw std::invalid_argument("SeqMesh: the given vertex flags and classes need one entry per vertex");
@@ -214,30 +221,23 @@ uint8_t SeqMesh::triangle_kind(int32_t x, int32_t y, int32_t z) const {
 
 uint8_t SeqMesh::edge_flags(int32_t a, int32_t b, bool with_ridge) {
   if (!vflags_[a] || !vflags_[b]) return 0;  // an S-edge joins two S vertices
-  // the tets around the edge; every face through a and b is a face of two of them (or one)
-  tab_.clear();
-  const int32_t* r = ring(a);
-  for (uint32_t i = 0; i < rlen_[a]; ++i)
-    if (has(tet(r[i]), b)) tab_.push_back(r[i]);
+  // the faces through a and b, in the tets around the edge, with the tets across them
   uint8_t flags = 0;
   int ns = 0;
   int32_t ft[2] = {-1, -1};
   int ff[2] = {0, 0};
-  for (int32_t t : tab_) {
+  const int32_t* r = ring(a);
+  for (uint32_t i = 0; i < rlen_[a]; ++i) {
+    const int32_t t = r[i];
     const int32_t* q = tet(t);
-    const int la = local(q, a), lb = local(q, b);
+    const int lb = local(q, b);
+    if (lb < 0) continue;
+    const int la = local(q, a);
     for (int f = 0; f < 4; ++f) {
       if (f == la || f == lb) continue;
-      const int32_t x = q[6 - la - lb - f];  // the face's third vertex
-      int n = 0;
-      int32_t other = -1;
-      for (int32_t u : tab_)
-        if (u != t && has(tet(u), x)) {
-          if (n == 0) other = u;
-          ++n;
-        }
+      const int32_t other = across(t, f);
       uint8_t on_s = 0, own = 0;
-      if (n != 1) {  // no other tet (boundary), or several (invalid input: boundary for each)
+      if (other < 0) {  // no other tet (boundary), or several (invalid input: boundary for each)
         on_s = own = TCC_BOUNDARY;
       } else if (labels_ && label(t) != label(other)) {
         on_s = TCC_INTERFACE;
@@ -269,8 +269,10 @@ uint8_t SeqMesh::edge_flags(int32_t a, int32_t b, bool with_ridge) {
 }
 
 void SeqMesh::classify(int32_t v, uint8_t& flags_out, uint8_t& cls_out) {
-  // every face through v, keyed by its two other vertices; equal keys are the same face
-  faces_.clear();
+  // every face through v with the tet across it (nbr_): on S and owned as tcc_owned_sface says
+  uint8_t flags = 0;
+  bool overflow = false;
+  sfaces_.clear();
   const int32_t* r = ring(v);
   for (uint32_t i = 0; i < rlen_[v]; ++i) {
     const int32_t t = r[i];
@@ -278,33 +280,13 @@ void SeqMesh::classify(int32_t v, uint8_t& flags_out, uint8_t& cls_out) {
     const int lv = local(q, v);
     for (int f = 0; f < 4; ++f) {
       if (f == lv) continue;
-      int32_t o[2];
-      int no = 0;
-      for (int j = 0; j < 4; ++j)
-        if (j != f && j != lv) o[no++] = q[j];
-      const uint32_t y = uint32_t(std::min(o[0], o[1])), z = uint32_t(std::max(o[0], o[1]));
-      faces_.push_back({uint64_t(y) << 32 | z, t, int8_t(f)});
-    }
-  }
-  std::sort(faces_.begin(), faces_.end(), [](const FaceAt& x, const FaceAt& y) { return x.key < y.key; });
-  uint8_t flags = 0;
-  bool overflow = false;
-  sfaces_.clear();
-  for (size_t i = 0; i < faces_.size();) {
-    size_t j = i + 1;
-    while (j < faces_.size() && faces_[j].key == faces_[i].key) ++j;
-    const size_t others = j - i - 1;
-    for (size_t k = i; k < j; ++k) {
-      const int32_t t = faces_[k].t;
+      const int32_t other = across(t, f);
       uint8_t on_s = 0, own = 0;
-      if (others != 1) {
+      if (other < 0) {  // no tet across, or several (an invalid input: boundary for each)
         on_s = own = TCC_BOUNDARY;
-      } else {
-        const int32_t other = faces_[k == i ? i + 1 : i].t;
-        if (labels_ && label(t) != label(other)) {
-          on_s = TCC_INTERFACE;
-          own = label(t) < label(other) ? TCC_INTERFACE : 0;
-        }
+      } else if (labels_ && label(t) != label(other)) {
+        on_s = TCC_INTERFACE;
+        own = label(t) < label(other) ? TCC_INTERFACE : 0;
       }
       flags |= on_s;
       if (!own) continue;
@@ -312,13 +294,10 @@ void SeqMesh::classify(int32_t v, uint8_t& flags_out, uint8_t& cls_out) {
         overflow = true;
         continue;
       }
-      const int32_t* q = tet(t);
-      const int f = faces_[k].f;
       int32_t w[3] = {q[geo::TC_TET_FACES[f][0]], q[geo::TC_TET_FACES[f][1]], q[geo::TC_TET_FACES[f][2]]};
       int p = w[0] == v ? 0 : w[1] == v ? 1 : 2;
       sfaces_.push_back({t, int8_t(f), w[(p + 1) % 3], w[(p + 2) % 3], face_normal(*points_, q, f)});
     }
-    i = j;
   }
   flags_out = flags;
   if (!flags || (sfaces_.empty() && !overflow)) {
@@ -582,6 +561,17 @@ int32_t SeqMesh::collapse(int32_t a, int32_t b, uint8_t dir) {
     int32_t* q = tets_->data() + 4 * size_t(t);
     if (has(q, s)) {
       gone_.insert(gone_.end(), q, q + 4);
+      // the tets A across the face opposite r (s, c, d) and B across the one opposite s (r, c, d)
+      // become neighbours through (s, c, d) (cl/collapse_update.cl, tet_nbr_update)
+      int32_t* nt = nbr_.data() + 4 * size_t(t);
+      const int32_t A = nt[local(q, r)], B = nt[local(q, s)];
+      for (int side = 0; side < 2; ++side) {
+        const int32_t X = side == 0 ? A : B, Y = side == 0 ? B : A;
+        if (X < 0) continue;
+        int32_t* nx = nbr_.data() + 4 * size_t(X);
+        for (int k = 0; k < 4; ++k)
+          if (nx[k] == t) nx[k] = Y;
+      }
       talive_[t] = 0;
       --alive_t_;
       for (int k = 0; k < 4; ++k)
@@ -677,12 +667,19 @@ void SeqMesh::compact(std::vector<int32_t>& vmap, std::vector<int32_t>& kept) {
         for (size_t c = 0; c < nc; ++c) f.values[size_t(vmap[v]) * nc + c] = f.values[size_t(v) * nc + c];
     f.values.resize(size_t(n) * nc);
   }
-  // tets with their labels and fields
+  // tets with their labels, fields and neighbours
   std::vector<int32_t>& tets = *tets_;
+  std::vector<int32_t> tmap(nt_, -1);
+  for (int32_t t = 0, m = 0; t < nt_; ++t)
+    if (talive_[t]) tmap[t] = m++;
   int32_t m = 0;
   for (int32_t t = 0; t < nt_; ++t) {
     if (!talive_[t]) continue;
-    for (int k = 0; k < 4; ++k) tets[4 * size_t(m) + k] = vmap[tets[4 * size_t(t) + k]];
+    for (int k = 0; k < 4; ++k) {
+      tets[4 * size_t(m) + k] = vmap[tets[4 * size_t(t) + k]];
+      const int32_t o = nbr_[4 * size_t(t) + k];
+      nbr_[4 * size_t(m) + k] = o < 0 ? o : tmap[o];  // a live tet's neighbours are alive
+    }
     for (Labels& l : mesh_.tet_labels) l.values[m] = l.values[t];
     for (Field& f : mesh_.tet_fields)
       for (int c = 0; c < f.components; ++c)
@@ -690,6 +687,7 @@ void SeqMesh::compact(std::vector<int32_t>& vmap, std::vector<int32_t>& kept) {
     ++m;
   }
   tets.resize(4 * size_t(m));
+  nbr_.resize(4 * size_t(m));
   for (Labels& l : mesh_.tet_labels) l.values.resize(m);
   for (Field& f : mesh_.tet_fields) f.values.resize(size_t(m) * f.components);
 
@@ -708,7 +706,7 @@ void SeqMesh::compact(std::vector<int32_t>& vmap, std::vector<int32_t>& kept) {
 
 // --- surface guard ---
 
-int32_t SeqMesh::across(int32_t t, int f) const {
+int32_t SeqMesh::scan_across(int32_t t, int f) const {
   const int32_t* q = tet(t);
   int32_t p[3];
   int n = 0;
@@ -728,6 +726,48 @@ int32_t SeqMesh::across(int32_t t, int f) const {
     }
   }
   return count == 0 ? -1 : count == 1 ? other : -2;
+}
+
+// nbr_ from scratch: every face matched by its smallest vertex v among the faces of ring(v) (a
+// sort of their keys), as the device's conn_tet_neighbours does.
+void SeqMesh::build_nbr() {
+  nbr_.assign(4 * size_t(nt_), -1);
+  for (int32_t v = 0; v < nv_; ++v) {
+    faces_.clear();
+    const int32_t* r = ring(v);
+    for (uint32_t i = 0; i < rlen_[v]; ++i) {
+      const int32_t t = r[i];
+      const int32_t* q = tet(t);
+      const int lv = local(q, v);
+      for (int f = 0; f < 4; ++f) {
+        if (f == lv) continue;
+        int32_t o[2];
+        int no = 0;
+        for (int j = 0; j < 4; ++j)
+          if (j != f && j != lv) o[no++] = q[j];
+        if (o[0] < v || o[1] < v) continue;  // v is not the face's smallest vertex
+        const uint32_t y = uint32_t(std::min(o[0], o[1])), z = uint32_t(std::max(o[0], o[1]));
+        faces_.push_back({uint64_t(y) << 32 | z, t, int8_t(f)});
+      }
+    }
+    std::sort(faces_.begin(), faces_.end(), [](const FaceAt& x, const FaceAt& y) { return x.key < y.key; });
+    for (size_t i = 0; i < faces_.size();) {
+      size_t j = i + 1;
+      while (j < faces_.size() && faces_[j].key == faces_[i].key) ++j;
+      for (size_t k = i; k < j; ++k)
+        nbr_[4 * size_t(faces_[k].t) + size_t(faces_[k].f)] =
+            j - i == 1 ? -1 : j - i == 2 ? faces_[k == i ? i + 1 : i].t : -2;
+      i = j;
+    }
+  }
+}
+
+int64_t SeqMesh::verify_nbr() const {
+  int64_t bad = 0;
+  for (int32_t t = 0; t < nt_; ++t)
+    if (talive_[t])
+      for (int f = 0; f < 4; ++f) bad += nbr_[4 * size_t(t) + size_t(f)] != scan_across(t, f) ? 1 : 0;
+  return bad;
 }
 
 uint8_t SeqMesh::owned_sface(int32_t t, int f) const {

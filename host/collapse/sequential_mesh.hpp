@@ -59,7 +59,7 @@ class SeqMesh {
   // computed: the parallel method's host tail hands over the device's, made by the same rules
   // (verify_classes() recomputes them).
   SeqMesh(Mesh& mesh, const SeqParams& params, const std::vector<uint8_t>* vflags = nullptr,
-          const std::vector<uint8_t>* vclass = nullptr);
+          const std::vector<uint8_t>* vclass = nullptr, const std::vector<int32_t>* tet_nbr = nullptr);
 
   int32_t num_vertices() const { return nv_; }  // slots, dead ones included until compact()
   int32_t num_tets() const { return nt_; }
@@ -101,6 +101,9 @@ class SeqMesh {
   // Recomputes every flag and class from scratch; returns the number of vertices whose cached
   // flags or class differ (0 when the incremental updates are right).
   int64_t verify_classes();
+  // The same for the tet neighbours: the faces of live tets whose kept neighbour differs from a
+  // ring scan's.
+  int64_t verify_nbr() const;
 
   // Surface guard (the device's: cl/collapse_guard.cl). build_guard() indexes the current
   // S faces in a hash grid of cells of the mean extent of an S face (h when there is none);
@@ -143,7 +146,11 @@ class SeqMesh {
   void classify(int32_t v, uint8_t& flags, uint8_t& cls);
   bool ring_has(int32_t x, int32_t y, int32_t z, int32_t w) const;
   uint8_t triangle_kind(int32_t x, int32_t y, int32_t z) const;
-  int32_t across(int32_t t, int f) const;      // tet_nbr: -1 none, -2 several, else the tet
+  // tet_nbr (collapse_common.h): -1 none, -2 several, else the tet; kept current by collapse()
+  // and compact() (nbr_), built once from the rings (build_nbr) unless given
+  int32_t across(int32_t t, int f) const { return nbr_[4 * size_t(t) + size_t(f)]; }
+  int32_t scan_across(int32_t t, int f) const;  // the same from a ring scan
+  void build_nbr();
   uint8_t owned_sface(int32_t t, int f) const;  // tcc_owned_sface
   void guard_insert(int32_t t, int f);
   void guard_cells(const geo::tc_d3* p, int (&lo)[3], int (&hi)[3]) const;
@@ -161,6 +168,7 @@ class SeqMesh {
   int vfield_comps_ = 0;
 
   std::vector<uint8_t> valive_, talive_;
+  std::vector<int32_t> nbr_;  // 4 per tet slot: across(t, f)
   // vertex -> tets: ring(v) = pool_[roff_[v] .. roff_[v] + rlen_[v]), capacity rcap_[v]; a list
   // that outgrows its slot moves to the end of the pool (rebuilt compactly by compact()).
   std::vector<int32_t> pool_;
@@ -171,7 +179,7 @@ class SeqMesh {
   // scratch, reused: no allocation per check or collapse once warm
   std::vector<uint32_t> mark_, lmark_;
   uint32_t stamp_ = 0;
-  std::vector<int32_t> cn_, pc_, pd_, rr_, touched_, tab_, gone_, reclass_;
+  std::vector<int32_t> cn_, pc_, pd_, rr_, touched_, gone_, reclass_;
   std::vector<FaceAt> faces_;
   // surface guard: cells of the grid -> S faces (4 t + f) registered there, possibly stale
   // (a dead tet, a face no longer on S, or one registered again after it moved): checked on use

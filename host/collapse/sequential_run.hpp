@@ -50,9 +50,9 @@ namespace tc::sequential_detail {
 
 SeqParams seq_params_from(const CollapseOptions& o);
 
-// What the parallel method hands its host tail (collapse.cpp) besides the mesh, all per vertex
-// of the current mesh: the flags and classes (the device's, made by the same rules: SeqMesh
-// does not compute them again), and whether the star changed in the device's last iteration
+// What the parallel method hands its host tail (collapse.cpp) besides the mesh: the tet
+// neighbours and, per vertex of the current mesh, the flags and classes (the device's, made by
+// the same rules: SeqMesh does not compute them again), and whether the star changed in the device's last iteration
 // (touched; also the end points of an edge the surface guard refused). An edge whose end points
 // are both untouched was not admissible then (the greedy selection takes or blocks, within
 // reach, every admissible candidate) and its star, cost, flags and classes are the same now,
@@ -60,6 +60,7 @@ SeqParams seq_params_from(const CollapseOptions& o);
 // its own earlier iterations' untouched edges.
 struct TailSeed {
   std::vector<uint8_t> vflags, vclass, touched;
+  std::vector<int32_t> tet_nbr;  // 4 per tet (collapse_common.h), the device's
 };
 
 class SequentialRun {

@@ -282,8 +282,9 @@ TEST(CollapseHostTail, TouchedFlagsFromDirtyVerticesAndGuardRefusals) {
   }
 }
 
-// SeqMesh takes the device's flags and classes as they are (the host tail's seed): they must be
-// what it computes itself (verify_classes recomputes them from the mesh). Sizes are checked.
+// SeqMesh takes the device's flags, classes and tet neighbours as they are (the host tail's
+// seed): they must be what it computes itself (verify_classes and verify_nbr recompute them from
+// the mesh). Sizes are checked.
 TEST(CollapseHostTail, SeededClassesAreTheHostsOwn) {
   using namespace collapse_detail;
   Context ctx;
@@ -294,12 +295,17 @@ TEST(CollapseHostTail, SeededClassesAreTheHostsOwn) {
   Connectivity c;
   build_connectivity(ctx, dm, c, params_from(o));
   const std::vector<uint8_t> vf = c.vflags.download_range(0, dm.nv), vc = c.vclass.download_range(0, dm.nv);
-  sequential_detail::SeqMesh seeded(m, sequential_detail::seq_params_from(o), &vf, &vc);
+  const std::vector<int32_t> nbr = c.tet_nbr.download_range(0, 4 * size_t(dm.nt));
+  sequential_detail::SeqMesh seeded(m, sequential_detail::seq_params_from(o), &vf, &vc, &nbr);
   EXPECT_EQ(seeded.verify_classes(), 0);
+  EXPECT_EQ(seeded.verify_nbr(), 0);
   int ridges_or_corners = 0;
   for (int32_t v = 0; v < seeded.num_vertices(); ++v) ridges_or_corners += seeded.vclass(v) >= 2 ? 1 : 0;
   EXPECT_GT(ridges_or_corners, 0);
   const std::vector<uint8_t> short_list(vf.begin(), vf.end() - 1);
   EXPECT_THROW(sequential_detail::SeqMesh(m, sequential_detail::seq_params_from(o), &short_list, &vc),
+               std::invalid_argument);
+  const std::vector<int32_t> short_nbr(nbr.begin(), nbr.end() - 1);
+  EXPECT_THROW(sequential_detail::SeqMesh(m, sequential_detail::seq_params_from(o), &vf, &vc, &short_nbr),
                std::invalid_argument);
 }
