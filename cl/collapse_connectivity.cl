@@ -10,6 +10,7 @@
  *                    vertex flags, ridge edges and vertex classes with tc::build_topology's rules.
  */
 #include "collapse_common.h"
+#include "collapse_classify.h"
 
 __kernel void conn_count(__global const int* tets, uint nt, __global uint* count) {
   uint t = get_global_id(0);
@@ -390,18 +391,8 @@ __kernel void conn_vertex_flags(uint nv, __global const uint* bits, __global uch
   vflags[v] = (uchar)bits[v];
 }
 
-/* The ridge rule of tc::build_topology for an S-edge (a, b) with ns owned S-faces through it, the
- * first two of them oriented a -> b or not (fwd0, fwd1) with unit normals n0, n1: a ridge when
- * ns != 2, when the two faces traverse the edge in the same direction, or when
- * 1 - dot(n0, n1) > eps_r. Symmetric in a and b (swapping them flips both directions). */
-inline int tcc_ridge_rule(int ns, int fwd0, int fwd1, double3 n0, double3 n1, double eps_r) {
-  if (ns != 2) return 1;
-  if (fwd0 == fwd1) return 1;
-  return 1.0 - tcc_dot(n0, n1) > eps_r;
-}
-
 /* Edge flags of (a, b) from ring(a): S membership (boundary / interface: the kinds of the
- * owned S-faces through the edge) and TCC_RIDGE by tcc_ridge_rule. */
+ * owned S-faces through the edge) and TCC_RIDGE by the ridge rule (collapse_classify.h). */
 inline uchar tcc_edge_flags_of(int a, int b, __global const int* tets, __global const uint* vt_off,
                                __global const int* vt, __global const int* tet_nbr, __global const int* labels,
                                int use_labels, __global const double* pts, double eps_r) {
@@ -436,7 +427,7 @@ inline uchar tcc_edge_flags_of(int a, int b, __global const int* tets, __global 
       dir[k] = (f0 == a && f1 == b) || (f1 == a && f2 == b) || (f2 == a && f0 == b);
       n[k] = tcc_face_normal(pts, tets, ft[k], ff[k]);
     }
-    if (tcc_ridge_rule(ns, dir[0], dir[1], n[0], n[1], eps_r)) flags |= TCC_RIDGE;
+    if (tc_sf_ridge_rule(ns, dir[0], dir[1], n[0], n[1], eps_r)) flags |= TCC_RIDGE;
   }
   return (uchar)flags;
 }
@@ -446,15 +437,11 @@ inline uchar tcc_edge_flags_of(int a, int b, __global const int* tets, __global 
 #endif
 
 /* Edge flags and vertex classes, per vertex v: the flags of the edges v owns (v < u) and the class
- * of v, from the owned S-faces through v, gathered once (rather than a ring scan per edge).
- *   Edge flags: S membership (boundary / interface) and the ridge rule of tc::build_topology
- *   (tcc_ridge_rule). An S-edge joins two S vertices (most edges are not: 0 at once); the
- *   S-faces through (v, u) are those of v's faces that have u as a vertex.
- *   Class, with tc::build_topology's rules (see include/tetcollapse/topology.hpp): ridge when
- *   exactly two ridge edges; face when no ridge edge, all normals within eps_f and the S-faces
- *   form one closed fan; corner otherwise. The ridge edges at v are those to the vertices of its
- *   S-faces (the rule is symmetric: v's work item decides the edges it does not own the same way
- *   as their owners do).
+ * of v, from the owned S-faces through v, gathered once (rather than a ring scan per edge), by
+ * the rules of collapse_classify.h (tc_sf_edge, tc_sf_class; the sequential method's too). An
+ * S-edge joins two S vertices (most edges are not: 0 at once). The ridge edges at v are those
+ * to the vertices of its S-faces (the rule is symmetric: v's work item decides the edges it
+ * does not own the same way as their owners do).
  * More than TCC_MAX_VERTEX_SFACES S-faces at a vertex (never seen in practice) classify it as
  * corner, which only protects it more, and its edges' flags come from ring scans
  * (tcc_edge_flags_of). With carry, a vertex whose ring is unchanged (ndirty == 0) keeps its
@@ -529,80 +516,13 @@ __kernel void conn_surface_flags(uint nv, __global const int* tets, __global con
     vclass[v] = TCC_CORNER;
     return;
   }
-  /* (v, u) through v's S-faces: flags, and whether it is a ridge */
-#define TCC_SF_EDGE(U, FLAGS, RIDGE)                                                             \
-  {                                                                                              \
-    int ns_ = 0, k0_ = 0, k1_ = 0;                                                               \
-    for (int j_ = 0; j_ < fn; ++j_)                                                              \
-      if (after[j_] == (U) || before[j_] == (U)) {                                               \
-        (FLAGS) |= kind[j_];                                                                     \
-        if (ns_ == 0) k0_ = j_;                                                                  \
-        else if (ns_ == 1) k1_ = j_;                                                             \
-        ++ns_;                                                                                   \
-      }                                                                                          \
-    (RIDGE) = ns_ > 0 && tcc_ridge_rule(ns_, after[k0_] == (U), after[k1_] == (U), normal[k0_], normal[k1_], eps_r); \
-  }
+  /* the edges v owns, then v's class (collapse_classify.h) */
   for (uint i = 0; i < up; ++i) {
     const int u = upper[i];
     uint fl = 0;
     int ridge = 0;
-    if (vflags[u]) TCC_SF_EDGE(u, fl, ridge);
+    if (vflags[u]) fl = tc_sf_edge(u, after, before, kind, normal, fn, eps_r, &ridge);
     eflags[e0 + i] = (uchar)(fl | (ridge ? TCC_RIDGE : 0u));
   }
-  if (fn == 0) {
-    vclass[v] = TCC_INTERIOR;
-    return;
-  }
-  /* the ridge edges at v: each vertex of v's S-faces once */
-  int ridges = 0;
-  for (int j = 0; j < fn; ++j)
-    for (int side = 0; side < 2; ++side) {
-      const int u = side == 0 ? after[j] : before[j];
-      int seen = side == 1 && after[j] == u;
-      for (int k = 0; k < j && !seen; ++k) seen = after[k] == u || before[k] == u;
-      if (seen) continue;
-      uint fl = 0;
-      int ridge = 0;
-      TCC_SF_EDGE(u, fl, ridge);
-      ridges += ridge;
-    }
-#undef TCC_SF_EDGE
-  uchar cls;
-  if (ridges == 2) {
-    cls = TCC_RIDGEV;
-  } else if (ridges != 0) {
-    cls = TCC_CORNER;
-  } else {
-    cls = TCC_FACE;
-    for (int i = 0; i < fn && cls == TCC_FACE; ++i)
-      for (int j = i + 1; j < fn; ++j)
-        if (1.0 - tcc_dot(normal[i], normal[j]) > eps_f) {
-          cls = TCC_CORNER;
-          break;
-        }
-    if (cls == TCC_FACE) {
-      /* one closed fan: following before -> the unique face whose `after` equals it runs
-       * through all fn faces and closes (the walk's result does not depend on the start) */
-      int cur = 0;
-      for (int step = 1; step <= fn; ++step) {
-        int want = before[cur], next = -1, found = 0;
-        for (int j = 0; j < fn; ++j)
-          if (after[j] == want) {
-            next = j;
-            ++found;
-          }
-        if (found != 1) {
-          cls = TCC_CORNER;
-          break;
-        }
-        cur = next;
-        if (cur == 0 && step != fn) {
-          cls = TCC_CORNER;
-          break;
-        }
-      }
-      if (cls == TCC_FACE && cur != 0) cls = TCC_CORNER;
-    }
-  }
-  vclass[v] = cls;
+  vclass[v] = fn == 0 ? TCC_INTERIOR : (uchar)tc_sf_class(after, before, normal, fn, eps_r, eps_f);
 }

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "collapse/stages.hpp"  // collapse_detail::Reason
+#include "collapse_classify.h"  // the classification rules, the device's own
 #include "collapse_guard_geometry.h"  // tc::geo::tc_sg_tri_tri, the device guard's own test
 #include "collapse_predicate.h"
 #include "tetcollapse/error.hpp"
@@ -272,104 +273,39 @@ void SeqMesh::classify(int32_t v, uint8_t& flags_out, uint8_t& cls_out) {
   // every face through v with the tet across it (nbr_): on S and owned as tcc_owned_sface says
   uint8_t flags = 0;
   bool overflow = false;
-  sfaces_.clear();
-  const int32_t* r = ring(v);
-  for (uint32_t i = 0; i < rlen_[v]; ++i) {
-    const int32_t t = r[i];
-    const int32_t* q = tet(t);
-    const int lv = local(q, v);
-    for (int f = 0; f < 4; ++f) {
-      if (f == lv) continue;
-      const int32_t other = across(t, f);
-      uint8_t on_s = 0, own = 0;
-      if (other < 0) {  // no tet across, or several (an invalid input: boundary for each)
-        on_s = own = TCC_BOUNDARY;
-      } else if (labels_ && label(t) != label(other)) {
-        on_s = TCC_INTERFACE;
-        own = label(t) < label(other) ? TCC_INTERFACE : 0;
-      }
-      flags |= on_s;
-      if (!own) continue;
-      if (sfaces_.size() == kMaxVertexSFaces) {
-        overflow = true;
-        continue;
-      }
-      int32_t w[3] = {q[geo::TC_TET_FACES[f][0]], q[geo::TC_TET_FACES[f][1]], q[geo::TC_TET_FACES[f][2]]};
-      int p = w[0] == v ? 0 : w[1] == v ? 1 : 2;
-      sfaces_.push_back({t, int8_t(f), w[(p + 1) % 3], w[(p + 2) % 3], face_normal(*points_, q, f)});
+  sf_after_.clear();
+  sf_before_.clear();
+  sf_normal_.clear();
+  each_face_through(v, [&](int32_t t, const int32_t* q, int f, int) {
+    const int32_t other = across(t, f);
+    uint8_t on_s = 0, own = 0;
+    if (other < 0) {  // no tet across, or several (an invalid input: boundary for each)
+      on_s = own = TCC_BOUNDARY;
+    } else if (labels_ && label(t) != label(other)) {
+      on_s = TCC_INTERFACE;
+      own = label(t) < label(other) ? TCC_INTERFACE : 0;
     }
-  }
+    flags |= on_s;
+    if (!own) return;
+    if (sf_after_.size() == kMaxVertexSFaces) {
+      overflow = true;
+      return;
+    }
+    int32_t w[3] = {q[geo::TC_TET_FACES[f][0]], q[geo::TC_TET_FACES[f][1]], q[geo::TC_TET_FACES[f][2]]};
+    int p = w[0] == v ? 0 : w[1] == v ? 1 : 2;
+    sf_after_.push_back(w[(p + 1) % 3]);
+    sf_before_.push_back(w[(p + 2) % 3]);
+    sf_normal_.push_back(face_normal(*points_, q, f));
+  });
   flags_out = flags;
-  if (!flags || (sfaces_.empty() && !overflow)) {
+  if (!flags || (sf_after_.empty() && !overflow)) {
     cls_out = TCC_INTERIOR;
     return;
   }
-  if (overflow) {
-    cls_out = TCC_CORNER;
-    return;
-  }
-  // ridge edges at v: the edges (v, u) of its owned S-faces that conn_surface_flags calls ridges (as it counts them)
-  us_.clear();
-  for (const SFace& s : sfaces_) {
-    us_.push_back(s.after);
-    us_.push_back(s.before);
-  }
-  std::sort(us_.begin(), us_.end());
-  us_.erase(std::unique(us_.begin(), us_.end()), us_.end());
-  int ridges = 0;
-  for (int32_t u : us_) {
-    int ns = 0;
-    const SFace* two[2] = {nullptr, nullptr};
-    for (const SFace& s : sfaces_)
-      if (s.after == u || s.before == u) {
-        if (ns < 2) two[ns] = &s;
-        ++ns;
-      }
-    bool ridge;
-    if (ns != 2) ridge = true;
-    else if ((two[0]->after == u) == (two[1]->after == u)) ridge = true;  // same direction along (v, u)
-    else ridge = 1.0 - geo::dot(two[0]->n, two[1]->n) > p_.eps_r;
-    ridges += ridge ? 1 : 0;
-  }
-  uint8_t cls;
-  if (ridges == 2) {
-    cls = TCC_RIDGEV;
-  } else if (ridges != 0) {
-    cls = TCC_CORNER;
-  } else {
-    cls = TCC_FACE;
-    const int fn = int(sfaces_.size());
-    for (int i = 0; i < fn && cls == TCC_FACE; ++i)
-      for (int j = i + 1; j < fn; ++j)
-        if (1.0 - geo::dot(sfaces_[i].n, sfaces_[j].n) > p_.eps_f) {
-          cls = TCC_CORNER;
-          break;
-        }
-    if (cls == TCC_FACE) {
-      // one closed fan, walked as conn_surface_flags does (the result does not depend on the start)
-      int cur = 0;
-      for (int step = 1; step <= fn; ++step) {
-        int32_t want = sfaces_[cur].before;
-        int next = -1, found = 0;
-        for (int j = 0; j < fn; ++j)
-          if (sfaces_[j].after == want) {
-            next = j;
-            ++found;
-          }
-        if (found != 1) {
-          cls = TCC_CORNER;
-          break;
-        }
-        cur = next;
-        if (cur == 0 && step != fn) {
-          cls = TCC_CORNER;
-          break;
-        }
-      }
-      if (cls == TCC_FACE && cur != 0) cls = TCC_CORNER;
-    }
-  }
-  cls_out = cls;
+  // the class by the connectivity stage's own rules (cl/collapse_classify.h)
+  cls_out = overflow ? TCC_CORNER
+                     : uint8_t(geo::tc_sf_class(sf_after_.data(), sf_before_.data(), sf_normal_.data(),
+                                                int(sf_after_.size()), p_.eps_r, p_.eps_f));
 }
 
 int64_t SeqMesh::verify_classes() {
@@ -599,20 +535,18 @@ int32_t SeqMesh::collapse(int32_t a, int32_t b, uint8_t dir) {
   // S (see the header). A touched vertex u's class depends on its S-faces and their vertices'
   // positions: those faces change (are renamed to s, moved with s, glued) only where they hold s
   // now, or belonged to a removed tet. So s is classified again, then the vertices of its S-faces
-  // (classify(s) lists them in sfaces_) and the vertices on S of the removed tets; every other
+  // (classify(s) lists them in sf_after_, sf_before_) and the vertices on S of the removed tets; every other
   // touched vertex keeps its class (verify_classes() checks it in the tests). When s's list
   // overflows, every touched vertex on S.
   if (on_s) {
     classify(s, vflags_[s], vclass_[s]);
-    if (sfaces_.size() >= kMaxVertexSFaces) {
+    if (sf_after_.size() >= kMaxVertexSFaces) {
       for (int32_t u : touched_)
         if (valive_[u] && vflags_[u] && u != s) classify(u, vflags_[u], vclass_[u]);
     } else {
       reclass_.clear();
-      for (const SFace& f : sfaces_) {
-        reclass_.push_back(f.after);
-        reclass_.push_back(f.before);
-      }
+      reclass_.assign(sf_after_.begin(), sf_after_.end());
+      reclass_.insert(reclass_.end(), sf_before_.begin(), sf_before_.end());
       reclass_.insert(reclass_.end(), gone_.begin(), gone_.end());
       const uint32_t st2 = next_stamp();
       mark_[s] = st2;
@@ -734,22 +668,15 @@ void SeqMesh::build_nbr() {
   nbr_.assign(4 * size_t(nt_), -1);
   for (int32_t v = 0; v < nv_; ++v) {
     faces_.clear();
-    const int32_t* r = ring(v);
-    for (uint32_t i = 0; i < rlen_[v]; ++i) {
-      const int32_t t = r[i];
-      const int32_t* q = tet(t);
-      const int lv = local(q, v);
-      for (int f = 0; f < 4; ++f) {
-        if (f == lv) continue;
-        int32_t o[2];
-        int no = 0;
-        for (int j = 0; j < 4; ++j)
-          if (j != f && j != lv) o[no++] = q[j];
-        if (o[0] < v || o[1] < v) continue;  // v is not the face's smallest vertex
-        const uint32_t y = uint32_t(std::min(o[0], o[1])), z = uint32_t(std::max(o[0], o[1]));
-        faces_.push_back({uint64_t(y) << 32 | z, t, int8_t(f)});
-      }
-    }
+    each_face_through(v, [&](int32_t t, const int32_t* q, int f, int lv) {
+      int32_t o[2];
+      int no = 0;
+      for (int j = 0; j < 4; ++j)
+        if (j != f && j != lv) o[no++] = q[j];
+      if (o[0] < v || o[1] < v) return;  // v is not the face's smallest vertex
+      const uint32_t y = uint32_t(std::min(o[0], o[1])), z = uint32_t(std::max(o[0], o[1]));
+      faces_.push_back({uint64_t(y) << 32 | z, t, int8_t(f)});
+    });
     std::sort(faces_.begin(), faces_.end(), [](const FaceAt& x, const FaceAt& y) { return x.key < y.key; });
     for (size_t i = 0; i < faces_.size();) {
       size_t j = i + 1;

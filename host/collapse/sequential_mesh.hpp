@@ -121,12 +121,6 @@ class SeqMesh {
     int32_t t;
     int8_t f;
   };
-  struct SFace {  // an S-face owned by a tet of ring(v)
-    int32_t t;
-    int8_t f;
-    int32_t after, before;  // the vertices after and before v along the face's orientation
-    geo::tc_d3 n;
-  };
 
   const int32_t* tet(int32_t t) const { return tets_->data() + 4 * size_t(t); }
   static bool has(const int32_t* q, int32_t x) { return q[0] == x || q[1] == x || q[2] == x || q[3] == x; }
@@ -134,6 +128,19 @@ class SeqMesh {
     return q[0] == x ? 0 : q[1] == x ? 1 : q[2] == x ? 2 : q[3] == x ? 3 : -1;
   }
   geo::tc_d3 point(int32_t v) const { return geo::tc_point(points_->data(), v); }
+  // fn(t, q, f, lv) for every face f of every tet t = q of ring(v) that holds v (f != lv, the
+  // local index of v)
+  template <class Fn>
+  void each_face_through(int32_t v, Fn&& fn) const {
+    const int32_t* r = ring(v);
+    for (uint32_t i = 0; i < rlen_[v]; ++i) {
+      const int32_t t = r[i];
+      const int32_t* q = tet(t);
+      const int lv = local(q, v);
+      for (int f = 0; f < 4; ++f)
+        if (f != lv) fn(t, q, f, lv);
+    }
+  }
   int32_t label(int32_t t) const { return labels_ ? (*labels_)[t] : 0; }
 
   const int32_t* ring(int32_t v) const { return pool_.data() + roff_[v]; }
@@ -195,8 +202,9 @@ class SeqMesh {
   std::vector<uint32_t> gseen_;
   uint32_t gstamp_ = 0;
   std::vector<NewTri> newtris_;
-  std::vector<SFace> sfaces_;
-  std::vector<int32_t> us_;
+  // the S-faces of the vertex classify() looked at last (cl/collapse_classify.h's arrays)
+  std::vector<int32_t> sf_after_, sf_before_;
+  std::vector<geo::tc_d3> sf_normal_;
 };
 
 }  // namespace tc::sequential_detail
