@@ -42,19 +42,27 @@ __kernel void verdict_tet_old(uint nt_prev, __global const uint* keep, __global 
   told[newidx[t]] = (int)t;
 }
 
-__kernel void verdict_carry(uint ne, __global const int* edges, __global const int* vold,
+/* verdict[] of the edges v owns (v < u), per vertex v: the previous verdict of (v, u) when both
+ * are clean (vdirty of their previous selves 0), else TCC_VERDICT_UNKNOWN. A clean v's N(v) is
+ * the previous one renumbered in order (conn_ring_sort_and_gather), so its part above v is the
+ * previous part above vold[v], entry for entry, with the previous edge ids in prev_nb_edge. */
+__kernel void verdict_carry(uint nv, __global const uint* nb_off, __global const int* nb,
+                            __global const uint* edge_off, __global const int* vold,
                             __global const uchar* vdirty, __global const uint* prev_nb_off,
-                            __global const int* prev_nb, __global const int* prev_nb_edge,
-                            __global const uchar* prev_verdict, __global uchar* verdict) {
-  uint e = get_global_id(0);
-  if (e >= ne) return;
-  int oa = vold[edges[2 * e]], ob = vold[edges[2 * e + 1]];
-  uchar r = TCC_VERDICT_UNKNOWN;
-  if (!vdirty[oa] && !vdirty[ob]) {
-    int eo = tcc_edge_id(prev_nb_off, prev_nb, prev_nb_edge, oa, ob);
-    if (eo >= 0) r = prev_verdict[eo];
+                            __global const int* prev_nb_edge, __global const uchar* prev_verdict,
+                            __global uchar* verdict) {
+  uint v = get_global_id(0);
+  if (v >= nv) return;
+  const uint e0 = edge_off[v], up = edge_off[v + 1] - e0;
+  const int ov = vold[v];
+  if (vdirty[ov]) {
+    for (uint i = 0; i < up; ++i) verdict[e0 + i] = TCC_VERDICT_UNKNOWN;
+    return;
   }
-  verdict[e] = r;
+  __global const int* upper = nb + (nb_off[v + 1] - up);
+  __global const int* prev_upper_edge = prev_nb_edge + (prev_nb_off[ov + 1] - up);
+  for (uint i = 0; i < up; ++i)
+    verdict[e0 + i] = vdirty[vold[upper[i]]] ? TCC_VERDICT_UNKNOWN : prev_verdict[prev_upper_edge[i]];
 }
 
 /* Merges an earlier selection round (fin1, dir1, vaff1) into the current one: the edges of the

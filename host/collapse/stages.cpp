@@ -249,12 +249,12 @@ void note_compaction(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s
   s.has_prev = true;
 }
 
-void carry_verdicts(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s) {
+void carry_verdicts(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
   ensure(s.verdict, ctx, c.ne);
   s.verdict_ready = s.has_prev;
   if (!s.has_prev) return;
-  run(ctx, "collapse_verdicts.cl", "verdict_carry", c.ne, "", U(c.ne), B(c.edges), B(s.vold), B(s.vdirty),
-      B(s.prev_nb_off), B(s.prev_nb), B(s.prev_nb_edge), B(s.prev_verdict), B(s.verdict));
+  run(ctx, "collapse_verdicts.cl", "verdict_carry", dm.nv, "", U(dm.nv), B(c.nb_off), B(c.nb), B(c.edge_off),
+      B(s.vold), B(s.vdirty), B(s.prev_nb_off), B(s.prev_nb_edge), B(s.prev_verdict), B(s.verdict));
   s.has_prev = false;
 }
 
