@@ -17,8 +17,12 @@
  *   sguard_tris       the new S triangles of each query with their boxes (the filter read
  *                     before a triangle pair is tested), and the vertices whose faces the
  *                     query replaces (x, and y when it moves);
+ *   sguard_vertex_cells  the grid cell of every vertex (a face's cells lie between its
+ *                     vertices' cells);
  *   sguard_surface    every S face of the current mesh that is not replaced by the query is
- *                     tested against the query's new triangles (over tets, through the grid);
+ *                     tested against the query's new triangles (over the tets owning S faces,
+ *                     their faces from smask, through the grid; a face in cells without a
+ *                     query is passed over before its points are read);
  *   sguard_pairs      the new triangles of two queries are tested against each other (two
  *                     collapses of one iteration never share a tet, but their new triangles
  *                     may still cross), and those of one query among themselves (a fold of
