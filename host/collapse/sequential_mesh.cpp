@@ -236,14 +236,8 @@ uint8_t SeqMesh::edge_flags(int32_t a, int32_t b, bool with_ridge) {
     const int la = local(q, a);
     for (int f = 0; f < 4; ++f) {
       if (f == la || f == lb) continue;
-      const int32_t other = across(t, f);
-      uint8_t on_s = 0, own = 0;
-      if (other < 0) {  // no other tet (boundary), or several (invalid input: boundary for each)
-        on_s = own = TCC_BOUNDARY;
-      } else if (labels_ && label(t) != label(other)) {
-        on_s = TCC_INTERFACE;
-        own = label(t) < label(other) ? TCC_INTERFACE : 0;
-      }
+      uint8_t on_s = 0;
+      const uint8_t own = owned_sface(t, f, &on_s);
       flags |= on_s;
       if (own) {
         if (ns < 2) {
@@ -270,21 +264,15 @@ uint8_t SeqMesh::edge_flags(int32_t a, int32_t b, bool with_ridge) {
 }
 
 void SeqMesh::classify(int32_t v, uint8_t& flags_out, uint8_t& cls_out) {
-  // every face through v with the tet across it (nbr_): on S and owned as tcc_owned_sface says
+  // every face through v: on S and owned as tcc_owned_sface says (owned_sface)
   uint8_t flags = 0;
   bool overflow = false;
   sf_after_.clear();
   sf_before_.clear();
   sf_normal_.clear();
   each_face_through(v, [&](int32_t t, const int32_t* q, int f, int) {
-    const int32_t other = across(t, f);
-    uint8_t on_s = 0, own = 0;
-    if (other < 0) {  // no tet across, or several (an invalid input: boundary for each)
-      on_s = own = TCC_BOUNDARY;
-    } else if (labels_ && label(t) != label(other)) {
-      on_s = TCC_INTERFACE;
-      own = label(t) < label(other) ? TCC_INTERFACE : 0;
-    }
+    uint8_t on_s = 0;
+    const uint8_t own = owned_sface(t, f, &on_s);
     flags |= on_s;
     if (!own) return;
     if (sf_after_.size() == kMaxVertexSFaces) {
@@ -697,11 +685,17 @@ int64_t SeqMesh::verify_nbr() const {
   return bad;
 }
 
-uint8_t SeqMesh::owned_sface(int32_t t, int f) const {
+uint8_t SeqMesh::owned_sface(int32_t t, int f, uint8_t* on_s) const {
   const int32_t o = across(t, f);
-  if (o < 0) return TCC_BOUNDARY;
-  if (labels_ && label(t) != label(o)) return label(t) < label(o) ? TCC_INTERFACE : 0;
-  return 0;
+  uint8_t kind = 0, own = 0;
+  if (o < 0) {  // no tet across, or several (an invalid input: boundary for each)
+    kind = own = TCC_BOUNDARY;
+  } else if (labels_ && label(t) != label(o)) {
+    kind = TCC_INTERFACE;
+    own = label(t) < label(o) ? TCC_INTERFACE : 0;
+  }
+  if (on_s) *on_s = kind;
+  return own;
 }
 
 void SeqMesh::guard_cells(const tc_d3* p, int (&lo)[3], int (&hi)[3]) const {

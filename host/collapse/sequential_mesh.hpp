@@ -158,7 +158,9 @@ class SeqMesh {
   int32_t across(int32_t t, int f) const { return nbr_[4 * size_t(t) + size_t(f)]; }
   int32_t scan_across(int32_t t, int f) const;  // the same from a ring scan
   void build_nbr();
-  uint8_t owned_sface(int32_t t, int f) const;  // tcc_owned_sface
+  // tcc_owned_sface: the kind of the face if t owns it on S, else 0; *on_s (when given) its kind
+  // on S whoever owns it
+  uint8_t owned_sface(int32_t t, int f, uint8_t* on_s = nullptr) const;
   void guard_insert(int32_t t, int f);
   void guard_cells(const geo::tc_d3* p, int (&lo)[3], int (&hi)[3]) const;
   uint64_t guard_key(int i, int j, int k) const { return (uint64_t(k) << 42) | (uint64_t(j) << 21) | uint64_t(i); }
