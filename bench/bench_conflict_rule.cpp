@@ -62,6 +62,8 @@ int main(int argc, char **argv) {
     }
     if (!std::strcmp(argv[i], "--target-factor") && i + 1 < argc)
       o.target_factor = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--priority-levels") && i + 1 < argc)
+      o.priority_levels = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--min-quality") && i + 1 < argc)
       o.min_quality = std::atof(argv[++i]);
     else if (argv[i][0] == '-') {
