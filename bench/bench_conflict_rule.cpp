@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "collapse/sequential_mesh.hpp"
+#include "collapse_predicate.h"
 #include "collapse/sequential_run.hpp"
 #include "collapse/stages.hpp"
 #include "tetcollapse/collapse.hpp"
@@ -55,19 +56,14 @@ int main(int argc, char** argv) {
       whole_run = true;
       continue;
     }
-    if (!std::strcmp(argv[i], "--out") && i + 1 < argc)
-      out_prefix = argv[++i];
-    else if (!std::strcmp(argv[i], "--target-factor") && i + 1 < argc)
-      o.target_factor = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--priority-levels") && i + 1 < argc)
-      o.priority_levels = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--min-quality") && i + 1 < argc)
-      o.min_quality = std::atof(argv[++i]);
+    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out_prefix = argv[++i];
+    else if (!std::strcmp(argv[i], "--target-factor") && i + 1 < argc) o.target_factor = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--priority-levels") && i + 1 < argc) o.priority_levels = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--min-quality") && i + 1 < argc) o.min_quality = std::atof(argv[++i]);
     else if (argv[i][0] == '-') {
       std::fprintf(stderr, "bench_conflict_rule: unknown option or missing value: %s\n", argv[i]);
       return 2;
-    } else
-      path = argv[i];
+    } else path = argv[i];
   }
   Mesh mesh;
   try {
@@ -100,25 +96,34 @@ int main(int argc, char** argv) {
   auto prio = [&](uint32_t e) {
     return std::floor(cost[e] / p.target * p.priority_levels) + double(e * 2654435761u) * (1.0 / 4294967296.0);
   };
-  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) {
+  auto by_prio = [&](uint32_t a, uint32_t b) {
     const double pa = prio(a), pb = prio(b);
     return pa < pb || (pa == pb && a < b);
-  });
+  };
+  std::sort(order.begin(), order.end(), by_prio);
   // the vertices a collapse moves or removes (dir bits: collapse_predicate.h)
   auto moved = [&](uint32_t e, int32_t* m) {
     const int32_t v0 = edges[2 * e], v1 = edges[2 * e + 1];
     const uint8_t d = dir[e];
-    if (d & (2u | 4u)) {  // midpoint or a user placement: both move
+    if (d & (TCC_DIR_MIDPOINT | TCC_DIR_USER)) {  // both move
       m[0] = v0;
       m[1] = v1;
       return 2;
     }
-    m[0] = (d & 1u) ? v1 : v0;  // TCC_DIR_REMOVE_V1: v1 goes, v0 stays
+    m[0] = (d & TCC_DIR_REMOVE_V1) ? v1 : v0;
     return 1;
   };
   auto close_nbhd = [&](int32_t v, auto&& fn) {
     fn(v);
     for (uint32_t j = nb_off[v]; j < nb_off[v + 1]; ++j) fn(nb[j]);
+  };
+  // The round of the first of two rounds given per vertex (-1: none), one of them given.
+  auto first_of = [](int32_t x, int32_t y) { return x >= 0 && y >= 0 ? std::min(x, y) : std::max(x, y); };
+  // The round after the last one in which a candidate within reach of (a, b) decided.
+  auto after_reach = [&](const std::vector<int32_t>& last, int32_t a, int32_t b) {
+    int32_t r = 0;
+    for (int32_t x : {a, b}) close_nbhd(x, [&](int32_t z) { r = std::max(r, last[z]); });
+    return r + 1;
   };
   // current rule: mark N[a] and N[b] of each taken edge; an edge with a marked end point waits.
   //
@@ -132,15 +137,7 @@ int main(int argc, char** argv) {
   int32_t rounds_current = 0;
   for (uint32_t e : order) {
     const int32_t a = edges[2 * e], b = edges[2 * e + 1];
-    int32_t r;
-    if (reach[a] || reach[b]) {
-      r = reach_at[a] >= 0 && reach_at[b] >= 0 ? std::min(reach_at[a], reach_at[b])
-                                               : std::max(reach_at[a], reach_at[b]);
-    } else {
-      r = 0;
-      for (int32_t x : {a, b}) close_nbhd(x, [&](int32_t z) { r = std::max(r, last_cur[z]); });
-      r += 1;
-    }
+    const int32_t r = reach[a] || reach[b] ? first_of(reach_at[a], reach_at[b]) : after_reach(last_cur, a, b);
     last_cur[a] = std::max(last_cur[a], r);
     last_cur[b] = std::max(last_cur[b], r);
     rounds_current = std::max(rounds_current, r);
@@ -201,36 +198,21 @@ int main(int argc, char** argv) {
     std::vector<uint32_t> cands;
     for (uint32_t e = 0; e < c.ne; ++e)
       if (reason[e] != kNotMarked && reason[e] != kRefusedQ) cands.push_back(e);
-    std::sort(cands.begin(), cands.end(), [&](uint32_t a, uint32_t b) {
-      const double pa = prio(a), pb = prio(b);
-      return pa < pb || (pa == pb && a < b);
-    });
+    std::sort(cands.begin(), cands.end(), by_prio);
     // The rounds a parallel version would need, from the decisions: a candidate decides once every
     // candidate before it within reach (an end point in N[a] or N[b], on the start mesh) has
     // decided, or at once in the round where an edge sharing an end point is taken. Per vertex: the
     // last round in which a candidate at it decided (last_at), and the round in which an edge at it
     // was taken (taken_at).
     std::vector<int32_t> last_at(dm.nv, 0), taken_at(dm.nv, -1);
-    int32_t rounds = 0;
-    std::vector<uint8_t> used(mesh.num_vertices(), 0);
+    std::vector<uint8_t> end_point(mesh.num_vertices(), 0);  // of a collapse taken (input numbering)
     for (uint32_t e : cands) {
-      const int32_t da = edges[2 * e],
-                    db = edges[2 * e + 1];  // device numbering (N on the start mesh)
-      int32_t r;
-      if (taken_at[da] >= 0 || taken_at[db] >= 0) {  // the first of the two (-1: not taken)
-        r = taken_at[da] >= 0 && taken_at[db] >= 0 ? std::min(taken_at[da], taken_at[db])
-                                                   : std::max(taken_at[da], taken_at[db]);
-      } else {
-        r = 0;
-        for (int32_t x : {da, db}) {
-          r = std::max(r, last_at[x]);
-          for (uint32_t j = nb_off[x]; j < nb_off[x + 1]; ++j) r = std::max(r, last_at[nb[j]]);
-        }
-        r += 1;
-      }
+      const int32_t da = edges[2 * e], db = edges[2 * e + 1];  // device numbering (N on the start mesh)
+      const int32_t r = taken_at[da] >= 0 || taken_at[db] >= 0 ? first_of(taken_at[da], taken_at[db])
+                                                               : after_reach(last_at, da, db);
       int32_t a = input_of[da], b = input_of[db];
       bool in = false;
-      if (!used[a] && !used[b] && sm.alive(a) && sm.alive(b) && sm.is_edge(a, b)) {
+      if (!end_point[a] && !end_point[b] && sm.alive(a) && sm.alive(b) && sm.is_edge(a, b)) {
         if (a > b) std::swap(a, b);
         ++checks_checked;
         if (size_t(r) >= checks_per_round.size()) checks_per_round.resize(size_t(r) + 1, 0);
@@ -238,7 +220,7 @@ int main(int argc, char** argv) {
         const sequential_detail::Verdict v = sm.check(a, b);
         if (v.reason == kOk) {
           sm.collapse(a, b, v.dir);
-          used[a] = used[b] = 1;
+          end_point[a] = end_point[b] = 1;
           ++taken_checked;
           in = true;
         }
@@ -246,9 +228,8 @@ int main(int argc, char** argv) {
       last_at[da] = std::max(last_at[da], r);
       last_at[db] = std::max(last_at[db], r);
       if (in) taken_at[da] = taken_at[db] = r;
-      rounds = std::max(rounds, r);
+      rounds_checked = std::max(rounds_checked, r);
     }
-    rounds_checked = rounds;
   }
   std::printf("mesh %s\n%u vertices, %u edges, %u marked, %u admissible (target %g, min_quality %g)\n", path.c_str(),
               dm.nv, c.ne, marked, adm, p.target, p.min_quality);
@@ -256,18 +237,16 @@ int main(int argc, char** argv) {
               rounds_current);
   std::printf("moved rule:   %zu collapses (%zu keep an end point in place): %.2fx\n", taken_moved, kept_moved,
               double(taken_moved) / double(std::max<size_t>(1, taken_current)));
-  std::printf(
-      "checked:      %zu collapses (vertex-disjoint, each checked after the earlier ones): %.2fx; %zu checks, %d "
-      "rounds\n",
-      taken_checked, double(taken_checked) / double(std::max<size_t>(1, taken_current)), checks_checked,
-      rounds_checked);
+  std::printf("checked:      %zu collapses (vertex-disjoint, each checked after the earlier ones): %.2fx; %zu checks, "
+              "%d rounds\n",
+              taken_checked, double(taken_checked) / double(std::max<size_t>(1, taken_current)), checks_checked,
+              rounds_checked);
   {
     std::printf("  checks by round:");
     size_t cum = 0;
     for (size_t r = 0; r < checks_per_round.size(); ++r) {
       cum += checks_per_round[r];
-      if (r == 5 || r == 10 || r == 20 || r == 30 || r == 50 || r == 100 || r == 150 ||
-          r + 1 == checks_per_round.size())
+      if (r == 5 || r == 10 || r == 20 || r == 30 || r == 50 || r == 100 || r == 150 || r + 1 == checks_per_round.size())
         std::printf(" <=%zu: %.1f%%", r, 100.0 * double(cum) / double(std::max<size_t>(1, checks_checked)));
     }
     std::printf("\n");
