@@ -3,7 +3,7 @@
 //
 //   bench_collapse [MESH] [--runs N] [--json FILE] [--wg N] [--max-iterations N]
 //                  [--eps-c N[,N...]] [--min-quality Q[,Q...]] [--rounds N] [--host-tail F]
-//                  [--conflicts greedy|two-pass|atomic-min[,...]]
+//                  [--conflicts greedy|two-pass|atomic-min|matching[,...]]
 // Defaults: eps_c 0 and 700, min_quality 0 (the paper: no quality guard) and 0.1 (the library's
 // default), the library's default conflict detection (greedy); every combination is run, the
 // conflict detections one after another for each run index (so that they share the machine's
@@ -58,6 +58,7 @@ bool conflicts_from(const std::string& name, CollapseOptions::Conflicts& c) {
   if (name == "greedy") c = CollapseOptions::Greedy;
   else if (name == "two-pass") c = CollapseOptions::TwoPass;
   else if (name == "atomic-min") c = CollapseOptions::AtomicMin;
+  else if (name == "matching") c = CollapseOptions::Matching;
   else return false;
   return true;
 }
@@ -89,7 +90,7 @@ int main(int argc, char** argv) {
   for (const std::string& c : conflicts) {
     CollapseOptions::Conflicts x;
     if (!conflicts_from(c, x)) {
-      std::fprintf(stderr, "bench_collapse: unknown --conflicts %s (greedy, two-pass, atomic-min)\n", c.c_str());
+      std::fprintf(stderr, "bench_collapse: unknown --conflicts %s (greedy, two-pass, atomic-min, matching)\n", c.c_str());
       return 2;
     }
   }

@@ -102,6 +102,13 @@ inline int tcc_face_others(__global const int* tets, __global const uint* vt_off
 /* tet_nbr[4 t + f]: the tet across the face of t opposite local vertex f; -1 when the face is in
  * no other tet (boundary), -2 when in several (invalid input: each side counts as boundary). */
 
+/* At most this many S-faces through a vertex are gathered (conn_surface_flags, the matching
+ * selection's live tests); more (never seen in practice) classify it as a corner there and
+ * refuse the edge here. */
+#ifndef TCC_MAX_VERTEX_SFACES
+#define TCC_MAX_VERTEX_SFACES 64
+#endif
+
 /* Is the face of tet t opposite local vertex f an S-face owned by t (as in tc::build_topology:
  * a boundary face is owned by its only tet; an interface face by the tet of the smaller label;
  * a face in more than two tets, invalid input, counts as boundary for each)? Returns 0 when
@@ -121,12 +128,15 @@ inline uint tcc_owned_sface(__global const int* tet_nbr, __global const int* lab
   return 0u;
 }
 
-/* Is the triangle (x, y, z) an S-face (boundary or interface)? Scans ring(x). */
+/* Is the triangle (x, y, z) an S-face (boundary or interface)? Scans ring(x), without the tets
+ * flagged in tdead when live (cl/collapse_select.h). */
 inline uint tcc_triangle_kind(__global const int* tets, __global const uint* vt_off, __global const int* vt,
-                              __global const int* labels, int use_labels, int x, int y, int z) {
+                              __global const int* labels, int use_labels, int x, int y, int z, int live,
+                              __global const uchar* tdead) {
   int n = 0, t0 = -1, t1 = -1;
   for (uint i = vt_off[x]; i < vt_off[x + 1]; ++i) {
     int u = vt[i];
+    if (live && tdead[u]) continue;
     if (tcc_has(tets, u, y) && tcc_has(tets, u, z)) {
       if (n == 0) t0 = u;
       else if (n == 1) t1 = u;
@@ -223,6 +233,31 @@ inline double3 tcc_placement(__global const double* pts, __global const double* 
 #endif
   if (dir & TCC_DIR_MIDPOINT) return (p0 + p1) * 0.5;
   return (dir & TCC_DIR_REMOVE_V1) ? p0 : p1;
+}
+
+/* The survivor's vertex fields after the collapse of (v0, v1) with the direction bits d, the
+ * survivor v placed at p (the placement of tcc_placement): at a midpoint the average of v's and
+ * the removed vertex's, at a user placement their interpolation at p's parameter along the edge
+ * (clamped to the edge), else v's own. Reads the ncomp values of v and of the removed vertex from
+ * in, writes them at out[o ncomp ..] (out may be in, with o = v). */
+inline void tcc_survivor_fields(int v, int v0, int v1, uint d, double3 p, __global const double* pts, uint ncomp,
+                                __global const double* in, __global double* out, uint o) {
+  const int partner = (d & TCC_DIR_MIDPOINT) ? (v == v0 ? v1 : v0) : -1;
+  double s = 0.5; /* the partner's parameter, seen from v */
+  if (d & TCC_DIR_USER) {
+    const double3 p0 = tc_point(pts, v0), d01 = tc_point(pts, v1) - p0;
+    const double len2 = tcc_dot(d01, d01);
+    const double s01 = len2 > 0.0 ? tcc_dot(p - p0, d01) / len2 : 0.5; /* the parameter of v1 */
+    s = v == v0 ? s01 : 1.0 - s01;
+  }
+  for (uint c = 0; c < ncomp; ++c) {
+    double x = in[(size_t)v * ncomp + c];
+    if (partner >= 0) {
+      const double y = in[(size_t)partner * ncomp + c];
+      x = s == 0.5 ? 0.5 * (x + y) : !(s > 0.0) ? x : s >= 1.0 ? y : x + s * (y - x);
+    }
+    out[(size_t)o * ncomp + c] = x;
+  }
 }
 
 /* Worklists of the conflict rounds (collapse_conflict.cl, collapse_admissible.cl): slot c of

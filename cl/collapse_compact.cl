@@ -6,6 +6,9 @@
  *   vertex_write   positions (survivor at the placement), vertex fields (averaged for midpoint
  *                  placement, interpolated for a user placement), vertex mask
  *   tet_keep       a tet holding both end points of a final edge disappears
+ * With in_place (the matching selection, collapse_matching.cl, applied its collapses to the mesh
+ * as it took them: tets renamed, removed tets flagged in tdead, survivors placed with their
+ * fields), vertex_write copies and tet_keep reads tdead.
  *   (host)         exclusive scan of the tet flags
  *   tet_write      tets remapped through vmap, labels and tet fields carried
  *   origin_update  origin[i] (input vertex -> current vertex) composed with vmap */
@@ -38,46 +41,34 @@ __kernel void vertex_write(uint nv, __global const int* vaff, __global const int
                            __global const uchar* edge_dir, __global const uint* keep, __global const uint* newidx,
                            __global const double* pts, __global double* out_pts, uint ncomp,
                            __global const double* vfields, __global double* out_vfields, int has_mask,
-                           __global const uchar* vmask, __global uchar* out_vmask) {
+                           __global const uchar* vmask, __global uchar* out_vmask, int in_place) {
   uint v = get_global_id(0);
   if (v >= nv || !keep[v]) return;
   uint o = newidx[v];
-  int e = vaff[v];
+  int e = in_place ? -1 : vaff[v];
   double3 p = tc_point(pts, (int)v);
-  int partner = -1;
-  /* the fields of v and of the removed vertex: averaged at the midpoint; at a user placement p,
-   * interpolated at p's parameter s along the edge (v0 + s (v1 - v0), clamped to [0, 1]) */
-  double s = 0.5;
-  if (e >= 0) { /* v survives the collapse of e */
+  if (e >= 0) { /* v survives the collapse of e: its position and fields as placed */
     const uint d = edge_dir[e];
     const int v0 = edges[2 * e], v1 = edges[2 * e + 1];
     p = tcc_placement(pts, vfields, ncomp, v0, v1, d);
-    if (d & TCC_DIR_MIDPOINT) partner = tcc_removed_vertex(edges, edge_dir, e);
-    if (d & TCC_DIR_USER) {
-      const double3 p0 = tc_point(pts, v0), d01 = tc_point(pts, v1) - p0;
-      const double len2 = tcc_dot(d01, d01);
-      const double s01 = len2 > 0.0 ? tcc_dot(p - p0, d01) / len2 : 0.5; /* the parameter of v1 */
-      s = (int)v == v0 ? s01 : 1.0 - s01; /* of the partner, seen from v (clamped below) */
-    }
+    tcc_survivor_fields((int)v, v0, v1, d, p, pts, ncomp, vfields, out_vfields, o);
+  } else {
+    for (uint c = 0; c < ncomp; ++c) out_vfields[(size_t)o * ncomp + c] = vfields[(size_t)v * ncomp + c];
   }
   out_pts[3 * o] = p.x;
   out_pts[3 * o + 1] = p.y;
   out_pts[3 * o + 2] = p.z;
-  for (uint c = 0; c < ncomp; ++c) {
-    double x = vfields[(size_t)v * ncomp + c];
-    if (partner >= 0) {
-      const double y = vfields[(size_t)partner * ncomp + c];
-      x = s == 0.5 ? 0.5 * (x + y) : !(s > 0.0) ? x : s >= 1.0 ? y : x + s * (y - x);
-    }
-    out_vfields[(size_t)o * ncomp + c] = x;
-  }
   if (has_mask) out_vmask[o] = vmask[v];
 }
 
 __kernel void tet_keep(uint nt, __global const int* tets, __global const int* vaff, __global const int* edges,
-                       __global uint* keep) {
+                       __global uint* keep, int in_place, __global const uchar* tdead) {
   uint t = get_global_id(0);
   if (t >= nt) return;
+  if (in_place) {
+    keep[t] = !tdead[t];
+    return;
+  }
   __global const int* q = tets + 4 * t;
   uint k = 1u;
   for (int i = 0; i < 4; ++i) {

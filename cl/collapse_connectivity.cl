@@ -432,10 +432,6 @@ inline uchar tcc_edge_flags_of(int a, int b, __global const int* tets, __global 
   return (uchar)flags;
 }
 
-#ifndef TCC_MAX_VERTEX_SFACES
-#define TCC_MAX_VERTEX_SFACES 64
-#endif
-
 /* Edge flags and vertex classes, per vertex v: the flags of the edges v owns (v < u) and the class
  * of v, from the owned S-faces through v, gathered once (rather than a ring scan per edge), by
  * the rules of collapse_classify.h (tc_sf_edge, tc_sf_class; the sequential method's too). An

@@ -150,6 +150,91 @@ __kernel void sguard_queries(uint ne, __global const int* edges, __global const 
   b[0] = lo.x, b[1] = lo.y, b[2] = lo.z, b[3] = hi.x, b[4] = hi.y, b[5] = hi.z;
 }
 
+/* --- The guard of the matching selection (collapse_matching.cl), whose collapses are applied to
+ * the mesh (tets renamed, tdead, tet_nbr glued, survivors placed) and may share tets: it tests
+ * the result. Every S face of the result that a collapse changed holds the survivor x of that
+ * collapse (renamed from the removed vertex y, moved with x, or glued across a removed tet), so
+ * a query is a collapse whose survivor is on S, with as new triangles all S faces through x
+ * now; the sweep (sguard_surface) is over the S faces of the result (sguard_applied_smask) and
+ * skips those through x, which are the query's own (sguard_pairs tests them among themselves).
+ * Every pair of faces of the result that was not a pair before has a face of a query, so
+ * nothing that crosses is missed. --- */
+
+/* The faces each tet of the result owns on S (tcc_owned_sface over tet_nbr as glued): smask and
+ * owns_s as conn_vertex_flags_faces writes them for a connectivity; 0 for the removed tets. */
+__kernel void sguard_applied_smask(uint nt, __global const int* tet_nbr, __global const int* labels, int use_labels,
+                                   __global const uchar* tdead, __global uint* owns_s, __global uchar* smask) {
+  uint t = get_global_id(0);
+  if (t >= nt) return;
+  uint mask = 0;
+  for (int f = 0; f < 4 && !tdead[t]; ++f) {
+    uint on_s;
+    if (tcc_owned_sface(tet_nbr, labels, use_labels, (int)t, f, &on_s)) mask |= 1u << f;
+  }
+  smask[t] = (uchar)mask;
+  owns_s[t] = mask != 0u;
+}
+
+/* Loop over the S faces of the result through the survivor x of the collapse of y onto x: the
+ * faces through x of the tets of ring(x) U ring(y) that are left (the two rings share only the
+ * removed tets). BODY sees id[3] and pos[3]. */
+#define TCC_SG_FOR_APPLIED_TRIS(x, y, id, pos, BODY)                                                    \
+  for (int side_ = 0; side_ < 2; ++side_) {                                                              \
+    int z_ = side_ == 0 ? (x) : (y);                                                                     \
+    for (uint i_ = vt_off[z_]; i_ < vt_off[z_ + 1]; ++i_) {                                              \
+      int t_ = vt[i_];                                                                                   \
+      uint m_ = smask[t_];                                                                               \
+      if (tdead[t_] || !m_) continue;                                                                    \
+      int l_ = tcc_local(tets, t_, (x));                                                                 \
+      for (int f_ = 0; f_ < 4; ++f_) {                                                                   \
+        if (f_ == l_ || !(m_ & (1u << f_))) continue;                                                    \
+        for (int k_ = 0; k_ < 3; ++k_) {                                                                 \
+          id[k_] = tets[4 * t_ + TC_TET_FACES[f_][k_]];                                                  \
+          pos[k_] = tc_point(pts, id[k_]);                                                               \
+        }                                                                                                \
+        BODY                                                                                             \
+      }                                                                                                  \
+    }                                                                                                    \
+  }
+
+/* The applied collapse of edge e: x survives, y was removed. */
+inline void tcc_sg_applied(int e, __global const int* edges, __global const uchar* dir, int* x, int* y) {
+  uint d = dir[e];
+  *x = (d & TCC_DIR_REMOVE_V1) ? edges[2 * e] : edges[2 * e + 1];
+  *y = (d & TCC_DIR_REMOVE_V1) ? edges[2 * e + 1] : edges[2 * e];
+}
+
+/* Queries of the matching selection: the taken collapses whose survivor is on S, with the box and
+ * the number of the S faces through it now. */
+__kernel void sguard_applied_queries(uint ne, __global const int* edges, __global const uint* fin,
+                                     __global const uchar* dir, __global const double* pts, __global const int* tets,
+                                     __global const uint* vt_off, __global const int* vt, __global const uchar* tdead,
+                                     __global const uchar* smask, __global const uchar* vflags, __global int* qedge,
+                                     __global double* qbox, __global uint* qntri, __global uint* qcount) {
+  uint e = get_global_id(0);
+  if (e >= ne || !fin[e]) return;
+  int x, y;
+  tcc_sg_applied((int)e, edges, dir, &x, &y);
+  if (!vflags[x] && !vflags[y]) return; /* S is not touched */
+  double3 lo = (double3)(INFINITY, INFINITY, INFINITY), hi = -lo;
+  int id[3];
+  double3 pos[3];
+  uint n = 0;
+  TCC_SG_FOR_APPLIED_TRIS(x, y, id, pos, {
+    ++n;
+    for (int k = 0; k < 3; ++k) {
+      lo = fmin(lo, pos[k]);
+      hi = fmax(hi, pos[k]);
+    }
+  })
+  if (n == 0) return;
+  uint slot = atomic_inc(qcount);
+  qedge[slot] = (int)e;
+  qntri[slot] = n;
+  __global double* b = qbox + 6 * slot;
+  b[0] = lo.x, b[1] = lo.y, b[2] = lo.z, b[3] = hi.x, b[4] = hi.y, b[5] = hi.z;
+}
+
 /* The plane data (tc_sg_plane) of new triangle n in tplane (5 doubles each). */
 inline void tcc_sg_store_plane(__global double* tplane, uint n, tc_sg_plane q) {
   __global double* d = tplane + 5 * n;
@@ -162,6 +247,20 @@ inline tc_sg_plane tcc_sg_load_plane(__global const double* tplane, uint n) {
   q.ln = d[3];
   q.e2 = d[4];
   return q;
+}
+
+/* Triangle n of a query: ids, positions, box and plane (sguard_tris, sguard_applied_tris). */
+inline void tcc_sg_store_tri(uint n, const int* id, const double3* pos, __global int* tid, __global double* tpos,
+                             __global double* tbox, __global double* tplane) {
+  for (int k = 0; k < 3; ++k) {
+    tid[3 * n + k] = id[k];
+    tpos[9 * n + 3 * k] = pos[k].x;
+    tpos[9 * n + 3 * k + 1] = pos[k].y;
+    tpos[9 * n + 3 * k + 2] = pos[k].z;
+  }
+  vstore3(fmin(fmin(pos[0], pos[1]), pos[2]), 2 * n, tbox);
+  vstore3(fmax(fmax(pos[0], pos[1]), pos[2]), 2 * n + 1, tbox);
+  tcc_sg_store_plane(tplane, n, tc_sg_plane_of(pos));
 }
 
 /* The new S triangles of each query, at qoff[q] .. qoff[q + 1] (ids, positions, boxes and
@@ -183,18 +282,30 @@ __kernel void sguard_tris(uint nq, __global const int* qedge, __global const uin
   int id[3];
   double3 pos[3];
   TCC_SG_FOR_NEW_TRIS(x, y, moves_y, p, id, pos, {
-    for (int k = 0; k < 3; ++k) {
-      tid[3 * n + k] = id[k];
-      tpos[9 * n + 3 * k] = pos[k].x;
-      tpos[9 * n + 3 * k + 1] = pos[k].y;
-      tpos[9 * n + 3 * k + 2] = pos[k].z;
-    }
-    /* its box (no comma at this level: the body is a macro argument) */
-    double3 lo = fmin(fmin(pos[0], pos[1]), pos[2]);
-    double3 hi = fmax(fmax(pos[0], pos[1]), pos[2]);
-    vstore3(lo, 2 * n, tbox);
-    vstore3(hi, 2 * n + 1, tbox);
-    tcc_sg_store_plane(tplane, n, tc_sg_plane_of(pos));
+    tcc_sg_store_tri(n, id, pos, tid, tpos, tbox, tplane);
+    ++n;
+  })
+}
+
+/* The S faces through the survivor of each query of sguard_applied_queries, at qoff[q] ..
+ * qoff[q + 1]; qrep: the survivor (the faces through it are the query's own). */
+__kernel void sguard_applied_tris(uint nq, __global const int* qedge, __global const uint* qoff,
+                                  __global const int* edges, __global const uchar* dir, __global const double* pts,
+                                  __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                                  __global const uchar* tdead, __global const uchar* smask, __global int* tid,
+                                  __global double* tpos, __global double* tbox, __global double* tplane,
+                                  __global int* qrep) {
+  uint qi = get_global_id(0);
+  if (qi >= nq) return;
+  int x, y;
+  tcc_sg_applied(qedge[qi], edges, dir, &x, &y);
+  qrep[2 * qi] = x;
+  qrep[2 * qi + 1] = -1;
+  uint n = qoff[qi];
+  int id[3];
+  double3 pos[3];
+  TCC_SG_FOR_APPLIED_TRIS(x, y, id, pos, {
+    tcc_sg_store_tri(n, id, pos, tid, tpos, tbox, tplane);
     ++n;
   })
 }
@@ -335,12 +446,14 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
   }
 }
 
-/* The new triangles of two queries against each other. */
+/* The new triangles of a query among themselves, and with cross (not for the matching
+ * selection's queries: the sweep meets the other queries' triangles among the S faces of the
+ * result) those of two queries against each other. */
 __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const uint* qoff, __global const int* tid,
                            __global const double* tpos, __global const double* tbox, __global const double* tplane,
                            double ox, double oy, double oz, double ih, int gx, int gy, int gz,
                            __global const uint* cell_off, __global const uint* cell_items, __global const int* qcell,
-                           __global uint* qbad) {
+                           __global uint* qbad, int cross) {
   uint qa = get_global_id(0);
   if (qa >= nq) return;
   __global const double* ba = qbox + 6 * qa;
@@ -363,6 +476,7 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
       return;
     }
   }
+  if (!cross) return;
   TCC_SG_FOR_CELL_QUERIES(lo, hi, qb, {
     if (qb == qa || !tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, qbox + 6 * qb, qcell + 6 * qb, ci, cj, ck)) continue;
     for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
@@ -401,4 +515,13 @@ __kernel void sguard_drop(uint nq, __global const int* qedge, __global const uin
   marked[qedge[q]] = 0u;
   if (has_verdict) verdict[qedge[q]] = TCC_REFUSED_SURFACE;
   atomic_inc(count);
+}
+
+/* The refused queries' edges (qbad), flagged and listed, for the matching selection's undo. */
+__kernel void sguard_refused_list(uint nq, __global const int* qedge, __global const uint* qbad,
+                                  __global uchar* flag, __global uint* list, __global uint* count) {
+  uint q = get_global_id(0);
+  if (q >= nq || !qbad[q]) return;
+  flag[qedge[q]] = 1;
+  list[atomic_inc(count)] = (uint)qedge[q];
 }

@@ -65,6 +65,19 @@ inline int tcc_predicate_q(int a, int b, unsigned int fa, unsigned int fb, unsig
   return ca > cb ? keep_a : keep_b;
 }
 
+/* The link condition's virtual vertex w (collapse_admissible.cl tcc_link_test, SeqMesh::link_ok),
+ * joined to every S-face: two simplices through a and b (the end points themselves, or the
+ * edges (a, c) and (b, c)) with the S flags k1 and k2, which the collapse merges, need their join
+ * (the edge (a, b), or the triangle (a, b, c)) with the flags k12 on S when both are on S; and
+ * on each kind of S they share, since the boundary and the interfaces are two surfaces, either
+ * of which the merge would pinch (an interface edge joining two points of the boundary: w of
+ * the boundary would be in lk(a) and lk(b) but not in lk(ab)). */
+inline int tcc_w_join_ok(unsigned int k1, unsigned int k2, unsigned int k12) {
+  const unsigned int s = TCC_BOUNDARY | TCC_INTERFACE;
+  if ((k1 & s) && (k2 & s) && !(k12 & s)) return 0;
+  return (k1 & k2 & s & ~k12) == 0u;
+}
+
 #ifndef __OPENCL_C_VERSION__
 }  // namespace tc::rules
 #endif

@@ -10,6 +10,8 @@
  *             neighbours. Every other face keeps its neighbour (the link condition rules out
  *             any other coincidence of faces). X and Y lie in the collapse's star, which no other
  *             final edge touches, so Y is kept.
+ * The matching selection (collapse_matching.cl) glues tet_nbr as it applies its collapses, so
+ * with in_place tet_nbr_update only renumbers.
  * Inputs are those of collapse_compact.cl before the swap: previous tets, rings (vt_off, vt,
  * ascending), tet_nbr, vaff and edge_dir of the final edges, keep flags and new indices. */
 #include "collapse_common.h"
@@ -55,12 +57,14 @@ __kernel void ring_update_write(uint nv_prev, __global const uint* vkeep, __glob
 
 __kernel void tet_nbr_update(uint nt_prev, __global const int* tets, __global const uint* tkeep,
                              __global const uint* tnew, __global const int* vaff, __global const int* edges,
-                             __global const int* tet_nbr, __global int* new_tet_nbr) {
+                             __global const int* tet_nbr, __global int* new_tet_nbr, int in_place) {
   uint t = get_global_id(0);
   if (t >= nt_prev || !tkeep[t]) return;
   for (int f = 0; f < 4; ++f) {
     int x = tet_nbr[4 * t + f], out = x;
-    if (x >= 0 && tkeep[x]) {
+    if (in_place) { /* glued already (collapse_matching.cl): every neighbour is kept */
+      out = x >= 0 ? (int)tnew[x] : x;
+    } else if (x >= 0 && tkeep[x]) {
       out = (int)tnew[x];
     } else if (x >= 0) {
       /* x = (u, s, c, d) was dropped by the final edge of its vertices; t holds one of u, s */

@@ -234,9 +234,11 @@ void register_collapse(CLI::App& app, int& exit_code) {
   app.add_option("--conflicts", c->conflicts,
                  "Conflict detection of the parallel method: greedy (default: one selection under both\n"
                  "of the paper's conflict rules, the edges taken in cost order), two-pass (the paper's\n"
-                 "pass 1 over edges, then pass 2 over tets) or atomic-min (Gautron and Kenzel 2023;\n"
-                 "needs 64-bit atomics on the device)")
-      ->check(CLI::IsMember({"greedy", "two-pass", "atomic-min"}));
+                 "pass 1 over edges, then pass 2 over tets), atomic-min (Gautron and Kenzel 2023;\n"
+                 "needs 64-bit atomics on the device) or matching (the edges taken in cost order, each\n"
+                 "tested on the mesh with the earlier ones collapsed, skipping only those sharing an end\n"
+                 "point with one taken: about four times the collapses per iteration)")
+      ->check(CLI::IsMember({"greedy", "two-pass", "atomic-min", "matching"}));
   app.add_option("--priority-levels", c->priority_levels,
                  "Greedy conflicts: edges are ordered by their cost in steps of target / N, and within a\n"
                  "step in a fixed pseudo-random order (default 64; 0: exact cost order, many more\n"
@@ -282,10 +284,13 @@ void register_collapse(CLI::App& app, int& exit_code) {
     opt.method = c->method == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
     opt.conflicts = c->conflicts == "atomic-min" ? CollapseOptions::AtomicMin
                     : c->conflicts == "two-pass" ? CollapseOptions::TwoPass
+                    : c->conflicts == "matching" ? CollapseOptions::Matching
                                                  : CollapseOptions::Greedy;
     if (c->priority_levels >= 0) {
-      if (opt.method == CollapseOptions::Sequential || opt.conflicts != CollapseOptions::Greedy)
-        throw CLI::ValidationError("--priority-levels", "applies to the greedy conflict detection only (--conflicts greedy)");
+      if (opt.method == CollapseOptions::Sequential ||
+          (opt.conflicts != CollapseOptions::Greedy && opt.conflicts != CollapseOptions::Matching))
+        throw CLI::ValidationError("--priority-levels",
+                                   "applies to the greedy and matching conflict detections only (--conflicts greedy|matching)");
       opt.priority_levels = c->priority_levels;
     }
     if (opt.method == CollapseOptions::Sequential && !c->device.empty())

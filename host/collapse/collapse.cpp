@@ -170,7 +170,7 @@ void tail_seed(Context& ctx, DeviceMesh& dm, Connectivity& conn, EdgeState& st, 
   seed.vflags = conn.vflags.download_range(0, dm.nv);
   seed.vclass = conn.vclass.download_range(0, dm.nv);
   seed.tet_nbr = conn.tet_nbr.download_range(0, 4 * size_t(dm.nt));
-  if (reuse && options.conflicts == CollapseOptions::Greedy) {
+  if (reuse && (options.conflicts == CollapseOptions::Greedy || options.conflicts == CollapseOptions::Matching)) {
     carry_verdicts(ctx, dm, conn, st);
     seed.touched = tail_touched(ctx, dm, conn, st);
   } else {
@@ -256,6 +256,10 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     // counted before the first selection, tested and the seconds add up over the selections
     // (a selection tests only edges no earlier one tested), the other counts are the last's.
     double t_sel = t2;
+    // the matching selection applies its collapses as it takes them: the mesh as it is now, for
+    // a selection again when the surface guard refuses some
+    const bool matching = options.conflicts == CollapseOptions::Matching;
+    if (matching) matching_backup(ctx, dm, st);
     for (bool first = true;; first = false) {
       // the admissible filter: every marked edge tested (atomic-min), or lazily within the greedy
       // selection or within pass 1
@@ -264,9 +268,9 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
         s.tested = s.marked;
       } else {
         uint32_t passed_q = 0, tested = 0;
-        s.admissible = options.conflicts == CollapseOptions::Greedy
-                           ? greedy_selection(ctx, dm, conn, st, p, passed_q, tested)
-                           : lazy_admissible_pass1(ctx, dm, conn, st, p, passed_q, tested);
+        s.admissible = options.conflicts == CollapseOptions::Greedy ? greedy_selection(ctx, dm, conn, st, p, passed_q, tested)
+                       : matching ? matching_selection(ctx, dm, conn, st, p, passed_q, tested)
+                                  : lazy_admissible_pass1(ctx, dm, conn, st, p, passed_q, tested);
         if (first) s.passed_q = passed_q;
         s.tested += tested;
       }
@@ -276,7 +280,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
       // the conflict detection (the greedy selection's is done)
       if (options.conflicts == CollapseOptions::AtomicMin) {
         s.after_pass2 = s.after_pass1 = conflicts_atomic_min(ctx, dm, conn, st);
-      } else if (options.conflicts == CollapseOptions::Greedy) {
+      } else if (options.conflicts == CollapseOptions::Greedy || matching) {
         s.after_pass2 = s.after_pass1 = s.admissible;
       } else {
         s.after_pass1 = s.admissible;
@@ -291,7 +295,16 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
       }
       // Surface guard (guard_surface.hpp): the refused edges are unmarked; this iteration's
       // verdicts still hold for the next selection.
-      const uint32_t refused = guard.run(ctx, dm, conn, st, p, uint32_t(s.after_pass2));
+      uint32_t refused = 0;
+      if (matching) {
+        // the collapses are applied: the refused ones are undone, with those that saw them, and
+        // the result is tested again
+        while ((refused = guard.run_applied(ctx, dm, conn, st, p, uint32_t(s.after_pass2))) > 0)
+          s.after_pass2 -= matching_undo(ctx, dm, conn, st, guard);
+        s.after_pass1 = s.admissible = s.after_pass2;
+      } else {
+        refused = guard.run(ctx, dm, conn, st, p, uint32_t(s.after_pass2));
+      }
       const double t5 = now();
       s.seconds_pass2 += t5 - t_sel;
       t_sel = t5;

@@ -74,22 +74,80 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   if (nq == 0) return 0;
 
   // the new triangles of each query, stored once (offsets by a scan of their counts)
+  reserve_triangles(ctx, nq, query_offsets(ctx, nq));
+  launch(ctx, p, "sguard_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(), s.dir.buffer(),
+         dm.points.buffer(), dm.vfields.buffer(), cl_uint(dm.vfield_comps), dm.tets.buffer(), c.vt_off.buffer(),
+         c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels, tid.buffer(), tpos.buffer(), tbox.buffer(),
+         tplane.buffer(), qrep.buffer());
+  // the tets owning an S face (conn_vertex_flags_faces), listed once per connectivity
+  if (stets_generation != c.generation) {
+    ensure_nonempty(stets, ctx, dm.nt);
+    n_stets = dev::compact_indices(ctx, c.owns_s, stets, dm.nt);
+    stets_generation = c.generation;
+  }
+  return test_queries(ctx, dm, c, s, p, chosen, nq, c.smask, stets, n_stets);
+}
+
+uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                                   uint32_t chosen) {
+  last_queries = 0;
+  if (chosen == 0) return 0;
+  // the S faces of the result
+  ensure_nonempty(applied_owns_s, ctx, dm.nt);
+  ensure_nonempty(applied_smask, ctx, dm.nt);
+  const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
+  launch(ctx, p, "sguard_applied_smask", dm.nt, cl_uint(dm.nt), c.tet_nbr.buffer(), dm.labels[0].buffer(), use_labels,
+         s.tdead.buffer(), applied_owns_s.buffer(), applied_smask.buffer());
+  ensure_nonempty(qedge, ctx, chosen);
+  ensure_nonempty(qbox, ctx, size_t(chosen) * 6);
+  ensure_nonempty(qntri, ctx, chosen);
+  ensure_nonempty(qcount, ctx, 1);
+  qcount.fill(0u);
+  launch(ctx, p, "sguard_applied_queries", c.ne, cl_uint(c.ne), c.edges.buffer(), s.fin.buffer(), s.dir.buffer(),
+         dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), s.tdead.buffer(),
+         applied_smask.buffer(), c.vflags.buffer(), qedge.buffer(), qbox.buffer(), qntri.buffer(), qcount.buffer());
+  uint32_t nq = 0;
+  qcount.download(&nq, 1);
+  last_queries = nq;
+  if (nq == 0) return 0;
+  const uint32_t ntri = query_offsets(ctx, nq);
+  reserve_triangles(ctx, nq, ntri);
+  launch(ctx, p, "sguard_applied_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(),
+         s.dir.buffer(), dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), s.tdead.buffer(),
+         applied_smask.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(), tplane.buffer(), qrep.buffer());
+  ensure_nonempty(applied_stets, ctx, dm.nt);
+  const uint32_t n_applied = dev::compact_indices(ctx, applied_owns_s, applied_stets, dm.nt);
+  return test_queries(ctx, dm, c, s, p, chosen, nq, applied_smask, applied_stets, n_applied);
+}
+
+void SurfaceGuard::refused_edges(Context& ctx, DeviceBuffer<uint8_t>& flag, DeviceBuffer<uint32_t>& list,
+                                 DeviceBuffer<uint32_t>& count) {
+  if (last_queries == 0) return;
+  StageParams p;  // the kernel has no user code
+  launch(ctx, p, "sguard_refused_list", last_queries, cl_uint(last_queries), qedge.buffer(), qbad.buffer(),
+         flag.buffer(), list.buffer(), count.buffer());
+}
+
+uint32_t SurfaceGuard::query_offsets(Context& ctx, uint32_t nq) {
   const std::vector<uint32_t> counts = qntri.download_range(0, nq);
   std::vector<uint32_t> off_tri(nq + 1, 0);
   for (uint32_t q = 0; q < nq; ++q) off_tri[q + 1] = off_tri[q] + counts[q];
-  const uint32_t ntri = off_tri[nq];
   ensure_nonempty(qoff, ctx, nq + 1);
   qoff.upload(off_tri);
+  return off_tri[nq];
+}
+
+void SurfaceGuard::reserve_triangles(Context& ctx, uint32_t nq, uint32_t ntri) {
   ensure_nonempty(tid, ctx, size_t(ntri) * 3);
   ensure_nonempty(tpos, ctx, size_t(ntri) * 9);
   ensure_nonempty(tbox, ctx, size_t(ntri) * 6);
   ensure_nonempty(tplane, ctx, size_t(ntri) * 5);
   ensure_nonempty(qrep, ctx, size_t(nq) * 2);
-  launch(ctx, p, "sguard_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(), s.dir.buffer(),
-         dm.points.buffer(), dm.vfields.buffer(), cl_uint(dm.vfield_comps), dm.tets.buffer(), c.vt_off.buffer(),
-         c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels, tid.buffer(), tpos.buffer(), tbox.buffer(),
-         tplane.buffer(), qrep.buffer());
+}
 
+uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                                    uint32_t chosen, uint32_t nq, DeviceBuffer<uint8_t>& smask,
+                                    DeviceBuffer<uint32_t>& sweep_tets, uint32_t n_sweep) {
   // The grid: cells twice the median query box (most boxes span <= 2 cells per axis, the large
   // ones are entered in every cell they span), at most kMaxCellsPerAxis per axis.
   const std::vector<double> box = qbox.download_range(0, size_t(nq) * 6);
@@ -143,22 +201,16 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
 
   ensure_nonempty(qbad, ctx, nq);
   qbad.fill(0u);
-  // the tets owning an S face (conn_vertex_flags_faces), listed once per connectivity
-  if (stets_generation != c.generation) {
-    ensure_nonempty(stets, ctx, dm.nt);
-    n_stets = dev::compact_indices(ctx, c.owns_s, stets, dm.nt);
-    stets_generation = c.generation;
-  }
   ensure_nonempty(vcell, ctx, dm.nv);
   launch(ctx, p, "sguard_vertex_cells", dm.nv, cl_uint(dm.nv), dm.points.buffer(), cl_double(lo[0]), cl_double(lo[1]),
          cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), vcell.buffer());
-  launch(ctx, p, "sguard_surface", n_stets, cl_uint(n_stets), stets.buffer(), c.smask.buffer(), vcell.buffer(),
+  launch(ctx, p, "sguard_surface", n_sweep, cl_uint(n_sweep), sweep_tets.buffer(), smask.buffer(), vcell.buffer(),
          dm.points.buffer(), dm.tets.buffer(), qrep.buffer(), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
          tbox.buffer(), tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
          cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer());
   launch(ctx, p, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),
          tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
-         cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer());
+         cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer(), cl_int(s.in_place ? 0 : 1));
   qcount.fill(0u);
   const bool has_verdict = s.verdict.size() >= c.ne && s.verdict.buffer()();
   launch(ctx, p, "sguard_drop", nq, cl_uint(nq), qedge.buffer(), qbad.buffer(), s.marked.buffer(),

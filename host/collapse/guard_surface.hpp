@@ -23,9 +23,30 @@ struct SurfaceGuard {
   uint64_t stets_generation = 0;  // of this Connectivity::generation
   uint32_t n_stets = 0;
 
+  DeviceBuffer<uint32_t> applied_owns_s, applied_stets;  // run_applied: the S faces of the result
+  DeviceBuffer<uint8_t> applied_smask;
+
   // Tests the `chosen` collapses of s.fin / s.dir; returns how many were refused (their edges
   // are unmarked in s.marked).
   uint32_t run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p, uint32_t chosen);
+  // The same for the matching selection, whose collapses are applied to dm and c.tet_nbr
+  // (EdgeState::in_place): on the result (cl/collapse_guard.cl, sguard_applied_*).
+  uint32_t run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                       uint32_t chosen);
+  // After a run that refused collapses: their edges flagged in flag (1) and listed in list (from
+  // count[0] on, which is advanced).
+  void refused_edges(Context& ctx, DeviceBuffer<uint8_t>& flag, DeviceBuffer<uint32_t>& list,
+                     DeviceBuffer<uint32_t>& count);
+
+ private:
+  // qoff from the nq queries' triangle counts (qntri); returns the triangles in all.
+  uint32_t query_offsets(Context& ctx, uint32_t nq);
+  void reserve_triangles(Context& ctx, uint32_t nq, uint32_t ntri);
+  // The queries' triangles (tid, ...) against the S faces the n_sweep tets of sweep_tets own
+  // (smask) and against each other, through a grid; the queries with a hit are refused.
+  uint32_t test_queries(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                        uint32_t chosen, uint32_t nq, DeviceBuffer<uint8_t>& smask, DeviceBuffer<uint32_t>& sweep_tets,
+                        uint32_t n_sweep);
 };
 
 }  // namespace tc::collapse_detail

@@ -391,12 +391,12 @@ bool SeqMesh::link_ok(int32_t a, int32_t b, uint8_t fe) {
   // (i) every common neighbour is a vertex of lk(ab); and w: a, b both on S needs an S-edge
   for (int32_t c : cn_)
     if (lmark_[c] != sL) return false;
-  if ((fa & kSMask) && (fb & kSMask) && !(fe & kSMask)) return false;
-  // (ii) with w: S-edges (a,c) and (b,c) need the S-face (a,b,c)
+  if (!rules::tcc_w_join_ok(fa, fb, fe)) return false;
+  // (ii) with w: S-edges (a,c) and (b,c) need the S-face (a,b,c), of the kinds they share
   for (int32_t c : cn_) {
     if (!(vflags_[c] & kSMask)) continue;
-    if ((edge_flags(a, c, false) & kSMask) && (edge_flags(b, c, false) & kSMask) && !triangle_kind(a, b, c))
-      return false;
+    const uint8_t fac = edge_flags(a, c, false), fbc = edge_flags(b, c, false);
+    if ((fac & kSMask) && (fbc & kSMask) && !rules::tcc_w_join_ok(fac, fbc, triangle_kind(a, b, c))) return false;
   }
   // (ii) triangles and (iii) tets and S-faces, from the tets of ring(a) without b
   for (uint32_t i = 0; i < rlen_[a]; ++i) {

@@ -1,6 +1,7 @@
 // Host side of the collapse stages: buffer management and kernel launches (cl/collapse_*.cl).
 #include "collapse/stages.hpp"
 #include "collapse/spatial_order.hpp"
+#include "collapse/guard_surface.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -9,6 +10,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 #include "device/primitives.hpp"
@@ -412,6 +414,7 @@ const cl::Buffer& tet_qualities(Context& ctx, DeviceMesh& dm, const Connectivity
 }  // namespace
 
 uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p) {
+  s.in_place = false;
   ensure(s.adm, ctx, c.ne);
   ensure(s.dir, ctx, c.ne);
   ensure(s.reason, ctx, c.ne);
@@ -619,6 +622,7 @@ namespace {
 void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                 const DeviceBuffer<double>& order, std::initializer_list<std::pair<cl::Kernel*, cl_uint>> tests) {
   const std::string A = "collapse_admissible.cl";
+  s.in_place = false;
   ensure(s.dir, ctx, c.ne);
   ensure(s.reason, ctx, c.ne);
   ensure(s.cand, ctx, c.ne);
@@ -740,6 +744,148 @@ uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
   return cnt[3];
 }
 
+uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                            uint32_t& passed_q, uint32_t& tested) {
+  const std::string A = "collapse_admissible.cl", M = "collapse_matching.cl";
+  cl::Kernel decide = stage_kernel(ctx, p, M, "match_decide"), apply = stage_kernel(ctx, p, M, "match_apply"),
+             loop = stage_kernel(ctx, p, M, "match_loop");
+  // the priority first: lazy_init claims the first slots in its order
+  const DeviceBuffer<double>* prio = &s.cost;
+  if (p.priority_levels > 0) {
+    ensure(s.prio, ctx, c.ne);
+    run(ctx, A, "greedy_priority", c.ne, "", U(c.ne), B(s.cost), B(s.marked), p.target, p.priority_levels,
+        B(s.prio));
+    prio = &s.prio;
+  }
+  // the test's arguments (TCC_MATCH_PARAMS): the lazy filter's, then the live test's
+  constexpr cl_uint kDecide = 18, kApply = 10, kLoop = 21, kTestArgs = 24;
+  lazy_start(ctx, dm, c, s, p, *prio, {{&decide, kDecide}, {&apply, kApply}, {&loop, kLoop}});
+  s.in_place = true;
+  ensure(s.tdead, ctx, std::max<size_t>(dm.nt, 1));
+  ensure(s.tkill, ctx, std::max<size_t>(dm.nt, 1));
+  ensure(s.dround, ctx, c.ne);
+  s.tdead.fill(0);
+  for (auto [k, first] : {std::pair{&decide, kDecide}, {&apply, kApply}, {&loop, kLoop}})
+    set_args_from(*k, first + kTestArgs, "match test", p.eps_r, p.eps_f, B(s.tdead));
+  ensure(s.fin, ctx, c.ne);
+  ensure(s.blocker, ctx, c.ne);
+  ensure(s.spec, ctx, c.ne);
+  ensure(s.queued, ctx, c.ne);
+  ensure(s.vstamp, ctx, dm.nv);
+  ensure(s.inlist, ctx, c.ne);
+  ensure(s.dlist, ctx, std::max<size_t>(dm.nv, 1));  // a vertex is listed at most once per round
+  ensure(s.work[0], ctx, c.ne);
+  ensure(s.work[1], ctx, c.ne);
+  ensure(s.work_n, ctx, 5);
+  ensure(s.resume, ctx, 3);
+  s.blocker.fill(-1);
+  s.spec.fill(p.match_early_tests ? 0 : 1);  // 1: the early test counts as done
+  s.queued.fill(0xffffffffu);
+  s.vstamp.fill(0xffffffffu);
+  s.work_n.fill(0);
+  run(ctx, A, "lazy_p1_first_turns", c.ne, "", U(c.ne), B(s.cand), B(c.edges), B(s.slot[0]), B(s.work[0]), B(s.work_n),
+      B(s.verdict));
+  uint32_t nt = 0;
+  s.work_n.download(&nt, 1);
+  cl::Kernel recompute = ctx.kernel(A, "lazy_p1_recompute"), turns = ctx.kernel(A, "lazy_p1_turns");
+  int cur = 0;  // the turn list of this round
+  for (cl_uint round = 0; nt > 0; ++round) {
+    auto t0 = std::chrono::steady_clock::now();
+    s.work_n.fill(0);
+    const bool one_group = nt <= p.greedy_loop_size;
+    if (one_group) {
+      s.resume.fill(0);
+      set_args(loop, "match_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
+               B(*prio), B(s.slot[0]), B(s.blocker), B(s.spec), B(s.dround), B(s.queued), B(s.inlist), B(s.vstamp),
+               B(s.dlist), B(s.state), B(s.vaff), B(s.tkill), U(p.greedy_loop_exit), B(s.resume));
+      ctx.launch(loop, ctx.group_size_for(loop), "match_loop");
+      uint32_t r[3];
+      s.resume.download(r, 3);
+      nt = r[0];  // 0: every round done; else the loop stopped before a long turn list
+      cur = int(r[1]);
+      round = r[2] - 1;
+    } else {
+      set_args_from(decide, 0, "match_decide", U(nt), cl_uint(cur), B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n),
+                    B(c.edges), B(*prio), B(s.slot[0]), B(s.blocker), B(s.spec), B(s.dround), B(s.queued), round,
+                    B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff));
+      ctx.launch(decide, nt, "match_decide");
+      set_args_from(apply, 0, "match_apply", B(s.inlist), B(s.work_n), B(c.edges), B(s.slot[0]), B(s.vstamp), round,
+                    B(s.dlist), B(s.state), B(s.vaff), B(s.tkill));
+      ctx.launch(apply, nt, "match_apply");  // over the round's taken edges (cnt[4] <= nt)
+      vertex_part(ctx, s, c, recompute, turns, *prio, cur, round);
+      s.work_n.download(&nt, 1, size_t(1 - cur));
+      cur = 1 - cur;
+    }
+    if (kProfile) {
+      ctx.finish();
+      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s%s\n", "match_round", nt,
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                   one_group ? " (one work-group)" : "");
+    }
+  }
+  run(ctx, A, "greedy_finish", c.ne, "", U(c.ne), B(s.state), B(s.p1), B(s.fin), B(s.counters));
+  uint32_t cnt[6];
+  s.counters.download(cnt, 6);
+  passed_q = cnt[5];
+  tested = cnt[4];
+  return cnt[3];
+}
+
+void matching_backup(Context& ctx, DeviceMesh& dm, EdgeState& s) {
+  if (!s.points0.buffer()()) {
+    s.points0 = DeviceBuffer<double>(ctx, 1);
+    s.vfields0 = DeviceBuffer<double>(ctx, 1);
+  }
+  s.points0.copy_from(dm.points, size_t(dm.nv) * 3);
+  s.vfields0.copy_from(dm.vfields, size_t(dm.nv) * dm.vfield_comps);
+}
+
+uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, SurfaceGuard& guard) {
+  const std::string M = "collapse_matching.cl";
+  ensure(s.refused, ctx, c.ne);
+  ensure(s.undo, ctx, c.ne);
+  ensure(s.reachmin, ctx, dm.nv);
+  s.refused.fill(0);
+  s.reachmin.fill(0xffffffffu);
+  // the undone, listed in s.work[0]: the refused first, then each growth
+  ensure(s.work_n, ctx, 5);
+  s.work_n.fill(0);
+  guard.refused_edges(ctx, s.refused, s.work[0], s.work_n);
+  s.undo.copy_from(s.refused, c.ne);
+  uint32_t n = 0;
+  s.work_n.download(&n, 1);
+  // the taken edges
+  ensure(s.cand_edges, ctx, c.ne);
+  const uint32_t taken = dev::compact_indices(ctx, s.fin, s.cand_edges, c.ne);
+  uint32_t done = 0;  // entries of work[0] whose reach is marked
+  while (done < n) {
+    // (the list's new part starts at done: marked through an offset sub-range of work[0])
+    std::vector<uint32_t> fresh = s.work[0].download_range(done, n - done);
+    s.work[1].upload(fresh.data(), fresh.size());
+    run(ctx, M, "match_undo_reach", fresh.size(), "", U(fresh.size()), B(s.work[1]), B(c.edges), B(c.nb_off), B(c.nb),
+        B(s.dround), B(s.reachmin));
+    done = n;
+    run(ctx, M, "match_undo_grow", taken, "", U(taken), B(s.cand_edges), B(c.edges), B(s.dround), B(s.reachmin),
+        B(s.undo), B(s.work[0]), B(s.work_n));
+    s.work_n.download(&n, 1);
+  }
+  // undone in the reverse order of their rounds (then of their index: any order within a round)
+  std::vector<uint32_t> order = s.work[0].download_range(0, n), rounds(n);
+  for (uint32_t i = 0; i < n; ++i) s.dround.download(&rounds[i], 1, order[i]);
+  std::vector<uint32_t> idx(n);
+  std::iota(idx.begin(), idx.end(), 0u);
+  std::sort(idx.begin(), idx.end(), [&](uint32_t a, uint32_t b) {
+    return rounds[a] != rounds[b] ? rounds[a] > rounds[b] : order[a] > order[b];
+  });
+  std::vector<uint32_t> sorted(n);
+  for (uint32_t i = 0; i < n; ++i) sorted[i] = order[idx[i]];
+  s.work[1].upload(sorted.data(), n);
+  run(ctx, M, "match_undo", 1, "", U(n), B(s.work[1]), B(s.refused), B(c.edges), B(s.dir), B(dm.tets), B(c.vt_off),
+      B(c.vt), B(c.tet_nbr), B(s.tdead), B(s.tkill), B(dm.points), B(dm.vfields), U(dm.vfield_comps), B(s.points0),
+      B(s.vfields0), B(s.vaff), B(s.state), B(s.fin), B(s.reason));
+  return n;
+}
+
 uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s, uint32_t loop_size) {
   const std::string F = "collapse_conflict.cl";
   ensure(s.fin, ctx, c.ne);
@@ -788,15 +934,17 @@ void collapse_and_compact(Context& ctx, const StageParams& p, DeviceMesh& dm, De
   next.tfield_comps = dm.tfield_comps;
   next.has_mask = dm.has_mask;
   next.has_labels = dm.has_labels;
+  const cl_int in_place = s.in_place ? 1 : 0;
   run_stage(ctx, p, F, "vertex_write", nv, U(nv), B(s.vaff), B(c.edges), B(s.dir), B(vkeep), B(vnew), B(dm.points),
       B(next.points), U(dm.vfield_comps), B(dm.vfields), B(next.vfields), I(dm.has_mask ? 1 : 0), B(dm.vmask),
-      B(next.vmask));
+      B(next.vmask), in_place);
   // tets
   DeviceBuffer<uint32_t>& tkeep = s.tkeep;  // kept for note_compaction
   DeviceBuffer<uint32_t>& tnew = s.tnew;
   ensure(tkeep, ctx, nt);
   ensure(tnew, ctx, nt);
-  run(ctx, F, "tet_keep", nt, "", U(nt), B(dm.tets), B(s.vaff), B(c.edges), B(tkeep));
+  run(ctx, F, "tet_keep", nt, "", U(nt), B(dm.tets), B(s.vaff), B(c.edges), B(tkeep), in_place,
+      s.in_place ? B(s.tdead) : B(vkeep));
   const uint32_t nt2 = dev::exclusive_scan(ctx, tkeep, tnew, nt);
   next.nt = nt2;
   ensure(next.tets, ctx, size_t(nt2) * 4);
@@ -833,7 +981,7 @@ void collapse_and_compact(Context& ctx, const StageParams& p, DeviceMesh& dm, De
         B(tkeep), B(tnew), B(s.upd_vt_off), B(s.upd_vt));
     ensure(s.upd_tet_nbr, ctx, size_t(nt2) * 4);
     run(ctx, U8, "tet_nbr_update", nt, "", U(nt), B(dm.tets), B(tkeep), B(tnew), B(s.vaff), B(c.edges), B(c.tet_nbr),
-        B(s.upd_tet_nbr));
+        B(s.upd_tet_nbr), in_place);
     s.update_next = false;
     s.has_update = true;
   }

@@ -12,6 +12,8 @@
 
 namespace tc::collapse_detail {
 
+struct SurfaceGuard;  // guard_surface.hpp
+
 // The current mesh on the device.
 struct DeviceMesh {
   uint32_t nv = 0, nt = 0;
@@ -68,6 +70,16 @@ struct EdgeState {
   DeviceBuffer<double> prio;
   DeviceBuffer<int32_t> blocker;
   DeviceBuffer<uint32_t> vstamp, inlist;
+  // matching selection (matching_selection): per edge whether its early test ran and the round
+  // it was taken in, per tet whether a collapse removed it and which; the positions and fields
+  // of the iteration's start (matching_backup), for undoing collapses the surface guard refuses
+  // (matching_undo: per edge refused / undone, per vertex the first round reaching it); in_place:
+  // the collapses are applied (collapse_and_compact only compacts)
+  DeviceBuffer<uint8_t> spec, tdead, refused, undo;
+  DeviceBuffer<uint32_t> dround, reachmin;
+  DeviceBuffer<int32_t> tkill;
+  DeviceBuffer<double> points0, vfields0;
+  bool in_place = false;
   // marked, admissible, pass1, pass2, tested (lazy), passed Q (lazy)
   DeviceBuffer<uint32_t> counters;
   // Verdicts of the link and volume tests kept across iterations (collapse_verdicts.cl):
@@ -147,6 +159,8 @@ struct StageParams {
   // more than greedy_loop_exit. Results do not depend on the last two.
   double priority_levels = 64;
   uint32_t greedy_loop_size = 512, greedy_loop_exit = 2048;
+  // Matching selection: a waiting edge's early volume test (cl/collapse_matching.cl, spec).
+  bool match_early_tests = true;
 };
 StageParams params_from(const CollapseOptions& o);
 
@@ -189,6 +203,20 @@ uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
 // lazy_admissible_pass1 (tested: the edges whose volume test ran).
 uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                           uint32_t& passed_q, uint32_t& tested);
+// The matching selection (cl/collapse_matching.cl), in place of greedy_selection: the edges that
+// taking the candidates one after another in priority order would take, each tested on the mesh
+// with the earlier ones collapsed, skipping only those that share an end point with an edge
+// taken before. The collapses are applied to dm (tets, points, fields) and c.tet_nbr as they are
+// taken (s.tdead: the removed tets; s.in_place), so matching_backup must come before and
+// collapse_and_compact after (it then only compacts). Outputs and counts as greedy_selection.
+uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                            uint32_t& passed_q, uint32_t& tested);
+// Keeps the positions and vertex fields as they are, for matching_undo.
+void matching_backup(Context& ctx, DeviceMesh& dm, EdgeState& s);
+// After SurfaceGuard::run_applied refused collapses of the matching selection: undoes them and
+// every collapse taken after one of them within reach (cl/collapse_matching.cl, match_undo*);
+// returns how many were undone (fin, vaff, state and the mesh updated).
+uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, SurfaceGuard& guard);
 // Atomic-min conflict detection (host/collapse/conflict_atomic.cpp) over the admissible edges
 // of admissible(): replaces both conflict passes, with the same outputs as conflict_pass2.
 // Returns the number of edges to collapse.

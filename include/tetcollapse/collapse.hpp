@@ -112,7 +112,12 @@ struct CollapseOptions {
   // AtomicMin: Gautron and Kenzel 2023, every admissible edge propagates a 64-bit descriptor
   //   (cost bits high, edge index low) with atomic_min to the tets of both one-rings and
   //   collapses when it holds the minimum in all of them; needs cl_khr_int64_extended_atomics.
-  enum Conflicts { TwoPass, AtomicMin, Greedy };
+  // Matching: the edges that taking the marked edges one after another in priority order would
+  //   take, each tested on the mesh with the collapses taken before it applied, skipping only
+  //   those that share an end point with an edge taken before: its collapses may share tets
+  //   (each is tested on the result of the earlier ones), so an iteration takes about four
+  //   times as many as Greedy's (cl/collapse_matching.cl). The surface guard tests the result.
+  enum Conflicts { TwoPass, AtomicMin, Greedy, Matching };
   Conflicts conflicts = Greedy;
   // Greedy: the order is the cost in steps of target_length / priority_levels and, within a
   // step, a fixed pseudo-random order of the edges (a bijective hash of the edge index). The

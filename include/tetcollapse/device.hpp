@@ -179,6 +179,15 @@ class DeviceBuffer {
       ctx_->queue().enqueueReadBuffer(buf_, CL_TRUE, offset * sizeof(T), count * sizeof(T), data);
     });
   }
+  // Becomes a copy of the first count elements of src (a copy on the device), resized to count.
+  void copy_from(const DeviceBuffer& src, size_t count) {
+    src.check_range(0, count, "copy_from");
+    resize(count);
+    if (count == 0) return;
+    detail::cl_call("DeviceBuffer::copy_from", [&] {
+      ctx_->queue().enqueueCopyBuffer(src.buf_, buf_, 0, 0, count * sizeof(T));
+    });
+  }
   // Sets every element to value.
   void fill(const T& value) {
     if (n_ == 0) return;

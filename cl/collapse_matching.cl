@@ -1,0 +1,412 @@
+/* The matching selection (tc::CollapseOptions::Matching): stages 3-5 of an iteration in one, the
+ * admissible filter, the conflict detection and the collapses.
+ *
+ * The edges that taking the candidates one after another in priority order would take, where
+ * each candidate is tested on the mesh with the collapses taken before it applied and only the
+ * edges sharing an end point with a taken one are skipped: the taken edges are a matching, and
+ * their collapses may share tets. The greedy selection (collapse_admissible.cl) skips every
+ * edge within reach of a taken one instead (no two of its collapses touch a common tet), which
+ * leaves about three quarters of what this one takes to later iterations (W1's first iteration:
+ * 10,095 against ~41,000; bench/bench_conflict_rule), each of them a pass over the mesh.
+ *
+ * Rounds as in the greedy selection (slot[x]: the first undecided candidate at x; an edge first
+ * at both end points is in the turn list, and it decides once no undecided candidate before it
+ * is within reach, an end point in N[a] or N[b]). Such an edge's test reads only ring(a) U
+ * ring(b) and the positions of their vertices, N[a] U N[b], which only the collapses of edges
+ * within reach change; those before it are decided, those after it wait for it. So the test
+ * sees exactly the collapses taken before it (priority order), and the edges deciding in one
+ * round touch disjoint stars. A round:
+ *   match_decide  each turn-list edge e = (a, b): while a candidate before it is within reach
+ *                 (blocker[e], as in the greedy selection) it waits, after one volume test on
+ *                 the mesh as it is (spec[e]: a refusal is OUT at once, which frees the way for
+ *                 the edges after it); else its tests (Q, volume, link) on the mesh as it is, IN
+ *                 or OUT. Read-only on the mesh;
+ *   match_apply   each edge taken this round is collapsed in place: the tets holding both end
+ *                 points flagged in tdead and tet_nbr glued across them (collapse_update.cl),
+ *                 the removed vertex renamed to the survivor in the tets of its ring, the
+ *                 survivor placed (pts) with its fields (tcc_survivor_fields); vaff of both end
+ *                 points; the other candidates at a and b OUT, the vertices whose slot they
+ *                 held listed;
+ *   lazy_p1_recompute and lazy_p1_turns (collapse_admissible.cl) over the listed vertices.
+ * A test is live (collapse_select.h) when an end point of a taken edge is in N[a] U N[b] (vaff):
+ * its star changed. Else the mesh around it is the iteration's start and the verdict kept from
+ * the previous iteration (collapse_verdicts.cl) holds, as in the greedy selection; a live
+ * verdict is not kept (the end points are dirty for the carry: their rings change).
+ * Decisions do not depend on the order of the work items: the turn lists are the same as a
+ * set whatever the order, and each decision reads only what the rounds before it wrote.
+ * What stays for the host (collapse_and_compact with in_place): compaction and renumbering. The
+ * surface guard runs on the result (guard_surface.hpp: SurfaceGuard::run_applied); when it
+ * refuses collapses the host restores the mesh and selects again.
+ *
+ * cnt[]: as in the greedy selection ([0], [1] the turn lists, [2] the vertex list, [4] the edges
+ * taken this round). counters[1] taken, counters[4] tests run (volume tests; link tests are
+ * not counted apart). */
+#include "collapse_common.h"
+#include "collapse_classify.h"
+#include "collapse_select.h"
+
+/* The test's arguments in the match kernels: those of the lazy filter's test (TCC_TEST_PARAMS,
+ * in the same order; the mesh writable here, for match_apply), then the ridge and face
+ * thresholds of the live classification and the removed tets. */
+#define TCC_MATCH_PARAMS                                                                                   \
+  __global int *tets, __global const uint *vt_off, __global const int *vt, __global int *tet_nbr,            \
+      __global const uint *nb_off, __global const int *nb, __global const int *nb_edge,                      \
+      __global const int *labels, int use_labels, __global double *pts, __global double *vfield,             \
+      uint vfield_stride, __global const uchar *vflags, __global const uchar *vclass,                        \
+      __global const uchar *eflags, int mode, int paper_rule, double eps_v, double q_min,                    \
+      __global const double *tet_quality, __global uchar *edge_dir, __global uchar *reason,                  \
+      __global uint *counters, __global uchar *verdict, double eps_r, double eps_f, __global uchar *tdead
+#define TCC_MATCH_ARGS TCC_TEST_ARGS, eps_r, eps_f, tdead
+
+/* Live: the S-faces through v owned by the tets of ring(v) that are left (tcc_owned_sface with
+ * tet_nbr as it is now), as conn_surface_flags gathers them: the vertices after and before v
+ * along each, its kind and unit normal. Returns their number, -1 when more than
+ * TCC_MAX_VERTEX_SFACES. */
+inline int tcc_live_sfaces(int v, __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                           __global const int* tet_nbr, __global const int* labels, int use_labels,
+                           __global const double* pts, __global const uchar* tdead, int* after, int* before,
+                           uchar* kind, double3* normal) {
+  int fn = 0;
+  for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
+    int t = vt[i];
+    if (tdead[t]) continue;
+    __global const int* q = tets + 4 * t;
+    int lv = tcc_local(tets, t, v);
+    for (int f = 0; f < 4; ++f) {
+      uint on_s;
+      if (f == lv || !tcc_owned_sface(tet_nbr, labels, use_labels, t, f, &on_s)) continue;
+      if (fn == TCC_MAX_VERTEX_SFACES) return -1;
+      int w[3] = {q[TC_TET_FACES[f][0]], q[TC_TET_FACES[f][1]], q[TC_TET_FACES[f][2]]};
+      int p = w[0] == v ? 0 : w[1] == v ? 1 : 2;
+      after[fn] = w[(p + 1) % 3];
+      before[fn] = w[(p + 2) % 3];
+      kind[fn] = (uchar)on_s;
+      normal[fn] = tcc_face_normal(pts, tets, t, f);
+      ++fn;
+    }
+  }
+  return fn;
+}
+
+/* Live: Q's direction bits of (a, b) (as tcc_lazy_dir) from the S flags, the classes and the
+ * edge's flags computed now (collapse_classify.h, the rules of conn_surface_flags); -1 refuses.
+ * *fa, *fb, *fe receive the flags for the link test. A vertex off S at the iteration's start
+ * (vflags) is off S now: collapses keep S's topology, and one that is no end point of a
+ * collapse gains no S-face (collapse_verdicts.cl). */
+inline int tcc_live_dir(int a, int b, __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                        __global const int* tet_nbr, __global const int* labels, int use_labels,
+                        __global const double* pts, __global const uchar* tdead, __global const uchar* vflags,
+                        int mode, int paper_rule, double eps_r, double eps_f, uint* fa, uint* fb, uint* fe) {
+  int after[2][TCC_MAX_VERTEX_SFACES], before[2][TCC_MAX_VERTEX_SFACES];
+  uchar kind[2][TCC_MAX_VERTEX_SFACES];
+  double3 normal[2][TCC_MAX_VERTEX_SFACES];
+  int fn[2], cls[2];
+  uint fv[2];
+  for (int s = 0; s < 2; ++s) {
+    const int v = s == 0 ? a : b;
+    fn[s] = vflags[v] ? tcc_live_sfaces(v, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, tdead, after[s],
+                                        before[s], kind[s], normal[s])
+                      : 0;
+    if (fn[s] < 0) return -1;
+    fv[s] = 0;
+    for (int j = 0; j < fn[s]; ++j) fv[s] |= kind[s][j];
+    cls[s] = fn[s] == 0 ? TCC_INTERIOR : tc_sf_class(after[s], before[s], normal[s], fn[s], eps_r, eps_f);
+  }
+  uint f = 0;
+  if (fv[0] && fv[1]) {
+    int ridge = 0;
+    f = tc_sf_edge(b, after[0], before[0], kind[0], normal[0], fn[0], eps_r, &ridge) | (ridge ? TCC_RIDGE : 0u);
+  }
+  *fa = fv[0];
+  *fb = fv[1];
+  *fe = f;
+  return tcc_user_dir(tcc_predicate_q(a, b, fv[0], fv[1], f, cls[0], cls[1], mode, paper_rule), fv[0], fv[1], mode);
+}
+
+/* The tests of e = (a, b) on the mesh as it is: the volume test alone (full = 0: the early
+ * test of a waiting edge) or Q, the volume test and the link condition (full = 1); TCC_OK or
+ * the refusal, with Q's direction bits in *dir. Not live: the lazy filter's test, with the
+ * verdicts kept. */
+inline uchar tcc_match_test(int e, int a, int b, int live, int full, int* dir, TCC_TEST_PARAMS, double eps_r,
+                            double eps_f, __global const uchar* tdead) {
+  if (!live) {
+    *dir = tcc_lazy_dir(e, a, b, TCC_TEST_ARGS);
+    if (!full) return tcc_lazy_volume(e, a, b, *dir, TCC_TEST_ARGS) ? TCC_OK : verdict[e];
+    return tcc_lazy_verdict(e, a, b, *dir, TCC_TEST_ARGS);
+  }
+  uint fa, fb, fe;
+  *dir = tcc_live_dir(a, b, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, tdead, vflags, mode, paper_rule,
+                      eps_r, eps_f, &fa, &fb, &fe);
+  if (*dir < 0 || !tcc_user_allows(pts, vfield, vfield_stride, a, b)) return TCC_REFUSED_Q;
+  atomic_inc(&counters[4]);
+  uchar r = tcc_volume_test(a, b, *dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tet_quality, 1,
+                            tdead);
+  if (r != TCC_OK || !full) return r;
+  return tcc_link_test(a, b, fa, fb, fe, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, vflags,
+                       eflags, 1, tdead);
+}
+
+inline void tcc_match_decide(int e, __global const int* edges, __global const double* prio,
+                             __global const int* slot, __global int* blocker, __global uchar* spec,
+                             __global uint* dround,
+                             __global uint* tnext, __global uint* tn, volatile __global uint* queued, uint round,
+                             __global uint* inlist, __global uint* in_n, volatile __global uint* vstamp,
+                             __global uint* dlist, __global uint* dn, __global uchar* state,
+                             __global const int* vaff, TCC_TEST_PARAMS, double eps_r, double eps_f,
+                             __global const uchar* tdead) {
+  if (state[e] != TCC_UNDECIDED) return; /* OUT by match_apply: an end point was taken */
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  int f = blocker[e];
+  int wait = f >= 0 && state[f] == TCC_UNDECIDED;
+  if (!wait) {
+    /* the blocker: the last, in priority order, of the slots over N(a) and N(b) holding an edge
+     * before e (when it decides, more of the others have: fewer scans than with the first);
+     * and whether a taken edge changed the star (vaff of a vertex of N(a) U N(b): its
+     * star changed) */
+    f = -1;
+    int touched = 0;
+    for (int s = 0; s < 2; ++s) {
+      int x = s == 0 ? a : b;
+      for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) {
+        const int z = nb[j], g = slot[z];
+        touched |= vaff[z] >= 0;
+        if (g >= 0 && g != e && tcc_before(prio, g, e) && (f < 0 || tcc_before(prio, f, g))) f = g;
+      }
+    }
+    blocker[e] = f;
+    wait = f >= 0;
+    /* the tests when e's turn has come; a waiting edge's early volume test, once (refused on the
+     * mesh as it is now: OUT) */
+    const int full = !wait;
+    if (full || !spec[e]) {
+      spec[e] = 1;
+      int dir;
+      const uchar r = tcc_match_test(e, a, b, touched, full, &dir, TCC_TEST_ARGS, eps_r, eps_f, tdead);
+      if (r == TCC_OK && full) {
+        reason[e] = TCC_OK;
+        edge_dir[e] = (uchar)dir;
+        state[e] = TCC_IN;
+        dround[e] = round;
+        atomic_inc(&counters[1]);
+        inlist[atomic_inc(in_n)] = (uint)e;
+        return;
+      }
+      if (r != TCC_OK) { /* refused: a and b need their next edge */
+        reason[e] = r;
+        state[e] = TCC_OUT;
+        tcc_greedy_list_vertex(a, vstamp, round, dlist, dn);
+        tcc_greedy_list_vertex(b, vstamp, round, dlist, dn);
+        return;
+      }
+    }
+  }
+  if (atomic_xchg(queued + e, round + 1) != round + 1) tnext[atomic_inc(tn)] = (uint)e;
+}
+
+__kernel void match_decide(uint n, uint cur, __global const uint* tlist, __global uint* tnext, __global uint* cnt,
+                           __global const int* edges, __global const double* prio, __global const int* slot,
+                           __global int* blocker, __global uchar* spec, __global uint* dround,
+                           volatile __global uint* queued, uint round,
+                           __global uint* inlist, volatile __global uint* vstamp, __global uint* dlist,
+                           __global uchar* state, __global int* vaff, TCC_MATCH_PARAMS) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+#ifdef TCC_PREFETCH_OK
+  tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets);
+#endif
+  tcc_match_decide((int)tlist[i], edges, prio, slot, blocker, spec, dround, tnext, cnt + (1 - cur), queued, round, inlist,
+                   cnt + 4, vstamp, dlist, cnt + 2, state, vaff, TCC_MATCH_ARGS);
+}
+
+/* Removed tet d = (x, y, c, d') of the collapse of y onto x: the tet X across its face opposite y
+ * (holding x) and the tet Y across its face opposite x (holding y) become neighbours, as
+ * tet_nbr_update glues them through a compaction (collapse_update.cl); a boundary on one side
+ * (-1, or -2: several tets, invalid input) becomes the other's. */
+inline void tcc_glue_across(int d, int x, int y, __global const int* tets, __global int* tet_nbr) {
+  int X = tet_nbr[4 * d + tcc_local(tets, d, y)], Y = tet_nbr[4 * d + tcc_local(tets, d, x)];
+  for (int k = 0; X >= 0 && k < 4; ++k)
+    if (tet_nbr[4 * X + k] == d) {
+      tet_nbr[4 * X + k] = Y;
+      break;
+    }
+  for (int k = 0; Y >= 0 && k < 4; ++k)
+    if (tet_nbr[4 * Y + k] == d) {
+      tet_nbr[4 * Y + k] = X;
+      break;
+    }
+}
+
+/* The collapse of the taken edge e, in place (see the top), then the other candidates at its
+ * end points OUT. Its star is disjoint from those of the other edges taken in the round. */
+inline void tcc_match_apply(int e, __global const int* edges, __global const int* slot, volatile __global uint* vstamp,
+                            uint round, __global uint* dlist, __global uint* dn, __global uchar* state,
+                            __global int* vaff, __global int* tkill, TCC_MATCH_PARAMS) {
+  const int v0 = edges[2 * e], v1 = edges[2 * e + 1];
+  const uint d = edge_dir[e];
+  const int y = (d & TCC_DIR_REMOVE_V1) ? v1 : v0, x = (d & TCC_DIR_REMOVE_V1) ? v0 : v1;
+  const double3 p = tcc_placement(pts, vfield, vfield_stride, v0, v1, d);
+  tcc_survivor_fields(x, v0, v1, d, p, pts, vfield_stride, vfield, vfield, (uint)x);
+  vstore3(p, x, pts);
+  vaff[v0] = e;
+  vaff[v1] = e;
+  for (uint i = vt_off[x]; i < vt_off[x + 1]; ++i) { /* the tets of the edge go */
+    int t = vt[i];
+    if (tdead[t] || !tcc_has(tets, t, y)) continue;
+    tdead[t] = 1;
+    tkill[t] = e;
+    tcc_glue_across(t, x, y, tets, tet_nbr);
+  }
+  for (uint i = vt_off[y]; i < vt_off[y + 1]; ++i) { /* y's other tets are x's */
+    int t = vt[i];
+    if (tdead[t]) continue;
+    for (int k = 0; k < 4; ++k)
+      if (tets[4 * t + k] == y) tets[4 * t + k] = x;
+  }
+  for (int s = 0; s < 2; ++s) {
+    int z = s == 0 ? v0 : v1;
+    tcc_greedy_list_vertex(z, vstamp, round, dlist, dn); /* its slot was e */
+    for (uint j = nb_off[z]; j < nb_off[z + 1]; ++j) {
+      int g = nb_edge[j];
+      if (g == e || state[g] != TCC_UNDECIDED) continue;
+      state[g] = TCC_OUT; /* two taken edges may both do this: the same write */
+      int u = nb[j];
+      if (slot[u] == g) tcc_greedy_list_vertex(u, vstamp, round, dlist, dn);
+    }
+  }
+}
+
+__kernel void match_apply(__global const uint* inlist, __global uint* cnt, __global const int* edges,
+                          __global const int* slot, volatile __global uint* vstamp, uint round, __global uint* dlist,
+                          __global uchar* state, __global int* vaff, __global int* tkill, TCC_MATCH_PARAMS) {
+  uint i = get_global_id(0);
+  if (i >= cnt[4]) return;
+  tcc_match_apply((int)inlist[i], edges, slot, vstamp, round, dlist, cnt + 2, state, vaff, tkill, TCC_MATCH_ARGS);
+}
+
+/* The remaining rounds in one work-group, once the turn list is short (as greedy_loop). */
+__kernel void match_loop(uint n, int cur, uint round, __global uint* t0, __global uint* t1, __global uint* cnt,
+                         __global const int* edges, __global const double* prio, __global int* slot,
+                         __global int* blocker, __global uchar* spec, __global uint* dround,
+                         volatile __global uint* queued, __global uint* inlist, volatile __global uint* vstamp, __global uint* dlist,
+                         __global uchar* state, __global int* vaff, __global int* tkill, uint max_n,
+                         __global uint* resume, TCC_MATCH_PARAMS) {
+  const uint lid = get_local_id(0), ls = get_local_size(0);
+  while (n > 0) {
+    __global uint* tl = cur ? t1 : t0;
+    __global uint* tnext = cur ? t0 : t1;
+    __global uint* cnext = cnt + (1 - cur);
+    for (uint i = lid; i < n; i += ls)
+      tcc_match_decide((int)tl[i], edges, prio, slot, blocker, spec, dround, tnext, cnext, queued, round, inlist, cnt + 4,
+                       vstamp, dlist, cnt + 2, state, vaff, TCC_MATCH_ARGS);
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    const uint nin = cnt[4];
+    for (uint i = lid; i < nin; i += ls)
+      tcc_match_apply((int)inlist[i], edges, slot, vstamp, round, dlist, cnt + 2, state, vaff, tkill, TCC_MATCH_ARGS);
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    tcc_p1_vertex_part(cnt[2], dlist, nb_off, nb_edge, state, prio, slot, edges, tnext, cnext, queued, round, verdict,
+                       cnt + 3);
+    n = *cnext;
+    barrier(CLK_GLOBAL_MEM_FENCE);
+    cur = 1 - cur;
+    ++round;
+    if (n > max_n) { /* the same value in every work item: a uniform exit */
+      if (lid == 0) {
+        resume[0] = n;
+        resume[1] = (uint)cur;
+        resume[2] = round;
+      }
+      return;
+    }
+    if (lid == 0) cnt[0] = cnt[1] = cnt[2] = cnt[3] = cnt[4] = 0;
+    barrier(CLK_GLOBAL_MEM_FENCE);
+  }
+}
+
+/* --- Collapses the surface guard refuses (SurfaceGuard::run_applied) are undone, with every
+ * taken collapse whose tests saw one of them: the taken ones of a later round within reach of
+ * one undone, and so on (match_undo_reach, match_undo_grow; W1: 10 refused, 143 undone, of
+ * 18,711). The others keep their collapses: each saw only collapses that stay. Undone in the
+ * reverse order of their rounds (the host sorts them), each the inverse of match_apply; the
+ * guard then tests the result again. --- */
+
+/* reachmin[v]: the first round of the listed collapses with v in N[a] U N[b]. */
+__kernel void match_undo_reach(uint n, __global const uint* list, __global const int* edges, __global const uint* nb_off,
+                               __global const int* nb, __global const uint* dround, volatile __global uint* reachmin) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  int d = (int)list[i];
+  uint r = dround[d];
+  for (int s = 0; s < 2; ++s) {
+    int x = edges[2 * d + s];
+    atomic_min(reachmin + x, r);
+    for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) atomic_min(reachmin + nb[j], r);
+  }
+}
+
+/* The taken collapses (taken[0 .. n)) not undone yet with an end point reached in an earlier
+ * round: undone too (listed). */
+__kernel void match_undo_grow(uint n, __global const uint* taken, __global const int* edges,
+                              __global const uint* dround, __global const uint* reachmin, __global uchar* undo,
+                              __global uint* list, __global uint* count) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  int h = (int)taken[i];
+  if (undo[h]) return;
+  uint r = dround[h];
+  if (reachmin[edges[2 * h]] < r || reachmin[edges[2 * h + 1]] < r) {
+    undo[h] = 1;
+    list[atomic_inc(count)] = (uint)h;
+  }
+}
+
+/* Removed tet d back: its neighbours across its faces point to it again (each at its face
+ * shared with d: the one opposite its vertex that d does not hold). */
+inline void tcc_unglue(int d, __global const int* tets, __global int* tet_nbr) {
+  for (int f = 0; f < 4; ++f) {
+    int m = tet_nbr[4 * d + f];
+    if (m < 0) continue;
+    for (int k = 0; k < 4; ++k)
+      if (!tcc_has(tets, d, tets[4 * m + k])) {
+        tet_nbr[4 * m + k] = d;
+        break;
+      }
+  }
+}
+
+/* The n collapses of order[] undone one after another (one work item: they are few, and in the
+ * order given, the reverse of their rounds). refused[g]: by the guard (its reason
+ * TCC_REFUSED_SURFACE) or undone with one (TCC_UNTESTED). */
+__kernel void match_undo(uint n, __global const uint* order, __global const uchar* refused, __global const int* edges,
+                         __global const uchar* edge_dir, __global int* tets, __global const uint* vt_off,
+                         __global const int* vt, __global int* tet_nbr, __global uchar* tdead, __global int* tkill,
+                         __global double* pts, __global double* vfield, uint vfield_stride,
+                         __global const double* pts0, __global const double* vfield0, __global int* vaff,
+                         __global uchar* state, __global uint* fin, __global uchar* reason) {
+  if (get_global_id(0) != 0) return;
+  for (uint i = 0; i < n; ++i) {
+    const int g = (int)order[i];
+    const int v0 = edges[2 * g], v1 = edges[2 * g + 1];
+    const uint d = edge_dir[g];
+    const int y = (d & TCC_DIR_REMOVE_V1) ? v1 : v0, x = (d & TCC_DIR_REMOVE_V1) ? v0 : v1;
+    for (uint k = vt_off[y]; k < vt_off[y + 1]; ++k) { /* y's tets that are left: y again */
+      int t = vt[k];
+      if (tdead[t]) continue;
+      for (int j = 0; j < 4; ++j)
+        if (tets[4 * t + j] == x) tets[4 * t + j] = y;
+    }
+    for (uint k = vt_off[x]; k < vt_off[x + 1]; ++k) { /* the tets g removed */
+      int t = vt[k];
+      if (!tdead[t] || tkill[t] != g) continue;
+      tdead[t] = 0;
+      tkill[t] = -1;
+      tcc_unglue(t, tets, tet_nbr);
+    }
+    for (int c = 0; c < 3; ++c) pts[3 * x + c] = pts0[3 * x + c];
+    for (uint c = 0; c < vfield_stride; ++c) vfield[(size_t)x * vfield_stride + c] = vfield0[(size_t)x * vfield_stride + c];
+    vaff[v0] = -1;
+    vaff[v1] = -1;
+    state[g] = TCC_OUT;
+    fin[g] = 0u;
+    reason[g] = refused[g] ? TCC_REFUSED_SURFACE : TCC_UNTESTED;
+  }
+}

@@ -1,0 +1,444 @@
+/* The link and volume tests of an edge collapse and the helpers of the selections' rounds, shared
+ * by the selections of cl/collapse_admissible.cl (the lazy filter, the greedy selection) and
+ * cl/collapse_matching.cl (the matching selection). The checks are described at the top of
+ * cl/collapse_admissible.cl. */
+#ifndef TETCOLLAPSE_COLLAPSE_SELECT_H
+#define TETCOLLAPSE_COLLAPSE_SELECT_H
+
+#include "collapse_common.h"
+
+/* The mesh a test reads. Every selection but the matching one tests edges on the mesh of the
+ * iteration's start (the connectivity as built). The matching selection (collapse_matching.cl)
+ * applies its collapses as it takes them: tets are renamed in place, the tets a collapse removes
+ * are flagged in tdead[] and tet_nbr is glued across them, and a survivor moves in pts[]. A
+ * test of an edge whose star such a collapse changed runs "live" (live = 1): ring(a) and
+ * ring(b), which gained no tet (a and b are no end point of a collapse taken), are read without
+ * their removed tets, and what the connectivity gives of the star (N(a), N(b), the S-edges,
+ * the S flags and classes of a and b, the tets' qualities) is computed from the rings, tet_nbr
+ * and the labels as they are now. With live = 0 (a constant at every call site, so the compiler
+ * drops the live code) tdead is not read. */
+#define TCC_DEAD(t) (live && tdead[t])
+#define TCC_NO_DEAD ((__global const uchar*)0) /* tdead of the tests that are never live */
+
+#ifndef TCC_MAX_LINK
+#define TCC_MAX_LINK 96
+#endif
+/* Tets per chunk of the volume loop: on CPU devices (TCC_PREFETCH) many, so that the gathers
+ * overlap; elsewhere few (private arrays indexed at run time cost GPUs scratch memory). */
+#ifdef TCC_PREFETCH
+#define TCC_VOL_CHUNK 32
+#else
+#define TCC_VOL_CHUNK 4
+#endif
+
+inline int tcc_in(const int* list, int n, int x) {
+  for (int i = 0; i < n; ++i)
+    if (list[i] == x) return 1;
+  return 0;
+}
+
+/* x in v[0..8) (pads of -1 never match a vertex): eight compares, no branch. The link test's
+ * small sets are kept so when they fit: a lookup by loop exits at a data-dependent place, and
+ * those mispredicted exits were about a third of a passing test on W1 (bench_admissible). */
+#define TCC_ANY8(v, x)                                                                                     \
+  (((x) == (v)[0]) | ((x) == (v)[1]) | ((x) == (v)[2]) | ((x) == (v)[3]) | ((x) == (v)[4]) | ((x) == (v)[5]) | \
+   ((x) == (v)[6]) | ((x) == (v)[7]))
+
+/* Does some tet of ring(x) contain y and z (and w when w >= 0)? */
+inline int tcc_ring_has(__global const int* tets, __global const uint* vt_off, __global const int* vt, int x, int y,
+                        int z, int w, int live, __global const uchar* tdead) {
+  for (uint i = vt_off[x]; i < vt_off[x + 1]; ++i) {
+    int t = vt[i];
+    if (TCC_DEAD(t)) continue;
+    if (tcc_has(tets, t, y) && tcc_has(tets, t, z) && (w < 0 || tcc_has(tets, t, w))) return 1;
+  }
+  return 0;
+}
+
+/* Predicate Q (tcc_predicate_q): shared with the sequential CPU method. */
+#include "collapse_predicate.h"
+
+/* The volume test (and the quality guard) of the edge (a, b), a < b, which passed Q with the
+ * direction bits dir: TCC_OK, TCC_REFUSED_VOLUME or TCC_REFUSED_QUALITY. Live (see the top):
+ * without the removed tets, and the qualities before computed here (tet_quality holds those of
+ * the iteration's start). */
+inline uchar tcc_volume_test(int a, int b, int dir, __global const int* tets, __global const uint* vt_off,
+                             __global const int* vt, __global const double* pts, __global const double* vfield,
+                             uint vfield_stride, double eps_v, double q_min, __global const double* tet_quality,
+                             int live, __global const uchar* tdead) {
+  /* --- volumes after the tentative collapse (first: cheaper, and it refuses more edges) --- */
+  double3 p = tcc_placement(pts, vfield, vfield_stride, a, b, (uint)dir);
+#ifdef TCC_USER_PLACEMENT
+  /* a user placement may be no point at all (inf, nan: e.g. a division by a zero field
+   * difference) */
+  if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z)) return TCC_REFUSED_VOLUME;
+#endif
+  double3 pa = tc_point(pts, a), pb = tc_point(pts, b);
+  /* Quality guard (q_min > 0): the worst mean ratio among the tets that change shape may not
+   * fall below min(its value before the collapse, q_min): a collapse never makes a good
+   * neighbourhood bad, nor a bad one worse. */
+  double q_old = 1.0, q_new = 1.0;
+  for (int side = 0; side < 2; ++side) {
+    int x = side == 0 ? a : b, y = side == 0 ? b : a;
+    double3 px = side == 0 ? pa : pb;
+    if (px.x == p.x && px.y == p.y && px.z == p.z) continue; /* x does not move: its tets keep their shape */
+    /* In chunks, two loops: first the vertices of the tets (independent loads, so that the
+     * processor has many cache misses in flight; branch-free), then their volumes. One loop
+     * doing both waited for each tet's vertices in turn: about half of the test's time. */
+    for (uint i0 = vt_off[x], iend = vt_off[x + 1]; i0 < iend; i0 += TCC_VOL_CHUNK) {
+      int4 qs[TCC_VOL_CHUNK];
+      int ts[TCC_VOL_CHUNK];
+      uint m = 0, i1 = iend - i0 < TCC_VOL_CHUNK ? iend : i0 + TCC_VOL_CHUNK;
+      for (uint i = i0; i < i1; ++i) {
+        int t = vt[i];
+        int4 q = vload4(t, tets);
+        qs[m] = q;
+        ts[m] = t;
+        m += (any(q == (int4)(y)) | TCC_DEAD(t)) ? 0u : 1u; /* else removed by this collapse or an earlier one */
+      }
+      for (uint j = 0; j < m; ++j) {
+        int4 q = qs[j];
+        double3 c[4];
+        c[0] = q.x == x ? p : tc_point(pts, q.x);
+        c[1] = q.y == x ? p : tc_point(pts, q.y);
+        c[2] = q.z == x ? p : tc_point(pts, q.z);
+        c[3] = q.w == x ? p : tc_point(pts, q.w);
+        double vol = tc_tet_volume(c[0], c[1], c[2], c[3]);
+        if (!(vol >= eps_v)) return TCC_REFUSED_VOLUME;
+#ifdef TCC_USER_PLACEMENT
+        if (!(vol < INFINITY)) return TCC_REFUSED_VOLUME; /* a finite placement far enough overflows */
+#endif
+        if (q_min > 0.0) {
+          double qn = tc_tet_quality_v(c[0], c[1], c[2], c[3], vol);
+          /* tc_tet_quality of the tet now (the tet_quality kernel's at the iteration's start) */
+          double qo = live ? tc_tet_quality(q.x == x ? px : c[0], q.y == x ? px : c[1], q.z == x ? px : c[2],
+                                            q.w == x ? px : c[3])
+                           : tet_quality[ts[j]];
+          q_new = qn < q_new ? qn : q_new;
+          q_old = qo < q_old ? qo : q_old;
+        }
+      }
+    }
+  }
+  if (q_min > 0.0 && q_new < (q_old < q_min ? q_old : q_min)) return TCC_REFUSED_QUALITY;
+  return TCC_OK;
+}
+
+/* Live (see the top): the S kind of the edge (x, c) (0 when it is no S-edge), from the faces
+ * through it of the tets of ring(x). */
+inline uint tcc_live_sedge(int x, int c, __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                           __global const int* tet_nbr, __global const int* labels, int use_labels,
+                           __global const uchar* tdead) {
+  uint flags = 0;
+  for (uint i = vt_off[x]; i < vt_off[x + 1]; ++i) {
+    int t = vt[i];
+    if (tdead[t]) continue;
+    int lc = tcc_local(tets, t, c);
+    if (lc < 0) continue;
+    int lx = tcc_local(tets, t, x);
+    for (int f = 0; f < 4; ++f) {
+      if (f == lx || f == lc) continue; /* the two faces through x and c */
+      uint on_s;
+      tcc_owned_sface(tet_nbr, labels, use_labels, t, f, &on_s);
+      flags |= on_s;
+    }
+  }
+  return flags;
+}
+
+/* Live: N(a) n N(b) from the tets of the rings into cn (at most TCC_MAX_LINK); returns its size,
+ * or -1 when a list does not fit. */
+inline int tcc_live_common(int a, int b, __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                           __global const uchar* tdead, int* cn) {
+  int na[TCC_MAX_LINK], nna = 0, ncn = 0;
+  for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
+    int t = vt[i];
+    if (tdead[t]) continue;
+    __global const int* q = tets + 4 * t;
+    for (int k = 0; k < 4; ++k) {
+      int v = q[k];
+      if (v == a || tcc_in(na, nna, v)) continue;
+      if (nna == TCC_MAX_LINK) return -1;
+      na[nna++] = v;
+    }
+  }
+  for (uint i = vt_off[b]; i < vt_off[b + 1]; ++i) {
+    int t = vt[i];
+    if (tdead[t]) continue;
+    __global const int* q = tets + 4 * t;
+    for (int k = 0; k < 4; ++k) {
+      int v = q[k]; /* a is not in na */
+      if (v == b || !tcc_in(na, nna, v) || tcc_in(cn, ncn, v)) continue;
+      if (ncn == TCC_MAX_LINK) return -1;
+      cn[ncn++] = v;
+    }
+  }
+  return ncn;
+}
+
+/* The link condition of the edge (a, b), a < b: TCC_OK or TCC_REFUSED_LINK. Live (see the top):
+ * N(a), N(b) and the S-edges from the rings; an edge that no tet holds any more is refused. */
+inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global const int* tets,
+                           __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
+                           __global const uint* nb_off, __global const int* nb, __global const int* nb_edge,
+                           __global const int* labels, int use_labels, __global const uchar* vflags,
+                           __global const uchar* eflags, int live, __global const uchar* tdead) {
+  /* --- link condition --- */
+  /* cn: the common neighbours of a and b, with the edges (a, cn[k]) and (b, cn[k]) (one more
+   * slot: the merge writes at ncn before it knows whether it keeps the entry); (pc, pd): the
+   * edges of lk(ab), one per tet of the edge */
+  int cn[TCC_MAX_LINK + 1], cea[TCC_MAX_LINK + 1], ceb[TCC_MAX_LINK + 1], pc[TCC_MAX_LINK], pd[TCC_MAX_LINK];
+  int ncn = 0, np = 0;
+  if (live) {
+    ncn = tcc_live_common(a, b, tets, vt_off, vt, tdead, cn);
+    if (ncn < 0) return TCC_REFUSED_LINK;
+  } else {
+    /* a merge of the sorted N(a) and N(b) without branches on their values */
+    uint i = nb_off[a], ie = nb_off[a + 1], j = nb_off[b], je = nb_off[b + 1];
+    while (i < ie && j < je) {
+      const int x = nb[i], y = nb[j];
+      if (x == y && ncn == TCC_MAX_LINK) return TCC_REFUSED_LINK;
+      cn[ncn] = x; /* ncn <= TCC_MAX_LINK here */
+      cea[ncn] = nb_edge[i]; /* the edges (a, x) and (b, x) when x == y */
+      ceb[ncn] = nb_edge[j];
+      ncn += x == y;
+      i += x <= y;
+      j += y <= x;
+    }
+  }
+  for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
+    int t = vt[i];
+    if (TCC_DEAD(t) || !tcc_has(tets, t, b)) continue;
+    if (np == TCC_MAX_LINK) return TCC_REFUSED_LINK;
+    __global const int* q = tets + 4 * t;
+    int o[2], no = 0;
+    for (int k = 0; k < 4; ++k)
+      if (q[k] != a && q[k] != b) o[no++] = q[k];
+    pc[np] = o[0];
+    pd[np] = o[1];
+    ++np;
+  }
+  if (live && np == 0) return TCC_REFUSED_LINK; /* earlier collapses removed every tet of the edge */
+  /* cn, pc and pd padded to 8 when they fit (the usual case), for TCC_ANY8 */
+  const int small = ncn <= 8 && np <= 8;
+  int c8[8], p8[8], d8[8];
+  for (int k = 0; k < 8; ++k) {
+    c8[k] = k < ncn ? cn[k] : -1;
+    p8[k] = k < np ? pc[k] : -1;
+    d8[k] = k < np ? pd[k] : -1;
+  }
+#define TCC_IN_CN(x) (small ? TCC_ANY8(c8, x) : tcc_in(cn, ncn, (x)))
+  int ok = 1;
+  const uint smask = TCC_BOUNDARY | TCC_INTERFACE;
+  /* (iii) with w, inside the tets (a,b,c,d) of the edge: no S-faces (a,c,d) and (b,c,d) (the
+   * triangle (c,d,w) would be in lk(a) and lk(b) but not in lk(ab); e.g. a lone tet, which the
+   * collapse would flatten away). An S-face has S vertices only. */
+  if ((fa & smask) && (fb & smask))
+    for (uint i = vt_off[a]; i < vt_off[a + 1] && ok; ++i) {
+      int t = vt[i];
+      int la = tcc_local(tets, t, a), lb = tcc_local(tets, t, b);
+      if (lb < 0 || TCC_DEAD(t)) continue;
+      int xa = tet_nbr[4 * t + lb], xb = tet_nbr[4 * t + la]; /* across (a,c,d) and (b,c,d) */
+      int acd = xa < 0 || (use_labels && labels[t] != labels[xa]);
+      int bcd = xb < 0 || (use_labels && labels[t] != labels[xb]);
+      if (acd && bcd) ok = 0;
+    }
+  /* (i) vertices, and w */
+  if (small) {
+    for (int k = 0; k < 8; ++k) ok &= (c8[k] < 0) | TCC_ANY8(p8, c8[k]) | TCC_ANY8(d8, c8[k]);
+  } else {
+    for (int k = 0; k < ncn && ok; ++k)
+      if (!tcc_in(pc, np, cn[k]) && !tcc_in(pd, np, cn[k])) ok = 0;
+  }
+  if (ok && !tcc_w_join_ok(fa, fb, fe)) ok = 0;
+  /* (ii) with w: S-edges (a,c) and (b,c) need the S-face (a,b,c), of the kinds they share
+   * (tcc_w_join_ok); an S-edge has both end points on S, so only when a and b are */
+  if ((fa & smask) && (fb & smask))
+    for (int k = 0; k < ncn && ok; ++k) {
+      int c = cn[k];
+      uint fac, fbc;
+      if (live) {
+        fac = tcc_live_sedge(a, c, tets, vt_off, vt, tet_nbr, labels, use_labels, tdead);
+        fbc = tcc_live_sedge(b, c, tets, vt_off, vt, tet_nbr, labels, use_labels, tdead);
+      } else {
+        if (!(vflags[c] & smask)) continue;
+        fac = eflags[cea[k]];
+        fbc = eflags[ceb[k]];
+      }
+      if ((fac & smask) && (fbc & smask) &&
+          !tcc_w_join_ok(fac, fbc, tcc_triangle_kind(tets, vt_off, vt, labels, use_labels, a, b, c, live, tdead)))
+        ok = 0;
+    }
+  /* (ii) triangles and (iii) tets and S-faces, from the tets of ring(a) without b */
+  for (uint i = vt_off[a]; i < vt_off[a + 1] && ok; ++i) {
+    int t = vt[i];
+    const int4 q4 = vload4(t, tets);
+    if ((q4.x == b) | (q4.y == b) | (q4.z == b) | (q4.w == b) || TCC_DEAD(t)) continue;
+    __global const int* q = tets + 4 * t;
+    /* the three vertices other than a, in the tet's order, without branches */
+    const int la = q4.x == a ? 0 : q4.y == a ? 1 : q4.z == a ? 2 : 3;
+    const int o[3] = {la == 0 ? q4.y : q4.x, la <= 1 ? q4.z : q4.y, la <= 2 ? q4.w : q4.z};
+    const int in0 = TCC_IN_CN(o[0]), in1 = TCC_IN_CN(o[1]), in2 = TCC_IN_CN(o[2]);
+    if (in0 + in1 + in2 < 2) continue; /* most tets: nothing below applies (no pair in cn) */
+    if (in0 && in1 && in2 && tcc_ring_has(tets, vt_off, vt, b, o[0], o[1], o[2], live, tdead)) {
+      ok = 0; /* tets (a,c,d,e) and (b,c,d,e) */
+      break;
+    }
+    const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+    const int inside[3] = {in0, in1, in2};
+    for (int k = 0; k < 3 && ok; ++k) {
+      if (!inside[pairs[k][0]] || !inside[pairs[k][1]]) continue;
+      int c = o[pairs[k][0]], d = o[pairs[k][1]];
+      int in_lk = 0;
+      if (small)
+        for (int m = 0; m < 8; ++m) in_lk |= (p8[m] == c & d8[m] == d) | (p8[m] == d & d8[m] == c);
+      else
+        for (int m = 0; m < np; ++m)
+          if ((pc[m] == c && pd[m] == d) || (pc[m] == d && pd[m] == c)) in_lk = 1;
+      if (!in_lk) {
+        /* (ii) triangles (a,c,d) and (b,c,d) need the tet (a,b,c,d) */
+        if (tcc_ring_has(tets, vt_off, vt, b, c, d, -1, live, tdead)) ok = 0;
+        continue;
+      }
+      /* (c,d) in lk(ab): (b,c,d) is a face of the tet (a,b,c,d). (iii) no S-faces (a,c,d) and
+       * (b,c,d); an S-face has S vertices only. (a,c,d) is the face of t opposite its fourth
+       * vertex: S when no tet or several are across it, or a tet of another label. */
+      if (!(fa & smask) || !(fb & smask)) continue;
+      int z = 0;
+      while (q[z] == a || q[z] == c || q[z] == d) ++z;
+      int across = tet_nbr[4 * t + z];
+      int acd_on_s = across < 0 || (use_labels && labels[t] != labels[across]);
+      if (acd_on_s && tcc_triangle_kind(tets, vt_off, vt, labels, use_labels, b, c, d, live, tdead)) ok = 0;
+    }
+  }
+#undef TCC_IN_CN
+  return ok ? TCC_OK : TCC_REFUSED_LINK;
+}
+
+/* The volume test, then the link condition (tcc_volume_test, tcc_link_test); returns TCC_OK or
+ * the first refusal. */
+inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int dir, __global const int* tets,
+                                 __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
+                                 __global const uint* nb_off,
+                                 __global const int* nb, __global const int* nb_edge, __global const int* labels,
+                                 int use_labels, __global const double* pts, __global const double* vfield,
+                                 uint vfield_stride, __global const uchar* vflags, __global const uchar* eflags,
+                                 double eps_v, double q_min, __global const double* tet_quality) {
+  uchar r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tet_quality, 0,
+                            TCC_NO_DEAD);
+  if (r != TCC_OK) return r;
+  return tcc_link_test(a, b, fa, fb, fe, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, vflags,
+                       eflags, 0, TCC_NO_DEAD);
+}
+
+/* The arguments of the lazy filter's test (tcc_lazy_decide), passed down unchanged by the
+ * kernels that decide turns: mesh, connectivity, flags, mode, thresholds, and the outputs. */
+#define TCC_TEST_PARAMS                                                                                     \
+  __global const int *tets, __global const uint *vt_off, __global const int *vt, __global const int *tet_nbr, \
+      __global const uint *nb_off, __global const int *nb, __global const int *nb_edge,                       \
+      __global const int *labels, int use_labels, __global const double *pts, __global const double *vfield,  \
+      uint vfield_stride, __global const uchar *vflags, __global const uchar *vclass,                         \
+      __global const uchar *eflags, int mode, int paper_rule, double eps_v,                                   \
+      double q_min, __global const double *tet_quality, __global uchar *edge_dir, __global uchar *reason,     \
+      __global uint *counters, __global uchar *verdict
+#define TCC_TEST_ARGS                                                                                       \
+  tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vfield, vfield_stride, vflags,     \
+      vclass, eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict
+
+/* Q's direction bits of the candidate e = (a, b), with the user's placement (tcc_user_dir). */
+inline int tcc_lazy_dir(int e, int a, int b, TCC_TEST_PARAMS) {
+  uint fa = vflags[a], fb = vflags[b];
+  return tcc_user_dir(tcc_predicate_q(a, b, fa, fb, eflags[e], vclass[a], vclass[b], mode, paper_rule), fa, fb, mode);
+}
+
+/* The volume test alone (the cheaper part, and the one that refuses most edges) of e = (a, b)
+ * in direction dir, unless a verdict is kept (carried from an earlier iteration: the rings of
+ * a and b are unchanged since): a new test is counted in counters[4] and kept in verdict[],
+ * as TCC_VOLUME_OK when it passes (the link condition is then still to run). Returns whether
+ * the edge is not refused. */
+inline int tcc_lazy_volume(int e, int a, int b, int dir, TCC_TEST_PARAMS) {
+  uchar r = verdict[e];
+  if (r == TCC_VERDICT_UNKNOWN) {
+    r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tet_quality, 0,
+                        TCC_NO_DEAD);
+    if (r == TCC_OK) r = TCC_VOLUME_OK;
+    verdict[e] = r;
+    atomic_inc(&counters[4]);
+  }
+  return r == TCC_OK || r == TCC_VOLUME_OK;
+}
+
+/* The verdict of the link and volume tests of e = (a, b) in direction dir: the volume test
+ * (tcc_lazy_volume), then the link condition where it passed, the result kept in verdict[]. */
+inline uchar tcc_lazy_verdict(int e, int a, int b, int dir, TCC_TEST_PARAMS) {
+  if (tcc_lazy_volume(e, a, b, dir, TCC_TEST_ARGS) && verdict[e] == TCC_VOLUME_OK)
+    verdict[e] = tcc_link_test(a, b, vflags[a], vflags[b], eflags[e], tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge,
+                               labels, use_labels, vflags, eflags, 0, TCC_NO_DEAD);
+  return verdict[e];
+}
+
+inline void tcc_p1_recompute(int v, __global const uint* nb_off, __global const int* nb_edge,
+                             __global const uchar* state, __global const double* cost, __global int* slot) {
+  int m = slot[v];
+  if (m >= 0 && state[m] == TCC_UNDECIDED) return; /* decisions only remove edges: still first */
+  m = -1;
+  for (uint j = nb_off[v]; j < nb_off[v + 1]; ++j) {
+    int g = nb_edge[j];
+    if (state[g] == TCC_UNDECIDED && (m < 0 || tcc_before(cost, g, m))) m = g;
+  }
+  slot[v] = m;
+}
+
+inline void tcc_p1_turn(int v, __global const int* edges, __global const int* slot, __global uint* tlist,
+                        __global uint* tn, volatile __global uint* queued, uint round, __global const uchar* verdict,
+                        __global uint* untested) {
+  int m = slot[v];
+  if (m < 0 || slot[edges[2 * m]] != m || slot[edges[2 * m + 1]] != m) return;
+  if (atomic_xchg(queued + m, round) == round) return; /* listed from its other end point */
+  tlist[atomic_inc(tn)] = (uint)m;
+  if (verdict[m] == TCC_VERDICT_UNKNOWN) atomic_inc(untested);
+}
+
+/* The vertex part of a round run in one work-group (lazy_p1_loop, greedy_loop): the slots of
+ * the nd listed vertices anew, then the edges now first at both end points to the next turn
+ * list; a barrier after each. */
+inline void tcc_p1_vertex_part(uint nd, __global const uint* dlist, __global const uint* nb_off,
+                               __global const int* nb_edge, __global const uchar* state,
+                               __global const double* order, __global int* slot, __global const int* edges,
+                               __global uint* tnext, __global uint* cnext, volatile __global uint* queued, uint round,
+                               __global const uchar* verdict, __global uint* untested) {
+  const uint lid = get_local_id(0), ls = get_local_size(0);
+  for (uint i = lid; i < nd; i += ls) tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, order, slot);
+  barrier(CLK_GLOBAL_MEM_FENCE);
+  for (uint i = lid; i < nd; i += ls)
+    tcc_p1_turn((int)dlist[i], edges, slot, tnext, cnext, queued, round + 1, verdict, untested);
+  barrier(CLK_GLOBAL_MEM_FENCE);
+}
+
+#ifdef TCC_PREFETCH_OK
+/* CPU devices (the host sets TCC_PREFETCH) run a work-group's items one after another: start the
+ * memory traffic of the next items' tests, whose first loop otherwise waits for each of its tets
+ * in turn (W1, lazy pass 1: the test's share of the CPU samples 23% -> 21%): three items ahead
+ * the rings' lists, two ahead the rings' tets. */
+inline void tcc_prefetch_test(uint i, uint n, __global const uint* tlist, __global const int* edges,
+                              __global const uint* vt_off, __global const int* vt, __global const int* tets) {
+  if (i + 3 < n) {
+    int e3 = (int)tlist[i + 3];
+    for (int s = 0; s < 2; ++s) __builtin_prefetch(vt + vt_off[edges[2 * e3 + s]]);
+  }
+  if (i + 2 < n) {
+    int e2 = (int)tlist[i + 2];
+    for (int s = 0; s < 2; ++s) {
+      int x = edges[2 * e2 + s];
+      for (uint k = vt_off[x]; k < vt_off[x + 1]; ++k) __builtin_prefetch(tets + 4 * vt[k]);
+    }
+  }
+}
+#endif
+
+inline void tcc_greedy_list_vertex(int v, volatile __global uint* vstamp, uint round, __global uint* dlist,
+                                   __global uint* dn) {
+  if (atomic_xchg(vstamp + v, round) != round) dlist[atomic_inc(dn)] = (uint)v;
+}
+
+#endif
