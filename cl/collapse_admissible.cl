@@ -234,7 +234,7 @@ __kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const 
 
 __kernel void lazy_p1_recompute(uint n, __global const uint* dlist, __global const uint* nb_off,
                                 __global const int* nb_edge, __global const uchar* state, __global const double* cost,
-                                __global int* slot) {
+                                __global int* slot, __global double* slotp, int with_slotp) {
   uint i = get_global_id(0);
   if (i >= n) return;
 #ifdef TCC_PREFETCH_OK
@@ -245,7 +245,7 @@ __kernel void lazy_p1_recompute(uint n, __global const uint* dlist, __global con
     for (uint j = nb_off[v1]; j < nb_off[v1 + 1]; ++j) __builtin_prefetch(cost + nb_edge[j]);
   }
 #endif
-  tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, cost, slot);
+  tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, cost, slot, with_slotp ? slotp : 0);
 }
 
 __kernel void lazy_p1_turns(uint n, __global const uint* dlist, __global const int* edges, __global const int* slot,
@@ -276,7 +276,7 @@ __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __glo
       tcc_p1_decide((int)tl[i], edges, state, vaff, slot, dlist, cnt + 2, TCC_TEST_ARGS);
     barrier(CLK_GLOBAL_MEM_FENCE);
     tcc_p1_vertex_part(cnt[2], dlist, nb_off, nb_edge, state, cost, slot, edges, tnext, cnext, queued, round, verdict,
-                       cnt + 3);
+                       cnt + 3, 0);
     n = *cnext;
     const uint untested = cnt[3];
     barrier(CLK_GLOBAL_MEM_FENCE);
@@ -464,7 +464,7 @@ __kernel void greedy_loop(uint n, int cur, uint round, __global uint* t0, __glob
       tcc_greedy_block((int)inlist[i], edges, nb_off, nb, nb_edge, slot, vstamp, round, dlist, cnt + 2, state);
     barrier(CLK_GLOBAL_MEM_FENCE);
     tcc_p1_vertex_part(cnt[2], dlist, nb_off, nb_edge, state, prio, slot, edges, tnext, cnext, queued, round, verdict,
-                       cnt + 3);
+                       cnt + 3, 0);
     n = *cnext;
     barrier(CLK_GLOBAL_MEM_FENCE);
     cur = 1 - cur;
@@ -480,6 +480,15 @@ __kernel void greedy_loop(uint n, int cur, uint round, __global uint* t0, __glob
     if (lid == 0) cnt[0] = cnt[1] = cnt[2] = cnt[3] = cnt[4] = 0;
     barrier(CLK_GLOBAL_MEM_FENCE);
   }
+}
+
+/* slotp[v] = the priority of slot[v] (INFINITY for none), after lazy_init's claims (the
+ * matching selection's scans, tcc_p1_recompute). */
+__kernel void slot_priority(uint nv, __global const int* slot, __global const double* prio, __global double* slotp) {
+  uint v = get_global_id(0);
+  if (v >= nv) return;
+  int m = slot[v];
+  slotp[v] = m >= 0 ? prio[m] : INFINITY;
 }
 
 /* After the greedy selection: p1 = fin = IN, counted in counters[2] and counters[3]. */

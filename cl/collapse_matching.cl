@@ -147,7 +147,8 @@ inline uchar tcc_match_test(int e, int a, int b, int live, int full, int* dir, T
 }
 
 inline void tcc_match_decide(int e, __global const int* edges, __global const double* prio,
-                             __global const int* slot, __global int* blocker, __global uchar* spec,
+                             __global const int* slot, __global const double* slotp, __global int* blocker,
+                             __global uchar* spec,
                              __global uint* dround,
                              __global uint* tnext, __global uint* tn, volatile __global uint* queued, uint round,
                              __global uint* inlist, __global uint* in_n, volatile __global uint* vstamp,
@@ -165,12 +166,21 @@ inline void tcc_match_decide(int e, __global const int* edges, __global const do
      * star changed) */
     f = -1;
     int touched = 0;
+    const double pe = prio[e];
+    double pf = 0.0;
     for (int s = 0; s < 2; ++s) {
       int x = s == 0 ? a : b;
       for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) {
-        const int z = nb[j], g = slot[z];
+        const int z = nb[j];
         touched |= vaff[z] >= 0;
-        if (g >= 0 && g != e && tcc_before(prio, g, e) && (f < 0 || tcc_before(prio, f, g))) f = g;
+        const double pz = slotp[z]; /* the slot's priority (slot_priority, tcc_p1_recompute) */
+        if (pz > pe) continue;     /* after e, or no slot (INFINITY) */
+        const int g = slot[z];
+        if (g == e || (pz == pe && g > e)) continue;
+        if (f < 0 || pf < pz || (pf == pz && f < g)) {
+          f = g;
+          pf = pz;
+        }
       }
     }
     blocker[e] = f;
@@ -205,7 +215,7 @@ inline void tcc_match_decide(int e, __global const int* edges, __global const do
 
 __kernel void match_decide(uint n, uint cur, __global const uint* tlist, __global uint* tnext, __global uint* cnt,
                            __global const int* edges, __global const double* prio, __global const int* slot,
-                           __global int* blocker, __global uchar* spec, __global uint* dround,
+                           __global const double* slotp, __global int* blocker, __global uchar* spec, __global uint* dround,
                            volatile __global uint* queued, uint round,
                            __global uint* inlist, volatile __global uint* vstamp, __global uint* dlist,
                            __global uchar* state, __global int* vaff, TCC_MATCH_PARAMS) {
@@ -214,7 +224,7 @@ __kernel void match_decide(uint n, uint cur, __global const uint* tlist, __globa
 #ifdef TCC_PREFETCH_OK
   tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets);
 #endif
-  tcc_match_decide((int)tlist[i], edges, prio, slot, blocker, spec, dround, tnext, cnt + (1 - cur), queued, round, inlist,
+  tcc_match_decide((int)tlist[i], edges, prio, slot, slotp, blocker, spec, dround, tnext, cnt + (1 - cur), queued, round, inlist,
                    cnt + 4, vstamp, dlist, cnt + 2, state, vaff, TCC_MATCH_ARGS);
 }
 
@@ -286,7 +296,7 @@ __kernel void match_apply(__global const uint* inlist, __global uint* cnt, __glo
 /* The remaining rounds in one work-group, once the turn list is short (as greedy_loop). */
 __kernel void match_loop(uint n, int cur, uint round, __global uint* t0, __global uint* t1, __global uint* cnt,
                          __global const int* edges, __global const double* prio, __global int* slot,
-                         __global int* blocker, __global uchar* spec, __global uint* dround,
+                         __global double* slotp, __global int* blocker, __global uchar* spec, __global uint* dround,
                          volatile __global uint* queued, __global uint* inlist, volatile __global uint* vstamp, __global uint* dlist,
                          __global uchar* state, __global int* vaff, __global int* tkill, uint max_n,
                          __global uint* resume, TCC_MATCH_PARAMS) {
@@ -296,7 +306,7 @@ __kernel void match_loop(uint n, int cur, uint round, __global uint* t0, __globa
     __global uint* tnext = cur ? t0 : t1;
     __global uint* cnext = cnt + (1 - cur);
     for (uint i = lid; i < n; i += ls)
-      tcc_match_decide((int)tl[i], edges, prio, slot, blocker, spec, dround, tnext, cnext, queued, round, inlist, cnt + 4,
+      tcc_match_decide((int)tl[i], edges, prio, slot, slotp, blocker, spec, dround, tnext, cnext, queued, round, inlist, cnt + 4,
                        vstamp, dlist, cnt + 2, state, vaff, TCC_MATCH_ARGS);
     barrier(CLK_GLOBAL_MEM_FENCE);
     const uint nin = cnt[4];
@@ -304,7 +314,7 @@ __kernel void match_loop(uint n, int cur, uint round, __global uint* t0, __globa
       tcc_match_apply((int)inlist[i], edges, slot, vstamp, round, dlist, cnt + 2, state, vaff, tkill, TCC_MATCH_ARGS);
     barrier(CLK_GLOBAL_MEM_FENCE);
     tcc_p1_vertex_part(cnt[2], dlist, nb_off, nb_edge, state, prio, slot, edges, tnext, cnext, queued, round, verdict,
-                       cnt + 3);
+                       cnt + 3, slotp);
     n = *cnext;
     barrier(CLK_GLOBAL_MEM_FENCE);
     cur = 1 - cur;

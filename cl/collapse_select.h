@@ -377,8 +377,11 @@ inline uchar tcc_lazy_verdict(int e, int a, int b, int dir, TCC_TEST_PARAMS) {
   return verdict[e];
 }
 
+/* slot[v] anew; with slotp (the matching selection), slotp[v] = the slot's priority (INFINITY for
+ * none), which its scans compare without loading the edge's. */
 inline void tcc_p1_recompute(int v, __global const uint* nb_off, __global const int* nb_edge,
-                             __global const uchar* state, __global const double* cost, __global int* slot) {
+                             __global const uchar* state, __global const double* cost, __global int* slot,
+                             __global double* slotp) {
   int m = slot[v];
   if (m >= 0 && state[m] == TCC_UNDECIDED) return; /* decisions only remove edges: still first */
   m = -1;
@@ -387,6 +390,7 @@ inline void tcc_p1_recompute(int v, __global const uint* nb_off, __global const 
     if (state[g] == TCC_UNDECIDED && (m < 0 || tcc_before(cost, g, m))) m = g;
   }
   slot[v] = m;
+  if (slotp) slotp[v] = m >= 0 ? cost[m] : INFINITY;
 }
 
 inline void tcc_p1_turn(int v, __global const int* edges, __global const int* slot, __global uint* tlist,
@@ -406,9 +410,9 @@ inline void tcc_p1_vertex_part(uint nd, __global const uint* dlist, __global con
                                __global const int* nb_edge, __global const uchar* state,
                                __global const double* order, __global int* slot, __global const int* edges,
                                __global uint* tnext, __global uint* cnext, volatile __global uint* queued, uint round,
-                               __global const uchar* verdict, __global uint* untested) {
+                               __global const uchar* verdict, __global uint* untested, __global double* slotp) {
   const uint lid = get_local_id(0), ls = get_local_size(0);
-  for (uint i = lid; i < nd; i += ls) tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, order, slot);
+  for (uint i = lid; i < nd; i += ls) tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, order, slot, slotp);
   barrier(CLK_GLOBAL_MEM_FENCE);
   for (uint i = lid; i < nd; i += ls)
     tcc_p1_turn((int)dlist[i], edges, slot, tnext, cnext, queued, round + 1, verdict, untested);

@@ -522,13 +522,14 @@ namespace {
 // decisions (cl/collapse_admissible.cl): the slots of the cnt[2] listed vertices (s.dlist) anew
 // in the order `order`, then the edges now first at both end points to turn list 1 - cur
 // (counted in s.work_n[1 - cur]; s.work_n[3]: those without a verdict). `recompute` and `turns`
-// are the kernels lazy_p1_recompute and lazy_p1_turns, made once by the caller.
+// are the kernels lazy_p1_recompute and lazy_p1_turns, made once by the caller. With slotp (the
+// matching selection) the slots' priorities are kept there too.
 void vertex_part(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kernel& recompute, cl::Kernel& turns,
-                 const DeviceBuffer<double>& order, int cur, cl_uint round) {
+                 const DeviceBuffer<double>& order, int cur, cl_uint round, DeviceBuffer<double>* slotp = nullptr) {
   uint32_t nd = 0;
   s.work_n.download(&nd, 1, 2);
   set_args(recompute, "lazy_p1_recompute", U(nd), B(s.dlist), B(c.nb_off), B(c.nb_edge), B(s.state), B(order),
-           B(s.slot[0]));
+           B(s.slot[0]), slotp ? B(*slotp) : B(order), cl_int(slotp ? 1 : 0));
   ctx.launch(recompute, nd, "lazy_p1_recompute");
   set_args(turns, "lazy_p1_turns", U(nd), B(s.dlist), B(c.edges), B(s.slot[0]), B(s.work[1 - cur]), B(s.work_n),
            cl_uint(1 - cur), B(s.queued), round + 1, B(s.verdict));
@@ -758,7 +759,7 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
     prio = &s.prio;
   }
   // the test's arguments (TCC_MATCH_PARAMS): the lazy filter's, then the live test's
-  constexpr cl_uint kDecide = 18, kApply = 10, kLoop = 21, kTestArgs = 24;
+  constexpr cl_uint kDecide = 19, kApply = 10, kLoop = 22, kTestArgs = 24;
   lazy_start(ctx, dm, c, s, p, *prio, {{&decide, kDecide}, {&apply, kApply}, {&loop, kLoop}});
   s.in_place = true;
   ensure(s.tdead, ctx, std::max<size_t>(dm.nt, 1));
@@ -785,6 +786,8 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
   s.work_n.fill(0);
   run(ctx, A, "lazy_p1_first_turns", c.ne, "", U(c.ne), B(s.cand), B(c.edges), B(s.slot[0]), B(s.work[0]), B(s.work_n),
       B(s.verdict));
+  ensure(s.slotp, ctx, dm.nv);
+  run(ctx, A, "slot_priority", dm.nv, "", U(dm.nv), B(s.slot[0]), B(*prio), B(s.slotp));
   uint32_t nt = 0;
   s.work_n.download(&nt, 1);
   cl::Kernel recompute = ctx.kernel(A, "lazy_p1_recompute"), turns = ctx.kernel(A, "lazy_p1_turns");
@@ -796,7 +799,8 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
     if (one_group) {
       s.resume.fill(0);
       set_args(loop, "match_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
-               B(*prio), B(s.slot[0]), B(s.blocker), B(s.spec), B(s.dround), B(s.queued), B(s.inlist), B(s.vstamp),
+               B(*prio), B(s.slot[0]), B(s.slotp), B(s.blocker), B(s.spec), B(s.dround), B(s.queued), B(s.inlist),
+               B(s.vstamp),
                B(s.dlist), B(s.state), B(s.vaff), B(s.tkill), U(p.greedy_loop_exit), B(s.resume));
       ctx.launch(loop, ctx.group_size_for(loop), "match_loop");
       uint32_t r[3];
@@ -806,13 +810,14 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
       round = r[2] - 1;
     } else {
       set_args_from(decide, 0, "match_decide", U(nt), cl_uint(cur), B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n),
-                    B(c.edges), B(*prio), B(s.slot[0]), B(s.blocker), B(s.spec), B(s.dround), B(s.queued), round,
+                    B(c.edges), B(*prio), B(s.slot[0]), B(s.slotp), B(s.blocker), B(s.spec), B(s.dround), B(s.queued),
+                    round,
                     B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff));
       ctx.launch(decide, nt, "match_decide");
       set_args_from(apply, 0, "match_apply", B(s.inlist), B(s.work_n), B(c.edges), B(s.slot[0]), B(s.vstamp), round,
                     B(s.dlist), B(s.state), B(s.vaff), B(s.tkill));
       ctx.launch(apply, nt, "match_apply");  // over the round's taken edges (cnt[4] <= nt)
-      vertex_part(ctx, s, c, recompute, turns, *prio, cur, round);
+      vertex_part(ctx, s, c, recompute, turns, *prio, cur, round, &s.slotp);
       s.work_n.download(&nt, 1, size_t(1 - cur));
       cur = 1 - cur;
     }

@@ -67,7 +67,7 @@ struct EdgeState {
   DeviceBuffer<int32_t> vaff;       // per vertex
   // greedy selection (greedy_selection): the priority (levels > 0), per edge the edge it waits
   // for, per vertex the round it was last listed, the edges taken in a round
-  DeviceBuffer<double> prio;
+  DeviceBuffer<double> prio, slotp;  // slotp: the priority of each vertex's slot (matching)
   DeviceBuffer<int32_t> blocker;
   DeviceBuffer<uint32_t> vstamp, inlist;
   // matching selection (matching_selection): per edge whether its early test ran and the round

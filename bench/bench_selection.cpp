@@ -1,0 +1,134 @@
+// The selection stage alone (issue 5): the greedy selection (greedy_selection) and the matching
+// selection (matching_selection) of one iteration, repeated on the same connectivity, so that a
+// change to either can be timed without the rest of the pipeline and the machine's noise over a
+// whole run. Iteration K's input is made by running K whole iterations of the pipeline's
+// stages first (matching selection, guard not run). Before each repetition the mesh the matching
+// selection collapses in place is copied back and the kept verdicts are dropped (every
+// repetition tests from scratch, as the first iteration does). Prints the median and minimum of
+// N repetitions and the counts (taken, tests), which a change that keeps the decisions keeps.
+//
+//   bench_selection [MESH] [--runs N] [--iteration K] [--target-factor F] [--min-quality Q]
+//                   [--priority-levels L] [--no-early-tests]
+// Defaults: W1's mesh (robot 514k) and target (2 x median edge length), 7 runs, iteration 0,
+// min_quality 0.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "collapse/stages.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/io.hpp"
+
+using namespace tc;
+using namespace tc::collapse_detail;
+
+namespace {
+
+double now() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+struct Timing {
+  std::vector<double> t;
+  uint32_t taken = 0, tested = 0;
+  double median() {
+    std::sort(t.begin(), t.end());
+    return t[t.size() / 2];
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string path = std::string(TC_SHARED_MESHES) + "/gen_tetgen_thingi255172_make-robot_514k.msh";
+  int runs = 7, iteration = 0;
+  CollapseOptions o;
+  o.target_factor = 2;
+  o.min_quality = 0;
+  bool early = true;
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--no-early-tests")) {
+      early = false;
+      continue;
+    }
+    if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--iteration") && i + 1 < argc) iteration = std::max(0, std::atoi(argv[++i]));
+    else if (!std::strcmp(argv[i], "--target-factor") && i + 1 < argc) o.target_factor = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--min-quality") && i + 1 < argc) o.min_quality = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--priority-levels") && i + 1 < argc) o.priority_levels = std::atof(argv[++i]);
+    else if (argv[i][0] == '-') {
+      std::fprintf(stderr, "bench_selection: unknown option or missing value: %s\n", argv[i]);
+      return 2;
+    } else path = argv[i];
+  }
+  Mesh mesh;
+  try {
+    mesh = read_mesh(path);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_selection: cannot read %s: %s\n", path.c_str(), e.what());
+    return 1;
+  }
+  Context ctx;
+  StageParams p = params_from(o);
+  p.target = o.target_factor * median_edge_length(mesh);
+  p.match_early_tests = early;
+  DeviceMesh dm, next;
+  std::vector<int32_t> vertex_new;  // in the spatial order collapse() uses by default
+  upload_mesh(ctx, mesh, o, dm, o.spatial_order ? &vertex_new : nullptr);
+  Connectivity c;
+  EdgeState s;
+  DeviceBuffer<int32_t> origin(ctx, 1);
+  uint32_t passed_q = 0, tested = 0;
+  for (int it = 0; it < iteration; ++it) {  // the earlier iterations, matching
+    build_connectivity(ctx, dm, c, p);
+    cost_and_mark(ctx, dm, c, s, p);
+    s.verdict_ready = false;
+    matching_backup(ctx, dm, s);
+    matching_selection(ctx, dm, c, s, p, passed_q, tested);
+    collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
+  }
+  build_connectivity(ctx, dm, c, p);
+  const uint32_t marked = cost_and_mark(ctx, dm, c, s, p);
+  std::printf("mesh %s\ndevice %s\niteration %d: %u vertices, %u tets, %u edges, %u marked; target %g, min_quality %g, "
+              "priority levels %g, early tests %s\n",
+              path.c_str(), ctx.info().name.c_str(), iteration, dm.nv, dm.nt, c.ne, marked, p.target, p.min_quality,
+              p.priority_levels, early ? "on" : "off");
+  // the mesh as it is, for the matching selection's repetitions
+  DeviceBuffer<int32_t> tets0(ctx, 1), nbr0(ctx, 1);
+  DeviceBuffer<double> pts0(ctx, 1), vf0(ctx, 1);
+  tets0.copy_from(dm.tets, size_t(dm.nt) * 4);
+  nbr0.copy_from(c.tet_nbr, size_t(dm.nt) * 4);
+  pts0.copy_from(dm.points, size_t(dm.nv) * 3);
+  vf0.copy_from(dm.vfields, size_t(dm.nv) * dm.vfield_comps);
+  Timing greedy, matching;
+  for (int r = 0; r < runs; ++r) {  // alternately, so that both see the same load
+    s.counters.fill(0u);
+    s.counters.upload(&marked, 1, 0);
+    s.verdict_ready = false;
+    double t0 = now();
+    greedy.taken = greedy_selection(ctx, dm, c, s, p, passed_q, greedy.tested);
+    ctx.finish();
+    greedy.t.push_back(now() - t0);
+    s.counters.fill(0u);
+    s.counters.upload(&marked, 1, 0);
+    s.verdict_ready = false;
+    t0 = now();
+    matching.taken = matching_selection(ctx, dm, c, s, p, passed_q, matching.tested);
+    ctx.finish();
+    matching.t.push_back(now() - t0);
+    dm.tets.copy_from(tets0, size_t(dm.nt) * 4);
+    c.tet_nbr.copy_from(nbr0, size_t(dm.nt) * 4);
+    dm.points.copy_from(pts0, size_t(dm.nv) * 3);
+    dm.vfields.copy_from(vf0, size_t(dm.nv) * dm.vfield_comps);
+  }
+  for (auto [name, t] : {std::pair<const char*, Timing*>{"greedy", &greedy}, {"matching", &matching}}) {
+    const double med = t->median();
+    std::printf("%-8s selection: median %.4f s, min %.4f s over %d runs; %u taken, %u tests; %.1f us per collapse\n", name,
+                med, t->t.front(), runs, t->taken, t->tested, 1e6 * med / std::max(1u, t->taken));
+  }
+  return 0;
+}
