@@ -50,6 +50,7 @@ int main(int argc, char** argv) {
   o.target_factor = 2;
   o.min_quality = 0;
   bool early = true;
+  uint32_t loop_size = StageParams{}.greedy_loop_size, loop_exit = StageParams{}.greedy_loop_exit;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--no-early-tests")) {
       early = false;
@@ -60,6 +61,10 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--target-factor") && i + 1 < argc) o.target_factor = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--min-quality") && i + 1 < argc) o.min_quality = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--priority-levels") && i + 1 < argc) o.priority_levels = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--loop") && i + 2 < argc) {
+      loop_size = uint32_t(std::atoi(argv[++i]));
+      loop_exit = uint32_t(std::atoi(argv[++i]));
+    }
     else if (argv[i][0] == '-') {
       std::fprintf(stderr, "bench_selection: unknown option or missing value: %s\n", argv[i]);
       return 2;
@@ -76,6 +81,8 @@ int main(int argc, char** argv) {
   StageParams p = params_from(o);
   p.target = o.target_factor * median_edge_length(mesh);
   p.match_early_tests = early;
+  p.greedy_loop_size = loop_size;
+  p.greedy_loop_exit = loop_exit;
   DeviceMesh dm, next;
   std::vector<int32_t> vertex_new;  // in the spatial order collapse() uses by default
   upload_mesh(ctx, mesh, o, dm, o.spatial_order ? &vertex_new : nullptr);

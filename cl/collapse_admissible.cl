@@ -92,7 +92,10 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
  * whose refusal is carried from an earlier iteration (verdict): OUT at once. Same fixpoint: a
  * refused edge ends OUT whatever its rivals do, and the others only wait for it to be decided.
  * In the late iterations nearly every candidate is such an edge, and the rounds then see only
- * the few that can still collapse. */
+ * the few that can still collapse. With keep_refused (the matching selection, whose early tests
+ * make its result depend on when each edge's turn comes) those edges stay candidates, their
+ * tests given by the verdicts: the rounds are then the same as when every verdict is computed
+ * anew (CollapseOptions::reuse_across_iterations off), and so is the result. */
 /* lazy_init for edge e; returns whether it passes Q (counted in counters[5]). */
 inline uint tcc_lazy_init_edge(uint e, __global const int* edges, __global const uint* marked,
                                __global const uchar* vflags, __global const uchar* vclass, __global const uchar* eflags,
@@ -100,7 +103,7 @@ inline uint tcc_lazy_init_edge(uint e, __global const int* edges, __global const
                                uint vfield_stride, __global uchar* state, __global uchar* edge_dir,
                                __global uchar* reason, __global uint* cand, int restrict_clean,
                                __global const uchar* vdirty, __global const uchar* verdict, __global const double* cost,
-                               volatile __global int* slot) {
+                               volatile __global int* slot, int keep_refused) {
   edge_dir[e] = 0;
   cand[e] = 0u;
   state[e] = TCC_OUT;
@@ -117,7 +120,7 @@ inline uint tcc_lazy_init_edge(uint e, __global const int* edges, __global const
     return 0u;
   }
   uchar r = verdict[e];
-  if (r != TCC_VERDICT_UNKNOWN && r != TCC_OK && r != TCC_VOLUME_OK) {
+  if (r != TCC_VERDICT_UNKNOWN && r != TCC_OK && r != TCC_VOLUME_OK && !keep_refused) {
     reason[e] = r;
     return 1u;
   }
@@ -135,12 +138,13 @@ __kernel void lazy_init(uint ne, __global const int* edges, __global const uint*
                         __global const double* pts, __global const double* vfield, uint vfield_stride,
                         __global uchar* state, __global uchar* edge_dir, __global uchar* reason, __global uint* cand,
                         __global uint* counters, int restrict_clean, __global const uchar* vdirty,
-                        __global const uchar* verdict, __global const double* cost, volatile __global int* slot) {
+                        __global const uchar* verdict, __global const double* cost, volatile __global int* slot,
+                        int keep_refused) {
   __local uint group_passed_q;
   uint e = get_global_id(0);
   uint q = e < ne ? tcc_lazy_init_edge(e, edges, marked, vflags, vclass, eflags, mode, paper_rule, pts, vfield,
                                        vfield_stride, state, edge_dir, reason, cand, restrict_clean, vdirty, verdict,
-                                       cost, slot)
+                                       cost, slot, keep_refused)
                   : 0u;
   tcc_group_count(q, &group_passed_q, &counters[5]);
 }

@@ -131,7 +131,8 @@ inline uchar tcc_match_test(int e, int a, int b, int live, int full, int* dir, T
                             double eps_f, __global const uchar* tdead) {
   if (!live) {
     *dir = tcc_lazy_dir(e, a, b, TCC_TEST_ARGS);
-    if (!full) return tcc_lazy_volume(e, a, b, *dir, TCC_TEST_ARGS) ? TCC_OK : verdict[e];
+    /* a kept refusal by the link condition: the volume test, which runs before it, passed */
+    if (!full) return verdict[e] == TCC_REFUSED_LINK || tcc_lazy_volume(e, a, b, *dir, TCC_TEST_ARGS) ? TCC_OK : verdict[e];
     return tcc_lazy_verdict(e, a, b, *dir, TCC_TEST_ARGS);
   }
   uint fa, fb, fe;

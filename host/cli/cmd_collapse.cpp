@@ -27,7 +27,7 @@ struct CollapseCli {
   CollapseOptions opt;
   double target_length = 0, target_factor = 0;
   double priority_levels = -1;  // not given
-  std::string boundary = "features", method = "parallel", conflicts = "greedy";
+  std::string boundary = "features", method = "parallel", conflicts = "matching";
   std::string region, sizing_field, labels, cost_cl, placement_cl, predicate_cl, device, stats;
   bool check = false, quiet = false, no_labels = false, no_spatial_order = false;
 };
@@ -232,15 +232,15 @@ void register_collapse(CLI::App& app, int& exit_code) {
                "Sequential method: skip (until the next iteration) an edge whose star an earlier\n"
                "collapse of the iteration changed, as the paper's baseline; default: re-check it");
   app.add_option("--conflicts", c->conflicts,
-                 "Conflict detection of the parallel method: greedy (default: one selection under both\n"
-                 "of the paper's conflict rules, the edges taken in cost order), two-pass (the paper's\n"
-                 "pass 1 over edges, then pass 2 over tets), atomic-min (Gautron and Kenzel 2023;\n"
-                 "needs 64-bit atomics on the device) or matching (the edges taken in cost order, each\n"
-                 "tested on the mesh with the earlier ones collapsed, skipping only those sharing an end\n"
-                 "point with one taken: about four times the collapses per iteration)")
+                 "Conflict detection of the parallel method: matching (default: the edges taken in cost\n"
+                 "order, each tested on the mesh with the earlier ones collapsed, skipping only those\n"
+                 "sharing an end point with one taken), greedy (one selection under both of the paper's\n"
+                 "conflict rules: no two collapses share a tet; about a quarter of matching's collapses\n"
+                 "per iteration), two-pass (the paper's pass 1 over edges, then pass 2 over tets) or\n"
+                 "atomic-min (Gautron and Kenzel 2023; needs 64-bit atomics on the device)")
       ->check(CLI::IsMember({"greedy", "two-pass", "atomic-min", "matching"}));
   app.add_option("--priority-levels", c->priority_levels,
-                 "Greedy conflicts: edges are ordered by their cost in steps of target / N, and within a\n"
+                 "Matching and greedy conflicts: edges are ordered by their cost in steps of target / N, and within a\n"
                  "step in a fixed pseudo-random order (default 64; 0: exact cost order, many more\n"
                  "parallel rounds)")
       ->check(CLI::NonNegativeNumber);

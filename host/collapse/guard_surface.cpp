@@ -212,7 +212,7 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
          tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
          cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer(), cl_int(s.in_place ? 0 : 1));
   qcount.fill(0u);
-  const bool has_verdict = s.verdict.size() >= c.ne && s.verdict.buffer()();
+  const bool has_verdict = !s.in_place && s.verdict.size() >= c.ne && s.verdict.buffer()();
   launch(ctx, p, "sguard_drop", nq, cl_uint(nq), qedge.buffer(), qbad.buffer(), s.marked.buffer(),
          cl_int(has_verdict ? 1 : 0), has_verdict ? s.verdict.buffer() : qbad.buffer(), qcount.buffer());
   uint32_t refused = 0;

@@ -621,7 +621,8 @@ namespace {
 // (candidates, Q, carried refusals, the first claims in s.slot[0] in the order of `order`), and
 // the test's arguments of each kernel of `tests` (from the given argument index on).
 void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
-                const DeviceBuffer<double>& order, std::initializer_list<std::pair<cl::Kernel*, cl_uint>> tests) {
+                const DeviceBuffer<double>& order, std::initializer_list<std::pair<cl::Kernel*, cl_uint>> tests,
+                bool keep_refused = false) {
   const std::string A = "collapse_admissible.cl";
   s.in_place = false;
   ensure(s.dir, ctx, c.ne);
@@ -643,7 +644,7 @@ void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, con
   run_stage(ctx, p, A, "lazy_init", c.ne, U(c.ne), B(c.edges), B(s.marked), B(c.vflags), B(c.vclass), B(c.eflags),
             mode, paper_rule, B(dm.points), B(dm.vfields), U(dm.vfield_comps), B(s.state), B(s.dir), B(s.reason),
             B(s.cand), B(s.counters), cl_int(restrict_clean ? 1 : 0), restrict_clean ? B(s.vdirty) : B(c.vflags),
-            B(s.verdict), B(order), B(s.slot[0]));
+            B(s.verdict), B(order), B(s.slot[0]), cl_int(keep_refused ? 1 : 0));
   const cl::Buffer& quality = tet_qualities(ctx, dm, c, s, p);
   for (auto [k, first] : tests)
     set_args_from(*k, first, "lazy filter test", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb),
@@ -760,7 +761,7 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
   }
   // the test's arguments (TCC_MATCH_PARAMS): the lazy filter's, then the live test's
   constexpr cl_uint kDecide = 19, kApply = 10, kLoop = 22, kTestArgs = 24;
-  lazy_start(ctx, dm, c, s, p, *prio, {{&decide, kDecide}, {&apply, kApply}, {&loop, kLoop}});
+  lazy_start(ctx, dm, c, s, p, *prio, {{&decide, kDecide}, {&apply, kApply}, {&loop, kLoop}}, true);
   s.in_place = true;
   ensure(s.tdead, ctx, std::max<size_t>(dm.nt, 1));
   ensure(s.tkill, ctx, std::max<size_t>(dm.nt, 1));
@@ -846,19 +847,32 @@ void matching_backup(Context& ctx, DeviceMesh& dm, EdgeState& s) {
 }
 
 uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, SurfaceGuard& guard) {
+  ensure(s.refused, ctx, c.ne);
+  ensure(s.work_n, ctx, 5);
+  s.refused.fill(0);
+  s.work_n.fill(0);
+  guard.refused_edges(ctx, s.refused, s.work[0], s.work_n);
+  uint32_t n = 0;
+  s.work_n.download(&n, 1);
+  return matching_undo(ctx, dm, c, s, s.work[0].download_range(0, n));
+}
+
+uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
+                       const std::vector<uint32_t>& refused) {
   const std::string M = "collapse_matching.cl";
   ensure(s.refused, ctx, c.ne);
   ensure(s.undo, ctx, c.ne);
   ensure(s.reachmin, ctx, dm.nv);
-  s.refused.fill(0);
-  s.reachmin.fill(0xffffffffu);
-  // the undone, listed in s.work[0]: the refused first, then each growth
   ensure(s.work_n, ctx, 5);
-  s.work_n.fill(0);
-  guard.refused_edges(ctx, s.refused, s.work[0], s.work_n);
-  s.undo.copy_from(s.refused, c.ne);
-  uint32_t n = 0;
-  s.work_n.download(&n, 1);
+  s.reachmin.fill(0xffffffffu);
+  // the refused flagged, and listed in s.work[0] (the undone: the refused first, then each growth)
+  std::vector<uint8_t> flags(c.ne, 0);
+  for (uint32_t e : refused) flags[e] = 1;
+  s.refused.upload(flags);
+  s.undo.upload(flags);
+  uint32_t n = uint32_t(refused.size());
+  s.work[0].upload(refused.data(), n);
+  s.work_n.upload(&n, 1);
   // the taken edges
   ensure(s.cand_edges, ctx, c.ne);
   const uint32_t taken = dev::compact_indices(ctx, s.fin, s.cand_edges, c.ne);

@@ -55,7 +55,8 @@ struct IterationStats {
   int64_t passed_q = 0;           // marked edges passing the predicate Q
   // Of those, the edges tested: link condition and volume test evaluated (greedy selection: the
   // volume test, which most of them end with; with the atomic-min conflicts: every marked
-  // edge). When the surface guard refuses a collapse, the edges are selected again (the lazy
+  // edge; matching selection: the tests run, up to two per edge: an early volume test while it
+  // waits, and the full test when its turn comes, on the mesh as it is then). When the surface guard refuses a collapse, the edges are selected again (the lazy
   // filter then tests only edges not tested before): marked and passed_q are counted before
   // the first selection, tested adds up over the selections and selection rounds, and
   // admissible, after_pass1 and after_pass2 are the last selection's.
@@ -118,7 +119,7 @@ struct CollapseOptions {
   //   (each is tested on the result of the earlier ones), so an iteration takes about four
   //   times as many as Greedy's (cl/collapse_matching.cl). The surface guard tests the result.
   enum Conflicts { TwoPass, AtomicMin, Greedy, Matching };
-  Conflicts conflicts = Greedy;
+  Conflicts conflicts = Matching;
   // Greedy: the order is the cost in steps of target_length / priority_levels and, within a
   // step, a fixed pseudo-random order of the edges (a bijective hash of the edge index). The
   // exact cost order (0) makes the parallel rounds follow chains of slowly growing cost: W1's

@@ -245,7 +245,7 @@ TEST(CollapseGreedy, WholeRunsValidAndNeedFewerIterationsThanTwoPass) {
   CollapseOptions o;
   o.target_factor = 2;
   o.host_tail = 0;  // every iteration on the device: the counts compare the detections
-  ASSERT_EQ(o.conflicts, CollapseOptions::Greedy);  // the default
+  o.conflicts = CollapseOptions::Greedy;
   Mesh g = in, again = in, t = in;
   const CollapseReport rg = collapse(g, o, ctx);
   ctx.set_work_group_size(16);
@@ -278,8 +278,8 @@ TEST(CollapseGreedy, WholeRunsValidAndNeedFewerIterationsThanTwoPass) {
   EXPECT_THROW(collapse(bad, o, ctx), std::invalid_argument);
 }
 
-// The CLI: greedy by default (named in the stats), --conflicts picks the others, the exact order
-// with --priority-levels 0, and a negative level count refused.
+// The CLI: the matching selection by default (named in the stats), --conflicts picks the others,
+// the exact order with --priority-levels 0, and a negative level count refused.
 TEST(CollapseGreedy, CommandLine) {
   test::TempDir dir;
   const std::string in = dir.file("cube.mesh"), out = dir.file("out.msh"), stats = dir.file("stats.json");
@@ -292,7 +292,9 @@ TEST(CollapseGreedy, CommandLine) {
     EXPECT_NE(log.find("valid"), std::string::npos) << log;
     EXPECT_GT(read_mesh(out).num_tets(), 0);
     const std::string json = test::read_text(stats);
-    const std::string name = opts.find("two-pass") != std::string::npos ? "two-pass" : "greedy";
+    const std::string name = opts.find("two-pass") != std::string::npos ? "two-pass"
+                             : opts.find("greedy") != std::string::npos  ? "greedy"
+                                                                         : "matching";
     EXPECT_NE(json.find("\"conflicts\":\"" + name + "\""), std::string::npos) << json.substr(0, 400);
   }
   for (const std::string bad : {" --priority-levels -1", " --priority-levels 8 --conflicts two-pass",
