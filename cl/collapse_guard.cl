@@ -210,9 +210,10 @@ __kernel void sguard_applied_queries(uint ne, __global const int* edges, __globa
                                      __global const uchar* dir, __global const double* pts, __global const int* tets,
                                      __global const uint* vt_off, __global const int* vt, __global const uchar* tdead,
                                      __global const uchar* smask, __global const uchar* vflags, __global int* qedge,
-                                     __global double* qbox, __global uint* qntri, __global uint* qcount) {
+                                     __global double* qbox, __global uint* qntri, __global uint* qcount,
+                                     int only_flagged, __global const uchar* requery) {
   uint e = get_global_id(0);
-  if (e >= ne || !fin[e]) return;
+  if (e >= ne || !fin[e] || (only_flagged && !requery[e])) return;
   int x, y;
   tcc_sg_applied((int)e, edges, dir, &x, &y);
   if (!vflags[x] && !vflags[y]) return; /* S is not touched */
@@ -524,4 +525,53 @@ __kernel void sguard_refused_list(uint nq, __global const int* qedge, __global c
   if (q >= nq || !qbad[q]) return;
   flag[qedge[q]] = 1;
   list[atomic_inc(count)] = (uint)qedge[q];
+}
+
+/* After the matching selection undid collapses (match_undo), the faces whose shape or
+ * neighbours changed since the last run are those through the end points of an undone
+ * collapse: they lie in the box of N[a] U N[b] (positions now; a removed vertex at its
+ * survivor's). Every pair of S faces that no run tested holds such a face and, unless both
+ * are faces of the iteration's start, the survivor of a collapse still taken whose query box
+ * (its new triangles') then meets that box: the next run needs only those queries
+ * (sguard_requery flags them, sguard_applied_queries with only_flagged). */
+__kernel void sguard_undone_boxes(uint n, __global const uint* undone, __global const int* edges,
+                                  __global const uchar* dir, __global const uint* nb_off, __global const int* nb,
+                                  __global const int* vaff, __global const double* pts, __global double* boxes) {
+  uint i = get_global_id(0);
+  if (i >= n) return;
+  const int g = (int)undone[i];
+  double3 lo = (double3)(INFINITY, INFINITY, INFINITY), hi = -lo;
+  for (int s = 0; s < 2; ++s) {
+    const int x = edges[2 * g + s];
+    for (uint j = nb_off[x]; j <= nb_off[x + 1]; ++j) { /* N(x), then x */
+      int z = j == nb_off[x + 1] ? x : nb[j];
+      const int h = vaff[z];
+      if (h >= 0) { /* an end point of a collapse still taken: where its survivor is */
+        const uint d = dir[h];
+        z = (d & TCC_DIR_REMOVE_V1) ? edges[2 * h] : edges[2 * h + 1];
+      }
+      const double3 p = tc_point(pts, z);
+      lo = fmin(lo, p);
+      hi = fmax(hi, p);
+    }
+  }
+  vstore3(lo, 2 * i, boxes);
+  vstore3(hi, 2 * i + 1, boxes);
+}
+
+/* The last run's queries whose box meets one of the nu boxes of sguard_undone_boxes: their
+ * edges flagged in requery (a loop over the boxes: they are few). */
+__kernel void sguard_requery(uint nq, __global const int* qedge, __global const double* qbox, uint nu,
+                             __global const double* boxes, __global uchar* requery) {
+  uint q = get_global_id(0);
+  if (q >= nq) return;
+  __global const double* b = qbox + 6 * q;
+  const double3 lo = (double3)(b[0], b[1], b[2]), hi = (double3)(b[3], b[4], b[5]);
+  for (uint i = 0; i < nu; ++i) {
+    const double3 ulo = vload3(2 * i, boxes), uhi = vload3(2 * i + 1, boxes);
+    if (!(lo.x > uhi.x || lo.y > uhi.y || lo.z > uhi.z || ulo.x > hi.x || ulo.y > hi.y || ulo.z > hi.z)) {
+      requery[qedge[q]] = 1;
+      return;
+    }
+  }
 }

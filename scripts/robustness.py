@@ -13,8 +13,9 @@ A run is valid when the CLI exits 0 with "check": "valid" (and, for strict, Haus
 Results: OUT/results.json and OUT/README.md (summary first). Failing inputs and outputs are
 copied to OUT/../robustness-failures/ (not committed) and listed. Exit 1 when anything failed.
 
-Methods are a parameter: `parallel` (the default pipeline), `sequential` (--method sequential)
-and `atomic-min` (--conflicts atomic-min). A method whose option the CLI rejects is skipped
+Methods are a parameter: `parallel` (the default pipeline: the matching selection), `greedy`
+(--conflicts greedy), `two-pass`, `sequential` (--method sequential) and `atomic-min`
+(--conflicts atomic-min). A method whose option the CLI rejects is skipped
 with a note, so the script runs before the baselines exist.
 """
 import argparse
@@ -34,6 +35,7 @@ ROOT = os.path.normpath(os.path.join(HERE, ".."))
 
 METHOD_ARGS = {
     "parallel": [],
+    "greedy": ["--conflicts", "greedy"],
     "sequential": ["--method", "sequential"],
     "atomic-min": ["--conflicts", "atomic-min"],
     "two-pass": ["--conflicts", "two-pass"],

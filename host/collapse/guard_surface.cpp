@@ -103,9 +103,13 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   ensure_nonempty(qntri, ctx, chosen);
   ensure_nonempty(qcount, ctx, 1);
   qcount.fill(0u);
+  const bool only = only_requery;
+  only_requery = false;
+  if (only) ensure_nonempty(requery, ctx, c.ne);  // (filled by restrict_to_undone)
   launch(ctx, p, "sguard_applied_queries", c.ne, cl_uint(c.ne), c.edges.buffer(), s.fin.buffer(), s.dir.buffer(),
          dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), s.tdead.buffer(),
-         applied_smask.buffer(), c.vflags.buffer(), qedge.buffer(), qbox.buffer(), qntri.buffer(), qcount.buffer());
+         applied_smask.buffer(), c.vflags.buffer(), qedge.buffer(), qbox.buffer(), qntri.buffer(), qcount.buffer(),
+         cl_int(only ? 1 : 0), only ? requery.buffer() : applied_smask.buffer());
   uint32_t nq = 0;
   qcount.download(&nq, 1);
   last_queries = nq;
@@ -118,6 +122,23 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   ensure_nonempty(applied_stets, ctx, dm.nt);
   const uint32_t n_applied = dev::compact_indices(ctx, applied_owns_s, applied_stets, dm.nt);
   return test_queries(ctx, dm, c, s, p, chosen, nq, applied_smask, applied_stets, n_applied);
+}
+
+void SurfaceGuard::restrict_to_undone(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
+                                      const std::vector<uint32_t>& undone) {
+  if (undone.empty() || last_queries == 0) return;
+  StageParams p;  // the kernels have no user code
+  const uint32_t nu = uint32_t(undone.size());
+  ensure_nonempty(undone_list, ctx, nu);
+  undone_list.upload(undone.data(), nu);
+  ensure_nonempty(undone_boxes, ctx, size_t(nu) * 6);
+  launch(ctx, p, "sguard_undone_boxes", nu, cl_uint(nu), undone_list.buffer(), c.edges.buffer(), s.dir.buffer(),
+         c.nb_off.buffer(), c.nb.buffer(), s.vaff.buffer(), dm.points.buffer(), undone_boxes.buffer());
+  ensure_nonempty(requery, ctx, c.ne);
+  requery.fill(0);
+  launch(ctx, p, "sguard_requery", last_queries, cl_uint(last_queries), qedge.buffer(), qbox.buffer(), cl_uint(nu),
+         undone_boxes.buffer(), requery.buffer());
+  only_requery = true;
 }
 
 void SurfaceGuard::refused_edges(Context& ctx, DeviceBuffer<uint8_t>& flag, DeviceBuffer<uint32_t>& list,

@@ -25,6 +25,10 @@ struct SurfaceGuard {
 
   DeviceBuffer<uint32_t> applied_owns_s, applied_stets;  // run_applied: the S faces of the result
   DeviceBuffer<uint8_t> applied_smask;
+  DeviceBuffer<uint8_t> requery;  // per edge: queried again by the next run_applied (restrict_to_undone)
+  DeviceBuffer<uint32_t> undone_list;
+  DeviceBuffer<double> undone_boxes;
+  bool only_requery = false;
 
   // Tests the `chosen` collapses of s.fin / s.dir; returns how many were refused (their edges
   // are unmarked in s.marked).
@@ -33,6 +37,11 @@ struct SurfaceGuard {
   // (EdgeState::in_place): on the result (cl/collapse_guard.cl, sguard_applied_*).
   uint32_t run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                        uint32_t chosen);
+  // After the matching selection undid the collapses of `undone` (after a run_applied that
+  // refused some): the next run_applied tests only the queries that the undo may concern
+  // (cl/collapse_guard.cl, sguard_undone_boxes).
+  void restrict_to_undone(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
+                          const std::vector<uint32_t>& undone);
   // After a run that refused collapses: their edges flagged in flag (1) and listed in list (from
   // count[0] on, which is advanced).
   void refused_edges(Context& ctx, DeviceBuffer<uint8_t>& flag, DeviceBuffer<uint32_t>& list,

@@ -854,11 +854,14 @@ uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   guard.refused_edges(ctx, s.refused, s.work[0], s.work_n);
   uint32_t n = 0;
   s.work_n.download(&n, 1);
-  return matching_undo(ctx, dm, c, s, s.work[0].download_range(0, n));
+  std::vector<uint32_t> undone;
+  const uint32_t count = matching_undo(ctx, dm, c, s, s.work[0].download_range(0, n), &undone);
+  guard.restrict_to_undone(ctx, dm, c, s, undone);  // the next guard run: only where the undo changed S
+  return count;
 }
 
 uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
-                       const std::vector<uint32_t>& refused) {
+                       const std::vector<uint32_t>& refused, std::vector<uint32_t>* undone) {
   const std::string M = "collapse_matching.cl";
   ensure(s.refused, ctx, c.ne);
   ensure(s.undo, ctx, c.ne);
@@ -899,6 +902,7 @@ uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   std::vector<uint32_t> sorted(n);
   for (uint32_t i = 0; i < n; ++i) sorted[i] = order[idx[i]];
   s.work[1].upload(sorted.data(), n);
+  if (undone) *undone = sorted;
   run(ctx, M, "match_undo", 1, "", U(n), B(s.work[1]), B(s.refused), B(c.edges), B(s.dir), B(dm.tets), B(c.vt_off),
       B(c.vt), B(c.tet_nbr), B(s.tdead), B(s.tkill), B(dm.points), B(dm.vfields), U(dm.vfield_comps), B(s.points0),
       B(s.vfields0), B(s.vaff), B(s.state), B(s.fin), B(s.reason));

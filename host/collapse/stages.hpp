@@ -215,11 +215,12 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
 void matching_backup(Context& ctx, DeviceMesh& dm, EdgeState& s);
 // After SurfaceGuard::run_applied refused collapses of the matching selection: undoes them and
 // every collapse taken after one of them within reach (cl/collapse_matching.cl, match_undo*);
-// returns how many were undone (fin, vaff, state and the mesh updated). The second form undoes
-// the edges of `refused` (taken ones) instead of the guard's refusals.
+// returns how many were undone (fin, vaff, state and the mesh updated), and has the guard's next
+// run test only what the undo may concern (SurfaceGuard::restrict_to_undone). The second form
+// undoes the edges of `refused` (taken ones) and their closure instead (listed in *undone).
 uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, SurfaceGuard& guard);
 uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
-                       const std::vector<uint32_t>& refused);
+                       const std::vector<uint32_t>& refused, std::vector<uint32_t>* undone = nullptr);
 // Atomic-min conflict detection (host/collapse/conflict_atomic.cpp) over the admissible edges
 // of admissible(): replaces both conflict passes, with the same outputs as conflict_pass2.
 // Returns the number of edges to collapse.

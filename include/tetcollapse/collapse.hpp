@@ -5,11 +5,13 @@
 //   opt.target_factor = 2;
 //   tc::CollapseReport r = tc::collapse(mesh, opt, ctx);   // mesh is replaced by the result
 //
-// One iteration = connectivity of the current mesh (rebuilt on the device without global
-// sorts), cost and marking, the admissible filter (predicate Q, link condition, volumes),
-// conflict pass 1 over edges (the two fused: an edge is tested only when its turn comes),
-// conflict pass 2 over tets, collapse + compaction. Iterations stop
-// when one collapses fewer than max(eps_c, 1) edges or after max_iterations.
+// One iteration = connectivity of the current mesh (carried through the compaction for the
+// vertices no collapse touched, rebuilt on the device for the others), cost and marking, the
+// admissible filter (predicate Q, link condition, volumes) and the conflict detection (by
+// default together: the matching selection, which also applies the collapses; the paper's
+// conflict pass 1 over edges and pass 2 over tets with Conflicts::TwoPass), the surface guard,
+// compaction. Iterations stop when one collapses fewer than max(eps_c, 1) edges or after
+// max_iterations.
 //
 // Boundary and material interfaces. The feature surface S is the outer boundary plus, when the
 // mesh has labels, every face between tets of different primary labels (tet_labels[0]).
@@ -102,7 +104,16 @@ struct CollapseOptions {
   // if the collapse has been invalidated by a prior collapse", fewer collapses per iteration).
   bool sequential_skip_invalidated = false;
   // Conflict detection of the parallel method.
-  // Greedy (default): one selection under the conflicts of both of the paper's passes: the
+  // Matching (default): the edges that taking the marked edges one after another in priority
+  //   order would take, each tested on the mesh with the collapses taken before it applied,
+  //   skipping only those that share an end point with an edge taken before: its collapses may
+  //   share tets (each is tested on the result of the earlier ones), so an iteration takes about
+  //   four times as many as Greedy's and a run needs about half the iterations
+  //   (cl/collapse_matching.cl). A waiting edge gets one early volume test, and a refusal there is
+  //   final for the iteration. The surface guard tests the result; the collapses it refuses are
+  //   undone with those taken after them within reach. W1 (bench/README.md): 19 iterations
+  //   against 30, 1.2x the speed of Greedy, 1-3% more tets at the end.
+  // Greedy: one selection under the conflicts of both of the paper's passes: the
   //   edges that taking the marked edges one after another in cost order would take, skipping
   //   each that fails the tests or touches a tet of an edge taken before. Like the two passes it
   //   never takes two edges that share a vertex or touch a common tet, but it chooses among all
@@ -113,14 +124,9 @@ struct CollapseOptions {
   // AtomicMin: Gautron and Kenzel 2023, every admissible edge propagates a 64-bit descriptor
   //   (cost bits high, edge index low) with atomic_min to the tets of both one-rings and
   //   collapses when it holds the minimum in all of them; needs cl_khr_int64_extended_atomics.
-  // Matching: the edges that taking the marked edges one after another in priority order would
-  //   take, each tested on the mesh with the collapses taken before it applied, skipping only
-  //   those that share an end point with an edge taken before: its collapses may share tets
-  //   (each is tested on the result of the earlier ones), so an iteration takes about four
-  //   times as many as Greedy's (cl/collapse_matching.cl). The surface guard tests the result.
   enum Conflicts { TwoPass, AtomicMin, Greedy, Matching };
   Conflicts conflicts = Matching;
-  // Greedy: the order is the cost in steps of target_length / priority_levels and, within a
+  // Matching and Greedy: the order is the cost in steps of target_length / priority_levels and, within a
   // step, a fixed pseudo-random order of the edges (a bijective hash of the edge index). The
   // exact cost order (0) makes the parallel rounds follow chains of slowly growing cost: W1's
   // first iteration then takes ~200 rounds instead of ~25, for 2% more collapses.
@@ -162,7 +168,7 @@ struct CollapseOptions {
   // before the run (memory locality of the stages: W1 about 20% faster with TetGen's numbering).
   // The output's vertices and tets follow that order instead of the input's.
   bool spatial_order = true;
-  // Host tail. Parallel method with the greedy or two-pass conflict detection, run until nothing
+  // Host tail. Parallel method (any conflict detection but AtomicMin), run until nothing
   // collapses (eps_c <= 1), without user functions (has_user_functions): once an iteration
   // collapses fewer than host_tail x (its tets) edges and the counts shrink slowly enough to
   // promise many more iterations (at the ratio of the last two, at least

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "collapse/guard_surface.hpp"
 #include "collapse/sequential_mesh.hpp"
 #include "collapse/sequential_run.hpp"
 #include "collapse/stages.hpp"
@@ -237,7 +238,9 @@ TEST(CollapseMatching, SameAtEveryWorkGroupSizeAndLoopThreshold) {
         EXPECT_EQ(st.dir, ref.dir) << what;
         EXPECT_EQ(st.reason, ref.reason) << what;
         for (uint32_t e = 0; e < st.ne; ++e)
-          if (ref.fin[e]) EXPECT_EQ(st.dround[e], ref.dround[e]) << what << ", round of edge " << e;
+          if (ref.fin[e]) {
+            EXPECT_EQ(st.dround[e], ref.dround[e]) << what << ", round of edge " << e;
+          }
         EXPECT_EQ(st.taken, ref.taken) << what;
         EXPECT_EQ(st.tested, ref.tested) << what;
         expect_same_mesh(st.result(ctx, in.mesh), ref_mesh, what);
@@ -429,4 +432,62 @@ TEST(CollapseMatching, WholeRunsValidDeterministicAndInFewerIterations) {
     EXPECT_LT(r.iterations.size(), rg.iterations.size());
     EXPECT_GT(r.iterations[0].collapsed, rg.iterations[0].collapsed);
   }
+}
+
+// After the undo of refused collapses, the surface guard tests only the queries near the
+// undone ones (SurfaceGuard::restrict_to_undone): on every iteration of a run where the guard
+// refuses (the shared gen_gmsh_wrenchnut_27k), it refuses what a guard testing every query of
+// the result refuses, and the result is valid.
+TEST(CollapseMatching, GuardAfterUndoTestsWhatTheUndoChanged) {
+  const std::string path = test::shared_mesh("gen_gmsh_wrenchnut_27k.msh");
+  if (path.empty()) GTEST_SKIP() << "gen_gmsh_wrenchnut_27k.msh absent from the shared meshes";
+  Context ctx;
+  const Mesh in = read_mesh(path);
+  CollapseOptions o;
+  StageParams p = params_from(o);
+  p.target = 2 * median_edge_length(in);
+  DeviceMesh dm, next;
+  std::vector<int32_t> vertex_new;  // the spatial order, as collapse() (the refusals depend on the order)
+  upload_mesh(ctx, in, o, dm, &vertex_new);
+  Connectivity c;
+  EdgeState s;
+  SurfaceGuard guard;
+  DeviceBuffer<int32_t> origin(ctx, 1);
+  int undos = 0, restricted_queries = 0, full_queries = 0;
+  for (int it = 0; it < 40; ++it) {
+    build_connectivity(ctx, dm, c, p, &s);
+    carry_verdicts(ctx, dm, c, s);
+    cost_and_mark(ctx, dm, c, s, p);
+    matching_backup(ctx, dm, s);
+    uint32_t passed_q = 0, tested = 0;
+    uint32_t chosen = matching_selection(ctx, dm, c, s, p, passed_q, tested);
+    while (guard.run_applied(ctx, dm, c, s, p, chosen) > 0) {
+      chosen -= matching_undo(ctx, dm, c, s, guard);
+      ++undos;
+      // a guard testing every query of the result, beside the restricted one the loop runs next
+      SurfaceGuard full;
+      const uint32_t full_refused = full.run_applied(ctx, dm, c, s, p, chosen);
+      full_queries += int(full.last_queries);
+      const std::vector<uint32_t> marked = s.marked.download_range(0, c.ne);
+      const uint32_t refused = guard.run_applied(ctx, dm, c, s, p, chosen);
+      restricted_queries += int(guard.last_queries);
+      EXPECT_EQ(refused, full_refused) << "iteration " << it;
+      EXPECT_EQ(s.marked.download_range(0, c.ne), marked) << "iteration " << it;  // the same ones unmarked
+      if (refused == 0) break;
+      chosen -= matching_undo(ctx, dm, c, s, guard);
+    }
+    if (chosen == 0) break;
+    remember_for_carry(ctx, dm, c, s);
+    collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
+    note_compaction(ctx, dm, c, s);
+  }
+  EXPECT_GT(undos, 0);
+  EXPECT_LT(restricted_queries, full_queries);
+  Mesh out = in;
+  download_mesh(dm, out);
+  CheckOptions co;
+  co.quality = false;
+  co.hausdorff = false;
+  const CheckReport check = check_mesh(out, co, &in);
+  EXPECT_TRUE(check.valid) << check_report_text(check);
 }
