@@ -124,7 +124,8 @@ inline int tcc_live_dir(int a, int b, __global const int* tets, __global const u
 }
 
 /* The tests of e = (a, b) on the mesh as it is: the volume test alone (full = 0: the early
- * test of a waiting edge) or Q, the volume test and the link condition (full = 1); TCC_OK or
+ * test of a waiting edge, at the placement Q gave at the iteration's start) or Q, the volume
+ * test and the link condition (full = 1); TCC_OK or
  * the refusal, with Q's direction bits in *dir. Not live: the lazy filter's test, with the
  * verdicts kept. */
 inline uchar tcc_match_test(int e, int a, int b, int live, int full, int* dir, TCC_TEST_PARAMS, double eps_r,
@@ -135,9 +136,13 @@ inline uchar tcc_match_test(int e, int a, int b, int live, int full, int* dir, T
     if (!full) return verdict[e] == TCC_REFUSED_LINK || tcc_lazy_volume(e, a, b, *dir, TCC_TEST_ARGS) ? TCC_OK : verdict[e];
     return tcc_lazy_verdict(e, a, b, *dir, TCC_TEST_ARGS);
   }
-  uint fa, fb, fe;
-  *dir = tcc_live_dir(a, b, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, tdead, vflags, mode, paper_rule,
-                      eps_r, eps_f, &fa, &fb, &fe);
+  uint fa = 0, fb = 0, fe = 0;
+  /* the early test at the placement of Q at the iteration's start (the classes of a changed S
+   * are computed for the full test only: the early test only has to refuse most of what the
+   * full one would, cheaply) */
+  *dir = full ? tcc_live_dir(a, b, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, tdead, vflags, mode, paper_rule,
+                             eps_r, eps_f, &fa, &fb, &fe)
+              : tcc_lazy_dir(e, a, b, TCC_TEST_ARGS);
   if (*dir < 0 || !tcc_user_allows(pts, vfield, vfield_stride, a, b)) return TCC_REFUSED_Q;
   atomic_inc(&counters[4]);
   uchar r = tcc_volume_test(a, b, *dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tet_quality, 1,

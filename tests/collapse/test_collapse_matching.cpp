@@ -435,59 +435,68 @@ TEST(CollapseMatching, WholeRunsValidDeterministicAndInFewerIterations) {
 }
 
 // After the undo of refused collapses, the surface guard tests only the queries near the
-// undone ones (SurfaceGuard::restrict_to_undone): on every iteration of a run where the guard
-// refuses (the shared gen_gmsh_wrenchnut_27k), it refuses what a guard testing every query of
-// the result refuses, and the result is valid.
+// undone ones (SurfaceGuard::restrict_to_undone): on every iteration of runs where the guard
+// refuses (the shared gen_gmsh_wrenchnut_27k at 3x and gen_gmsh_917_fusee_88k at 1x the median
+// edge length), it refuses what a guard testing every query of the result refuses, and the
+// results are valid.
 TEST(CollapseMatching, GuardAfterUndoTestsWhatTheUndoChanged) {
-  const std::string path = test::shared_mesh("gen_gmsh_wrenchnut_27k.msh");
-  if (path.empty()) GTEST_SKIP() << "gen_gmsh_wrenchnut_27k.msh absent from the shared meshes";
+  std::vector<std::pair<std::string, double>> runs;
+  for (auto [name, factor] : {std::pair<const char*, double>{"gen_gmsh_wrenchnut_27k.msh", 3.0},
+                              {"gen_gmsh_917_fusee_88k.msh", 1.0}}) {
+    const std::string path = test::shared_mesh(name);
+    if (!path.empty()) runs.push_back({path, factor});
+  }
+  if (runs.empty()) GTEST_SKIP() << "gen_gmsh_wrenchnut_27k.msh and gen_gmsh_917_fusee_88k.msh absent from the shared meshes";
   Context ctx;
-  const Mesh in = read_mesh(path);
-  CollapseOptions o;
-  StageParams p = params_from(o);
-  p.target = 2 * median_edge_length(in);
-  DeviceMesh dm, next;
-  std::vector<int32_t> vertex_new;  // the spatial order, as collapse() (the refusals depend on the order)
-  upload_mesh(ctx, in, o, dm, &vertex_new);
-  Connectivity c;
-  EdgeState s;
-  SurfaceGuard guard;
-  DeviceBuffer<int32_t> origin(ctx, 1);
   int undos = 0, restricted_queries = 0, full_queries = 0;
-  for (int it = 0; it < 40; ++it) {
-    build_connectivity(ctx, dm, c, p, &s);
-    carry_verdicts(ctx, dm, c, s);
-    cost_and_mark(ctx, dm, c, s, p);
-    matching_backup(ctx, dm, s);
-    uint32_t passed_q = 0, tested = 0;
-    uint32_t chosen = matching_selection(ctx, dm, c, s, p, passed_q, tested);
-    while (guard.run_applied(ctx, dm, c, s, p, chosen) > 0) {
-      chosen -= matching_undo(ctx, dm, c, s, guard);
-      ++undos;
-      // a guard testing every query of the result, beside the restricted one the loop runs next
-      SurfaceGuard full;
-      const uint32_t full_refused = full.run_applied(ctx, dm, c, s, p, chosen);
-      full_queries += int(full.last_queries);
-      const std::vector<uint32_t> marked = s.marked.download_range(0, c.ne);
-      const uint32_t refused = guard.run_applied(ctx, dm, c, s, p, chosen);
-      restricted_queries += int(guard.last_queries);
-      EXPECT_EQ(refused, full_refused) << "iteration " << it;
-      EXPECT_EQ(s.marked.download_range(0, c.ne), marked) << "iteration " << it;  // the same ones unmarked
-      if (refused == 0) break;
-      chosen -= matching_undo(ctx, dm, c, s, guard);
+  for (const auto& [path, factor] : runs) {
+    SCOPED_TRACE(path);
+    const Mesh in = read_mesh(path);
+    CollapseOptions o;
+    StageParams p = params_from(o);
+    p.target = factor * median_edge_length(in);
+    DeviceMesh dm, next;
+    std::vector<int32_t> vertex_new;  // the spatial order, as collapse() (the refusals depend on the order)
+    upload_mesh(ctx, in, o, dm, &vertex_new);
+    Connectivity c;
+    EdgeState s;
+    SurfaceGuard guard;
+    DeviceBuffer<int32_t> origin(ctx, 1);
+    for (int it = 0; it < 40; ++it) {
+      build_connectivity(ctx, dm, c, p, &s);
+      carry_verdicts(ctx, dm, c, s);
+      cost_and_mark(ctx, dm, c, s, p);
+      matching_backup(ctx, dm, s);
+      uint32_t passed_q = 0, tested = 0;
+      uint32_t chosen = matching_selection(ctx, dm, c, s, p, passed_q, tested);
+      while (guard.run_applied(ctx, dm, c, s, p, chosen) > 0) {
+        chosen -= matching_undo(ctx, dm, c, s, guard);
+        ++undos;
+        // a guard testing every query of the result, beside the restricted one the loop runs next
+        SurfaceGuard full;
+        const uint32_t full_refused = full.run_applied(ctx, dm, c, s, p, chosen);
+        full_queries += int(full.last_queries);
+        const std::vector<uint32_t> marked = s.marked.download_range(0, c.ne);
+        const uint32_t refused = guard.run_applied(ctx, dm, c, s, p, chosen);
+        restricted_queries += int(guard.last_queries);
+        EXPECT_EQ(refused, full_refused) << "iteration " << it;
+        EXPECT_EQ(s.marked.download_range(0, c.ne), marked) << "iteration " << it;  // the same ones unmarked
+        if (refused == 0) break;
+        chosen -= matching_undo(ctx, dm, c, s, guard);
+      }
+      if (chosen == 0) break;
+      remember_for_carry(ctx, dm, c, s);
+      collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
+      note_compaction(ctx, dm, c, s);
     }
-    if (chosen == 0) break;
-    remember_for_carry(ctx, dm, c, s);
-    collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
-    note_compaction(ctx, dm, c, s);
+    Mesh out = in;
+    download_mesh(dm, out);
+    CheckOptions co;
+    co.quality = false;
+    co.hausdorff = false;
+    const CheckReport check = check_mesh(out, co, &in);
+    EXPECT_TRUE(check.valid) << check_report_text(check);
   }
   EXPECT_GT(undos, 0);
   EXPECT_LT(restricted_queries, full_queries);
-  Mesh out = in;
-  download_mesh(dm, out);
-  CheckOptions co;
-  co.quality = false;
-  co.hausdorff = false;
-  const CheckReport check = check_mesh(out, co, &in);
-  EXPECT_TRUE(check.valid) << check_report_text(check);
 }
