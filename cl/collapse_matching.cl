@@ -419,8 +419,8 @@ __kernel void match_undo(uint n, __global const uint* order, __global const ucha
     }
     for (int c = 0; c < 3; ++c) pts[3 * x + c] = pts0[3 * x + c];
     for (uint c = 0; c < vfield_stride; ++c) vfield[(size_t)x * vfield_stride + c] = vfield0[(size_t)x * vfield_stride + c];
-    vaff[v0] = -1;
-    vaff[v1] = -1;
+    vaff[v0] = -2; /* no collapse, but dirty for the carry (verdict_dirty): g's tests must run again */
+    vaff[v1] = -2;
     state[g] = TCC_OUT;
     fin[g] = 0u;
     reason[g] = refused[g] ? TCC_REFUSED_SURFACE : TCC_UNTESTED;

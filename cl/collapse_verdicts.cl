@@ -12,13 +12,15 @@
 #include "collapse_common.h"
 
 /* vdirty[v]: v is an end point of a final edge (vaff[v] >= 0 after conflict_finalize) or a
- * neighbour of one. */
+ * neighbour of one; or of a collapse the matching selection undid (vaff -2: its edge was
+ * admissible, which a verdict kept for an edge at a clean vertex must not hide from the host
+ * tail, tail_touched). */
 __kernel void verdict_dirty(uint nv, __global const int* vaff, __global const uint* nb_off, __global const int* nb,
                             __global uchar* vdirty) {
   uint v = get_global_id(0);
   if (v >= nv) return;
-  uchar d = vaff[v] >= 0;
-  for (uint i = nb_off[v]; i < nb_off[v + 1] && !d; ++i) d = vaff[nb[i]] >= 0;
+  uchar d = vaff[v] != -1;
+  for (uint i = nb_off[v]; i < nb_off[v + 1] && !d; ++i) d = vaff[nb[i]] != -1;
   vdirty[v] = d;
 }
 

@@ -102,7 +102,15 @@ namespace {
 // CollapseOptions::host_tail on this device (negative: automatic).
 double host_tail_fraction(const CollapseOptions& o, const DeviceInfo& device) {
   if (o.host_tail >= 0) return o.host_tail;
-  return device.type == "CPU" ? CollapseOptions::kHostTailCpu : 0.0;
+  if (device.type != "CPU") return 0.0;
+  return o.conflicts == CollapseOptions::Matching ? CollapseOptions::kHostTailCpuMatching : CollapseOptions::kHostTailCpu;
+}
+
+// CollapseOptions::host_tail_min_iterations (negative: automatic).
+double host_tail_iterations(const CollapseOptions& o) {
+  if (o.host_tail_min_iterations >= 0) return o.host_tail_min_iterations;
+  return o.conflicts == CollapseOptions::Matching ? CollapseOptions::kHostTailIterationsMatching
+                                                  : CollapseOptions::kHostTailIterations;
 }
 
 // After the last iteration of `its`, does the rest run on the host? When it collapsed fewer
@@ -118,7 +126,7 @@ bool host_tail_due(const CollapseOptions& o, double fraction, const std::vector<
   if (s.iteration + 1 >= o.max_iterations || !(double(s.collapsed) < fraction * double(s.tets))) return false;
   const double c = double(s.collapsed);
   const double r = std::min(0.95, c / double(std::max<int64_t>(its[its.size() - 2].collapsed, 1)));
-  return std::log(c) >= o.host_tail_min_iterations * std::log(1 / r);
+  return std::log(c) >= host_tail_iterations(o) * std::log(1 / r);
 }
 
 // The host tail: the sequential method, greedy, on the downloaded mesh (current numbering; its
