@@ -469,20 +469,7 @@ __kernel void greedy_loop(uint n, int cur, uint round, __global uint* t0, __glob
     barrier(CLK_GLOBAL_MEM_FENCE);
     tcc_p1_vertex_part(cnt[2], dlist, nb_off, nb_edge, state, prio, slot, edges, tnext, cnext, queued, round, verdict,
                        cnt + 3, 0);
-    n = *cnext;
-    barrier(CLK_GLOBAL_MEM_FENCE);
-    cur = 1 - cur;
-    ++round;
-    if (n > max_n) { /* the same value in every work item: a uniform exit */
-      if (lid == 0) {
-        resume[0] = n;
-        resume[1] = (uint)cur;
-        resume[2] = round;
-      }
-      return;
-    }
-    if (lid == 0) cnt[0] = cnt[1] = cnt[2] = cnt[3] = cnt[4] = 0;
-    barrier(CLK_GLOBAL_MEM_FENCE);
+    if (tcc_loop_next(&n, &cur, &round, max_n, cnt, resume)) return;
   }
 }
 

@@ -303,17 +303,17 @@ __kernel void match_apply(__global const uint* inlist, __global uint* cnt, __glo
 __kernel void match_loop(uint n, int cur, uint round, __global uint* t0, __global uint* t1, __global uint* cnt,
                          __global const int* edges, __global const double* prio, __global int* slot,
                          __global double* slotp, __global int* blocker, __global uchar* spec, __global uint* dround,
-                         volatile __global uint* queued, __global uint* inlist, volatile __global uint* vstamp, __global uint* dlist,
-                         __global uchar* state, __global int* vaff, __global int* tkill, uint max_n,
-                         __global uint* resume, TCC_MATCH_PARAMS) {
+                         volatile __global uint* queued, __global uint* inlist, volatile __global uint* vstamp,
+                         __global uint* dlist, __global uchar* state, __global int* vaff, __global int* tkill,
+                         uint max_n, __global uint* resume, TCC_MATCH_PARAMS) {
   const uint lid = get_local_id(0), ls = get_local_size(0);
   while (n > 0) {
     __global uint* tl = cur ? t1 : t0;
     __global uint* tnext = cur ? t0 : t1;
     __global uint* cnext = cnt + (1 - cur);
     for (uint i = lid; i < n; i += ls)
-      tcc_match_decide((int)tl[i], edges, prio, slot, slotp, blocker, spec, dround, tnext, cnext, queued, round, inlist, cnt + 4,
-                       vstamp, dlist, cnt + 2, state, vaff, TCC_MATCH_ARGS);
+      tcc_match_decide((int)tl[i], edges, prio, slot, slotp, blocker, spec, dround, tnext, cnext, queued, round, inlist,
+                       cnt + 4, vstamp, dlist, cnt + 2, state, vaff, TCC_MATCH_ARGS);
     barrier(CLK_GLOBAL_MEM_FENCE);
     const uint nin = cnt[4];
     for (uint i = lid; i < nin; i += ls)
@@ -321,20 +321,7 @@ __kernel void match_loop(uint n, int cur, uint round, __global uint* t0, __globa
     barrier(CLK_GLOBAL_MEM_FENCE);
     tcc_p1_vertex_part(cnt[2], dlist, nb_off, nb_edge, state, prio, slot, edges, tnext, cnext, queued, round, verdict,
                        cnt + 3, slotp);
-    n = *cnext;
-    barrier(CLK_GLOBAL_MEM_FENCE);
-    cur = 1 - cur;
-    ++round;
-    if (n > max_n) { /* the same value in every work item: a uniform exit */
-      if (lid == 0) {
-        resume[0] = n;
-        resume[1] = (uint)cur;
-        resume[2] = round;
-      }
-      return;
-    }
-    if (lid == 0) cnt[0] = cnt[1] = cnt[2] = cnt[3] = cnt[4] = 0;
-    barrier(CLK_GLOBAL_MEM_FENCE);
+    if (tcc_loop_next(&n, &cur, &round, max_n, cnt, resume)) return;
   }
 }
 

@@ -419,6 +419,28 @@ inline void tcc_p1_vertex_part(uint nd, __global const uint* dlist, __global con
   barrier(CLK_GLOBAL_MEM_FENCE);
 }
 
+/* After a round of greedy_loop or match_loop (its vertex part done): the next round's turn list
+ * becomes the current one; returns 1 when the loop stops because that list holds more than
+ * max_n edges (resume[] = its length, its list, its round, for the host's per-round kernels),
+ * else 0 with the counters cleared. The same values in every work item: a uniform exit. */
+inline int tcc_loop_next(uint* n, int* cur, uint* round, uint max_n, __global uint* cnt, __global uint* resume) {
+  *n = cnt[1 - *cur];
+  barrier(CLK_GLOBAL_MEM_FENCE);
+  *cur = 1 - *cur;
+  ++*round;
+  if (*n > max_n) {
+    if (get_local_id(0) == 0) {
+      resume[0] = *n;
+      resume[1] = (uint)*cur;
+      resume[2] = *round;
+    }
+    return 1;
+  }
+  if (get_local_id(0) == 0) cnt[0] = cnt[1] = cnt[2] = cnt[3] = cnt[4] = 0;
+  barrier(CLK_GLOBAL_MEM_FENCE);
+  return 0;
+}
+
 #ifdef TCC_PREFETCH_OK
 /* CPU devices (the host sets TCC_PREFETCH) run a work-group's items one after another: start the
  * memory traffic of the next items' tests, whose first loop otherwise waits for each of its tets

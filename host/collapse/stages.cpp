@@ -670,19 +670,19 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   return cnt[2];
 }
 
-uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
-                          uint32_t& passed_q, uint32_t& tested) {
-  const std::string A = "collapse_admissible.cl";
-  cl::Kernel decide = stage_kernel(ctx, p, A, "greedy_decide"), loop = stage_kernel(ctx, p, A, "greedy_loop");
-  // the priority first: lazy_init claims the first slots in its order
-  const DeviceBuffer<double>* prio = &s.cost;
-  if (p.priority_levels > 0) {
-    ensure(s.prio, ctx, c.ne);
-    run(ctx, A, "greedy_priority", c.ne, "", U(c.ne), B(s.cost), B(s.marked), p.target, p.priority_levels,
-        B(s.prio));
-    prio = &s.prio;
-  }
-  lazy_start(ctx, dm, c, s, p, *prio, {{&decide, 16}, {&loop, 18}});
+namespace {
+// The priority of the greedy and matching selections: greedy_priority with levels > 0, else the
+// cost.
+const DeviceBuffer<double>& selection_priority(Context& ctx, Connectivity& c, EdgeState& s, const StageParams& p) {
+  if (!(p.priority_levels > 0)) return s.cost;
+  ensure(s.prio, ctx, c.ne);
+  run(ctx, "collapse_admissible.cl", "greedy_priority", c.ne, "", U(c.ne), B(s.cost), B(s.marked), p.target,
+      p.priority_levels, B(s.prio));
+  return s.prio;
+}
+
+// The buffers of the greedy and matching selections' rounds, set for the first round.
+void selection_buffers(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
   ensure(s.fin, ctx, c.ne);
   ensure(s.blocker, ctx, c.ne);
   ensure(s.queued, ctx, c.ne);
@@ -697,12 +697,23 @@ uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
   s.queued.fill(0xffffffffu);
   s.vstamp.fill(0xffffffffu);
   s.work_n.fill(0);
+}
+
+// The rounds of the greedy and matching selections (after lazy_start, selection_buffers and the
+// first claims): the first turn list, then round after round until none is left, each either
+// the per-round kernels (`round(nt, cur, round)`, which leave the next turn list's length in
+// s.work_n[1 - cur]) or, once a turn list holds at most p.greedy_loop_size edges, the loop in
+// one work-group (`loop(nt, cur, round)`, which stops before a turn list longer than
+// p.greedy_loop_exit and leaves where in s.resume); then greedy_finish and the counts (passed_q
+// and tested as lazy_admissible_pass1; returns the number taken).
+template <class Round, class Loop>
+uint32_t selection_rounds(Context& ctx, Connectivity& c, EdgeState& s, const StageParams& p, const char* name,
+                          const Round& one_round, const Loop& loop, uint32_t& passed_q, uint32_t& tested) {
+  const std::string A = "collapse_admissible.cl";
   run(ctx, A, "lazy_p1_first_turns", c.ne, "", U(c.ne), B(s.cand), B(c.edges), B(s.slot[0]), B(s.work[0]), B(s.work_n),
       B(s.verdict));
   uint32_t nt = 0;
   s.work_n.download(&nt, 1);
-  cl::Kernel block = ctx.kernel(A, "greedy_block"), recompute = ctx.kernel(A, "lazy_p1_recompute"),
-             turns = ctx.kernel(A, "lazy_p1_turns");
   int cur = 0;  // the turn list of this round
   for (cl_uint round = 0; nt > 0; ++round) {
     auto t0 = std::chrono::steady_clock::now();
@@ -710,30 +721,20 @@ uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
     const bool one_group = nt <= p.greedy_loop_size;
     if (one_group) {
       s.resume.fill(0);
-      set_args(loop, "greedy_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
-               B(*prio), B(s.slot[0]), B(s.blocker), B(s.queued), B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state),
-               B(s.vaff), U(p.greedy_loop_exit), B(s.resume));
-      ctx.launch(loop, ctx.group_size_for(loop), "greedy_loop");
+      loop(nt, cur, round);
       uint32_t r[3];
       s.resume.download(r, 3);
       nt = r[0];  // 0: every round done; else the loop stopped before a long turn list
       cur = int(r[1]);
       round = r[2] - 1;
     } else {
-      set_args_from(decide, 0, "greedy_decide", U(nt), cl_uint(cur), B(s.work[cur]), B(s.work[1 - cur]),
-                    B(s.work_n), B(c.edges), B(*prio), B(s.slot[0]), B(s.blocker), B(s.queued), round, B(s.inlist),
-                    B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff));
-      ctx.launch(decide, nt, "greedy_decide");
-      set_args(block, "greedy_block", B(s.inlist), B(s.work_n), B(c.edges), B(c.nb_off), B(c.nb), B(c.nb_edge),
-               B(s.slot[0]), B(s.vstamp), round, B(s.dlist), B(s.state));
-      ctx.launch(block, nt, "greedy_block");  // over the round's taken edges (cnt[4] <= nt)
-      vertex_part(ctx, s, c, recompute, turns, *prio, cur, round);
+      one_round(nt, cur, round);
       s.work_n.download(&nt, 1, size_t(1 - cur));
       cur = 1 - cur;
     }
     if (kProfile) {
       ctx.finish();
-      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s%s\n", "greedy_round", nt,
+      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s%s\n", name, nt,
                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
                    one_group ? " (one work-group)" : "");
     }
@@ -745,6 +746,36 @@ uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
   tested = cnt[4];
   return cnt[3];
 }
+}  // namespace
+
+uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                          uint32_t& passed_q, uint32_t& tested) {
+  const std::string A = "collapse_admissible.cl";
+  cl::Kernel decide = stage_kernel(ctx, p, A, "greedy_decide"), loop = stage_kernel(ctx, p, A, "greedy_loop");
+  // the priority first: lazy_init claims the first slots in its order
+  const DeviceBuffer<double>& prio = selection_priority(ctx, c, s, p);
+  lazy_start(ctx, dm, c, s, p, prio, {{&decide, 16}, {&loop, 18}});
+  selection_buffers(ctx, dm, c, s);
+  cl::Kernel block = ctx.kernel(A, "greedy_block"), recompute = ctx.kernel(A, "lazy_p1_recompute"),
+             turns = ctx.kernel(A, "lazy_p1_turns");
+  auto one_round = [&](uint32_t nt, int cur, cl_uint round) {
+    set_args_from(decide, 0, "greedy_decide", U(nt), cl_uint(cur), B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n),
+                  B(c.edges), B(prio), B(s.slot[0]), B(s.blocker), B(s.queued), round, B(s.inlist), B(s.vstamp),
+                  B(s.dlist), B(s.state), B(s.vaff));
+    ctx.launch(decide, nt, "greedy_decide");
+    set_args(block, "greedy_block", B(s.inlist), B(s.work_n), B(c.edges), B(c.nb_off), B(c.nb), B(c.nb_edge),
+             B(s.slot[0]), B(s.vstamp), round, B(s.dlist), B(s.state));
+    ctx.launch(block, nt, "greedy_block");  // over the round's taken edges (cnt[4] <= nt)
+    vertex_part(ctx, s, c, recompute, turns, prio, cur, round);
+  };
+  auto in_one_group = [&](uint32_t nt, int cur, cl_uint round) {
+    set_args(loop, "greedy_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
+             B(prio), B(s.slot[0]), B(s.blocker), B(s.queued), B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state),
+             B(s.vaff), U(p.greedy_loop_exit), B(s.resume));
+    ctx.launch(loop, ctx.group_size_for(loop), "greedy_loop");
+  };
+  return selection_rounds(ctx, c, s, p, "greedy_round", one_round, in_one_group, passed_q, tested);
+}
 
 uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                             uint32_t& passed_q, uint32_t& tested) {
@@ -752,16 +783,10 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
   cl::Kernel decide = stage_kernel(ctx, p, M, "match_decide"), apply = stage_kernel(ctx, p, M, "match_apply"),
              loop = stage_kernel(ctx, p, M, "match_loop");
   // the priority first: lazy_init claims the first slots in its order
-  const DeviceBuffer<double>* prio = &s.cost;
-  if (p.priority_levels > 0) {
-    ensure(s.prio, ctx, c.ne);
-    run(ctx, A, "greedy_priority", c.ne, "", U(c.ne), B(s.cost), B(s.marked), p.target, p.priority_levels,
-        B(s.prio));
-    prio = &s.prio;
-  }
+  const DeviceBuffer<double>& prio = selection_priority(ctx, c, s, p);
   // the test's arguments (TCC_MATCH_PARAMS): the lazy filter's, then the live test's
   constexpr cl_uint kDecide = 19, kApply = 10, kLoop = 22, kTestArgs = 24;
-  lazy_start(ctx, dm, c, s, p, *prio, {{&decide, kDecide}, {&apply, kApply}, {&loop, kLoop}}, true);
+  lazy_start(ctx, dm, c, s, p, prio, {{&decide, kDecide}, {&apply, kApply}, {&loop, kLoop}}, true);
   s.in_place = true;
   ensure(s.tdead, ctx, std::max<size_t>(dm.nt, 1));
   ensure(s.tkill, ctx, std::max<size_t>(dm.nt, 1));
@@ -769,72 +794,29 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
   s.tdead.fill(0);
   for (auto [k, first] : {std::pair{&decide, kDecide}, {&apply, kApply}, {&loop, kLoop}})
     set_args_from(*k, first + kTestArgs, "match test", p.eps_r, p.eps_f, B(s.tdead));
-  ensure(s.fin, ctx, c.ne);
-  ensure(s.blocker, ctx, c.ne);
+  selection_buffers(ctx, dm, c, s);
   ensure(s.spec, ctx, c.ne);
-  ensure(s.queued, ctx, c.ne);
-  ensure(s.vstamp, ctx, dm.nv);
-  ensure(s.inlist, ctx, c.ne);
-  ensure(s.dlist, ctx, std::max<size_t>(dm.nv, 1));  // a vertex is listed at most once per round
-  ensure(s.work[0], ctx, c.ne);
-  ensure(s.work[1], ctx, c.ne);
-  ensure(s.work_n, ctx, 5);
-  ensure(s.resume, ctx, 3);
-  s.blocker.fill(-1);
   s.spec.fill(p.match_early_tests ? 0 : 1);  // 1: the early test counts as done
-  s.queued.fill(0xffffffffu);
-  s.vstamp.fill(0xffffffffu);
-  s.work_n.fill(0);
-  run(ctx, A, "lazy_p1_first_turns", c.ne, "", U(c.ne), B(s.cand), B(c.edges), B(s.slot[0]), B(s.work[0]), B(s.work_n),
-      B(s.verdict));
   ensure(s.slotp, ctx, dm.nv);
-  run(ctx, A, "slot_priority", dm.nv, "", U(dm.nv), B(s.slot[0]), B(*prio), B(s.slotp));
-  uint32_t nt = 0;
-  s.work_n.download(&nt, 1);
+  run(ctx, A, "slot_priority", dm.nv, "", U(dm.nv), B(s.slot[0]), B(prio), B(s.slotp));
   cl::Kernel recompute = ctx.kernel(A, "lazy_p1_recompute"), turns = ctx.kernel(A, "lazy_p1_turns");
-  int cur = 0;  // the turn list of this round
-  for (cl_uint round = 0; nt > 0; ++round) {
-    auto t0 = std::chrono::steady_clock::now();
-    s.work_n.fill(0);
-    const bool one_group = nt <= p.greedy_loop_size;
-    if (one_group) {
-      s.resume.fill(0);
-      set_args(loop, "match_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
-               B(*prio), B(s.slot[0]), B(s.slotp), B(s.blocker), B(s.spec), B(s.dround), B(s.queued), B(s.inlist),
-               B(s.vstamp),
-               B(s.dlist), B(s.state), B(s.vaff), B(s.tkill), U(p.greedy_loop_exit), B(s.resume));
-      ctx.launch(loop, ctx.group_size_for(loop), "match_loop");
-      uint32_t r[3];
-      s.resume.download(r, 3);
-      nt = r[0];  // 0: every round done; else the loop stopped before a long turn list
-      cur = int(r[1]);
-      round = r[2] - 1;
-    } else {
-      set_args_from(decide, 0, "match_decide", U(nt), cl_uint(cur), B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n),
-                    B(c.edges), B(*prio), B(s.slot[0]), B(s.slotp), B(s.blocker), B(s.spec), B(s.dround), B(s.queued),
-                    round,
-                    B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff));
-      ctx.launch(decide, nt, "match_decide");
-      set_args_from(apply, 0, "match_apply", B(s.inlist), B(s.work_n), B(c.edges), B(s.slot[0]), B(s.vstamp), round,
-                    B(s.dlist), B(s.state), B(s.vaff), B(s.tkill));
-      ctx.launch(apply, nt, "match_apply");  // over the round's taken edges (cnt[4] <= nt)
-      vertex_part(ctx, s, c, recompute, turns, *prio, cur, round, &s.slotp);
-      s.work_n.download(&nt, 1, size_t(1 - cur));
-      cur = 1 - cur;
-    }
-    if (kProfile) {
-      ctx.finish();
-      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s%s\n", "match_round", nt,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-                   one_group ? " (one work-group)" : "");
-    }
-  }
-  run(ctx, A, "greedy_finish", c.ne, "", U(c.ne), B(s.state), B(s.p1), B(s.fin), B(s.counters));
-  uint32_t cnt[6];
-  s.counters.download(cnt, 6);
-  passed_q = cnt[5];
-  tested = cnt[4];
-  return cnt[3];
+  auto one_round = [&](uint32_t nt, int cur, cl_uint round) {
+    set_args_from(decide, 0, "match_decide", U(nt), cl_uint(cur), B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n),
+                  B(c.edges), B(prio), B(s.slot[0]), B(s.slotp), B(s.blocker), B(s.spec), B(s.dround), B(s.queued),
+                  round, B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff));
+    ctx.launch(decide, nt, "match_decide");
+    set_args_from(apply, 0, "match_apply", B(s.inlist), B(s.work_n), B(c.edges), B(s.slot[0]), B(s.vstamp), round,
+                  B(s.dlist), B(s.state), B(s.vaff), B(s.tkill));
+    ctx.launch(apply, nt, "match_apply");  // over the round's taken edges (cnt[4] <= nt)
+    vertex_part(ctx, s, c, recompute, turns, prio, cur, round, &s.slotp);
+  };
+  auto in_one_group = [&](uint32_t nt, int cur, cl_uint round) {
+    set_args(loop, "match_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
+             B(prio), B(s.slot[0]), B(s.slotp), B(s.blocker), B(s.spec), B(s.dround), B(s.queued), B(s.inlist),
+             B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff), B(s.tkill), U(p.greedy_loop_exit), B(s.resume));
+    ctx.launch(loop, ctx.group_size_for(loop), "match_loop");
+  };
+  return selection_rounds(ctx, c, s, p, "match_round", one_round, in_one_group, passed_q, tested);
 }
 
 void matching_backup(Context& ctx, DeviceMesh& dm, EdgeState& s) {

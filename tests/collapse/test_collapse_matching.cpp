@@ -17,6 +17,7 @@
 #include "collapse/sequential_run.hpp"
 #include "collapse/stages.hpp"
 #include "collapse_predicate.h"
+#include "stage_inputs.hpp"
 #include "tetcollapse/check.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/io.hpp"
@@ -33,19 +34,6 @@ struct Input {
   CollapseOptions options;
   double target;
 };
-
-// Two materials, the interface the plane z = 0.5 (labels 1 below, 2 above).
-Mesh two_materials(int n) {
-  Mesh m = test::cube_tets(n);
-  Labels l{"material", {}};
-  for (int64_t t = 0; t < m.num_tets(); ++t) {
-    double z = 0;
-    for (int k = 0; k < 4; ++k) z += m.points[3 * m.tets[4 * t + k] + 2] / 4;
-    l.values.push_back(z > 0.5 ? 2 : 1);
-  }
-  m.tet_labels.push_back(l);
-  return m;
-}
 
 // The bracket (features, strict, free; with and without the quality guard), cubes with tets
 // taken away (odd links), two materials, and a shared mesh when present. No spatial order: the
@@ -76,7 +64,7 @@ std::vector<Input> inputs() {
                     2 * median_edge_length(holes)});
     }
   }
-  const Mesh two = two_materials(5);
+  const Mesh two = test::two_materials(5);
   for (auto mode : {CollapseOptions::Features, CollapseOptions::Free}) {
     CollapseOptions b = o;
     b.boundary = mode;
@@ -336,7 +324,7 @@ TEST(CollapseMatching, LinkConditionPerKindOfSurface) {
   EXPECT_TRUE(tcc_w_join_ok(B | I, B, B | TCC_RIDGE));
 
   Context ctx;
-  const Mesh m = two_materials(4);
+  const Mesh m = test::two_materials(4);
   auto vertex = [&](double x, double y, double z) {
     for (int32_t v = 0; v < int32_t(m.num_vertices()); ++v)
       if (m.points[3 * v] == x && m.points[3 * v + 1] == y && m.points[3 * v + 2] == z) return v;
@@ -350,14 +338,10 @@ TEST(CollapseMatching, LinkConditionPerKindOfSurface) {
   o.min_quality = 0;
   o.spatial_order = false;
   StageParams p = params_from(o);
-  p.target = 10;
   DeviceMesh dm;
   Connectivity c;
   EdgeState s;
-  upload_mesh(ctx, m, o, dm);
-  build_connectivity(ctx, dm, c, p);
-  cost_and_mark(ctx, dm, c, s, p);
-  admissible(ctx, dm, c, s, p);
+  test::run_to_admissible(ctx, m, p, 10, dm, c, s);
   const std::vector<int32_t> edges = c.edges.download_range(0, 2 * size_t(c.ne));
   const std::vector<uint8_t> reason = s.reason.download_range(0, c.ne), eflags = c.eflags.download_range(0, c.ne);
   int32_t e = -1;
@@ -389,7 +373,7 @@ TEST(CollapseMatching, WholeRunsValidDeterministicAndInFewerIterations) {
   CollapseOptions two;
   two.boundary = CollapseOptions::Free;
   two.target_factor = 3;
-  runs.push_back({"two materials, free", two_materials(6), two, 0});
+  runs.push_back({"two materials, free", test::two_materials(6), two, 0});
   const std::string bimetal = test::shared_mesh("polyfem_bimetal.msh");
   if (!bimetal.empty()) {
     CollapseOptions o;

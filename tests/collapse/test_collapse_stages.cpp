@@ -264,14 +264,7 @@ TEST(CollapseAdmissible, VolumeTestMatchesHostReference) {
 
 TEST(CollapseAdmissible, MaterialInterfaceIsProtected) {
   Context ctx;
-  Mesh m = test::cube_tets(4);
-  Labels l{"material", {}};
-  for (int64_t t = 0; t < m.num_tets(); ++t) {
-    double z = 0;
-    for (int k = 0; k < 4; ++k) z += m.points[3 * m.tets[4 * t + k] + 2] / 4;
-    l.values.push_back(z > 0.5 ? 2 : 1);
-  }
-  m.tet_labels.push_back(l);
+  const Mesh m = test::two_materials(4);
   Staged with(ctx, m, CollapseOptions{}, 10.0);
   CollapseOptions nolab;
   nolab.use_labels = false;

@@ -90,6 +90,18 @@ Mesh single_tet() {
 
 Mesh cube_tets(int n) { return make_cube_mesh(n); }
 
+Mesh two_materials(int n) {
+  Mesh m = cube_tets(n);
+  Labels l{"material", {}};
+  for (int64_t t = 0; t < m.num_tets(); ++t) {
+    double z = 0;
+    for (int k = 0; k < 4; ++k) z += m.points[3 * m.tets[4 * t + k] + 2] / 4;
+    l.values.push_back(z > 0.5 ? 2 : 1);
+  }
+  m.tet_labels.push_back(l);
+  return m;
+}
+
 Mesh sub_mesh(const Mesh& m, const std::function<bool(int64_t)>& keep) {
   Mesh out;
   std::vector<int32_t> map(size_t(m.num_vertices()), -1);

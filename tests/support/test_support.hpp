@@ -54,6 +54,7 @@ std::string read_text(const std::string& path);
 Mesh single_tet();             // the unit right-corner tet, positively oriented
 Mesh cube_tets(int n);         // [0,1]^3 split into n^3 cubes of 6 tets each (Kuhn), labels none
 Mesh slab(int n);              // the bottom layer of cube_tets(n): one tet thick, every vertex on the boundary
+Mesh two_materials(int n);     // cube_tets(n) with labels 1 below z = 0.5 and 2 above (an interface plane)
 // The tets t of m with keep(t), in order, with only their vertices (renumbered in order of use).
 Mesh sub_mesh(const Mesh& m, const std::function<bool(int64_t)>& keep);
 // m closed by a cone: a new last vertex at (x, y, z) joined by a tet to every boundary face (each
