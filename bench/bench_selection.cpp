@@ -8,9 +8,10 @@
 // N repetitions and the counts (taken, tests), which a change that keeps the decisions keeps.
 //
 //   bench_selection [MESH] [--runs N] [--iteration K] [--target-factor F] [--min-quality Q]
-//                   [--priority-levels L] [--no-early-tests]
+//                   [--priority-levels L] [--no-early-tests] [--loop SIZE EXIT]
 // Defaults: W1's mesh (robot 514k) and target (2 x median edge length), 7 runs, iteration 0,
-// min_quality 0.
+// min_quality 0; --loop: the rounds run in one work-group once a turn list holds at most SIZE
+// edges, back to per-round kernels above EXIT (StageParams::greedy_loop_size, greedy_loop_exit).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
