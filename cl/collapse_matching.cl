@@ -97,25 +97,25 @@ inline int tcc_live_dir(int a, int b, __global const int* tets, __global const u
                         __global const int* tet_nbr, __global const int* labels, int use_labels,
                         __global const double* pts, __global const uchar* tdead, __global const uchar* vflags,
                         int mode, int paper_rule, double eps_r, double eps_f, uint* fa, uint* fb, uint* fe) {
-  int after[2][TCC_MAX_VERTEX_SFACES], before[2][TCC_MAX_VERTEX_SFACES];
-  uchar kind[2][TCC_MAX_VERTEX_SFACES];
-  double3 normal[2][TCC_MAX_VERTEX_SFACES];
-  int fn[2], cls[2];
-  uint fv[2];
-  for (int s = 0; s < 2; ++s) {
+  /* b first, then a in the same arrays (the edge's flags come from a's S-faces) */
+  int after[TCC_MAX_VERTEX_SFACES], before[TCC_MAX_VERTEX_SFACES];
+  uchar kind[TCC_MAX_VERTEX_SFACES];
+  double3 normal[TCC_MAX_VERTEX_SFACES];
+  int cls[2];
+  uint fv[2], f = 0;
+  for (int s = 1; s >= 0; --s) {
     const int v = s == 0 ? a : b;
-    fn[s] = vflags[v] ? tcc_live_sfaces(v, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, tdead, after[s],
-                                        before[s], kind[s], normal[s])
-                      : 0;
-    if (fn[s] < 0) return -1;
+    const int fn = vflags[v] ? tcc_live_sfaces(v, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, tdead, after,
+                                               before, kind, normal)
+                             : 0;
+    if (fn < 0) return -1;
     fv[s] = 0;
-    for (int j = 0; j < fn[s]; ++j) fv[s] |= kind[s][j];
-    cls[s] = fn[s] == 0 ? TCC_INTERIOR : tc_sf_class(after[s], before[s], normal[s], fn[s], eps_r, eps_f);
-  }
-  uint f = 0;
-  if (fv[0] && fv[1]) {
-    int ridge = 0;
-    f = tc_sf_edge(b, after[0], before[0], kind[0], normal[0], fn[0], eps_r, &ridge) | (ridge ? TCC_RIDGE : 0u);
+    for (int j = 0; j < fn; ++j) fv[s] |= kind[j];
+    cls[s] = fn == 0 ? TCC_INTERIOR : tc_sf_class(after, before, normal, fn, eps_r, eps_f);
+    if (s == 0 && fv[0] && fv[1]) {
+      int ridge = 0;
+      f = tc_sf_edge(b, after, before, kind, normal, fn, eps_r, &ridge) | (ridge ? TCC_RIDGE : 0u);
+    }
   }
   *fa = fv[0];
   *fb = fv[1];
