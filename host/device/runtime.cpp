@@ -1,12 +1,17 @@
 // OpenCL runtime: listing, selection, context, program build with the on-disk binary cache.
 #include <algorithm>
 #include <cctype>
+#include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "device/program_cache.hpp"
 #include "tetcollapse/device.hpp"
@@ -329,13 +334,61 @@ size_t Context::group_size_for(const cl::Kernel& kernel) const {
   return p;
 }
 
+namespace {
+// TETCOLLAPSE_PROFILE_KERNELS=1: every launch waits for its kernel, and the wall time is summed
+// per launch name; the table (slowest first) goes to stderr when the process ends. For finding
+// where a run's time goes: the waits remove the overlap of launches with the host, so totals run
+// a little above a normal run's.
+struct KernelProfile {
+  struct Entry {
+    double seconds = 0;
+    long launches = 0;
+    long items = 0;
+  };
+  std::mutex m;
+  std::map<std::string, Entry> table;
+  ~KernelProfile() {
+    if (table.empty()) return;
+    std::vector<std::pair<std::string, Entry>> rows(table.begin(), table.end());
+    std::sort(rows.begin(), rows.end(), [](const auto& x, const auto& y) { return x.second.seconds > y.second.seconds; });
+    double total = 0;
+    for (const auto& r : rows) total += r.second.seconds;
+    std::fprintf(stderr, "kernel profile (TETCOLLAPSE_PROFILE_KERNELS): %.4f s in %zu kernels\n", total, rows.size());
+    std::fprintf(stderr, "  %-36s %10s %6s %10s %12s\n", "launch", "seconds", "share", "launches", "launched");
+    for (const auto& [name, e] : rows)
+      std::fprintf(stderr, "  %-36s %10.4f %5.1f%% %10ld %12ld\n", name.c_str(), e.seconds,
+                   total > 0 ? 100 * e.seconds / total : 0.0, e.launches, e.items);
+  }
+};
+KernelProfile* kernel_profile() {
+  static const bool on = [] {
+    const char* e = std::getenv("TETCOLLAPSE_PROFILE_KERNELS");
+    return e && *e && std::strcmp(e, "0") != 0;
+  }();
+  if (!on) return nullptr;
+  static KernelProfile profile;
+  return &profile;
+}
+}  // namespace
+
 void Context::launch(cl::Kernel& kernel, size_t n, const char* what, size_t local) {
   if (n == 0) return;
   if (local == 0) local = group_size_for(kernel);
   size_t global = (n + local - 1) / local * local;
+  KernelProfile* prof = kernel_profile();
+  if (prof) finish();  // the time of this launch alone
+  const auto t0 = std::chrono::steady_clock::now();
   detail::cl_call(what, [&] {
     queue_.enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(global), cl::NDRange(local));
   });
+  if (!prof) return;
+  finish();
+  const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::lock_guard<std::mutex> lock(prof->m);
+  KernelProfile::Entry& e = prof->table[what];
+  e.seconds += dt;
+  e.launches += 1;
+  e.items += long(n);
 }
 
 void Context::finish() {

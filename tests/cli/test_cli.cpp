@@ -207,6 +207,21 @@ TEST(Cli, CoarsenWritesAValidMeshAndStats) {
   EXPECT_TRUE(out.empty()) << out;
 }
 
+// TETCOLLAPSE_PROFILE_KERNELS=1: the per-kernel table on stderr at the end, with the stages'
+// kernels in it, and the same output mesh as without it (the waits change no decision).
+TEST(Cli, KernelProfileTableAndTheSameResult) {
+  tc::test::TempDir dir;
+  std::string out;
+  const std::string in = q(tc::test::project_mesh("bracket.msh")), a = dir.file("a.vtu"), b = dir.file("b.vtu");
+  ASSERT_EQ(run_command("TETCOLLAPSE_PROFILE_KERNELS=1 " + cli() + " " + in + " " + q(a) + " -q", &out), 0) << out;
+  EXPECT_NE(out.find("kernel profile (TETCOLLAPSE_PROFILE_KERNELS)"), std::string::npos) << out;
+  for (const char* k : {"match_decide", "match_apply", "conn_ring_sort_and_gather", "cost_and_mark", "sguard_surface"})
+    EXPECT_NE(out.find(std::string("\n  ") + k + " "), std::string::npos) << k << " not in " << out;
+  ASSERT_EQ(run_command(cli() + " " + in + " " + q(b) + " -q", &out), 0) << out;
+  EXPECT_TRUE(out.empty()) << out;  // off by default: quiet stays quiet
+  EXPECT_EQ(tc::test::read_text(a), tc::test::read_text(b));
+}
+
 }  // namespace
 
 namespace {
