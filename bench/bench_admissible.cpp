@@ -6,8 +6,9 @@
 // the test can be timed on its own. Prints the median of N launches and the verdict counts
 // (which a change that keeps the decisions must keep).
 //
-//   bench_admissible [MESH] [--runs N] [--target-factor F] [--min-quality Q]
-// Defaults: W1's mesh (robot 514k) and target (2 x median edge length), 7 runs, min_quality 0.
+//   bench_admissible [MESH] [--runs N] [--target-factor F] [--min-quality Q] [--priority-levels L]
+// Defaults (bench_stage_setup.hpp): W1's mesh (robot 514k) and target (2 x median edge length),
+// 7 runs, min_quality 0.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -16,43 +17,19 @@
 #include <string>
 #include <vector>
 
-#include "collapse/stages.hpp"
-#include "tetcollapse/collapse.hpp"
-#include "tetcollapse/io.hpp"
+#include "bench_stage_setup.hpp"
 
 using namespace tc;
 using namespace tc::collapse_detail;
 
 int main(int argc, char** argv) {
-  std::string path = std::string(TC_SHARED_MESHES) + "/gen_tetgen_thingi255172_make-robot_514k.msh";
-  int runs = 7;
-  CollapseOptions o;
-  o.target_factor = 2;
-  o.min_quality = 0;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--target-factor") && i + 1 < argc) o.target_factor = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--min-quality") && i + 1 < argc) o.min_quality = std::atof(argv[++i]);
-    else if (argv[i][0] == '-') {
-      std::fprintf(stderr, "bench_admissible: unknown option or missing value: %s\n", argv[i]);
-      return 2;
-    } else path = argv[i];
-  }
-  Mesh mesh;
-  try {
-    mesh = read_mesh(path);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_admissible: cannot read %s: %s\n", path.c_str(), e.what());
-    return 1;
-  }
-  Context ctx;
-  StageParams p = params_from(o);
-  p.target = o.target_factor * median_edge_length(mesh);
-  DeviceMesh dm;
-  std::vector<int32_t> vertex_new;  // in the spatial order collapse() uses by default
-  upload_mesh(ctx, mesh, o, dm, o.spatial_order ? &vertex_new : nullptr);
-  Connectivity c;
-  build_connectivity(ctx, dm, c, p);
+  bench::StageBenchArgs a;
+  if (int rc = bench::parse_stage_args("bench_admissible", argc, argv, a); rc >= 0) return rc;
+  bench::StageBench b;
+  if (!bench::load_stage_bench("bench_admissible", a, b)) return 1;
+  auto& [mesh, ctx, p, dm, vertex_new, c] = b;
+  const std::string& path = a.path;
+  const int runs = a.runs;
   EdgeState s;
   const uint32_t marked = cost_and_mark(ctx, dm, c, s, p);
   std::printf("mesh %s\ndevice %s\n%u edges, %u marked; target %g, min_quality %g\n", path.c_str(),

@@ -24,7 +24,7 @@
 //
 //   bench_conflict_rule [MESH] [--target-factor F] [--min-quality Q] [--priority-levels L]
 //                       [--whole-run [--out PREFIX]]
-// Defaults: W1's mesh (robot 514k), 2 x median edge length, min_quality 0.
+// Defaults (bench_stage_setup.hpp): W1's mesh (robot 514k), 2 x median edge length, min_quality 0.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -37,49 +37,30 @@
 #include "collapse/sequential_mesh.hpp"
 #include "collapse_predicate.h"
 #include "collapse/sequential_run.hpp"
-#include "collapse/stages.hpp"
-#include "tetcollapse/collapse.hpp"
-#include "tetcollapse/io.hpp"
+#include "bench_stage_setup.hpp"
 
 using namespace tc;
 using namespace tc::collapse_detail;
 
 int main(int argc, char** argv) {
-  std::string path = std::string(TC_SHARED_MESHES) + "/gen_tetgen_thingi255172_make-robot_514k.msh";
-  CollapseOptions o;
-  o.target_factor = 2;
-  o.min_quality = 0;
+  bench::StageBenchArgs a;
   bool whole_run = false;
   std::string out_prefix;  // with --whole-run: each rule's final mesh to PREFIX{current,checked}.vtu
-  for (int i = 1; i < argc; ++i) {
+  auto own = [&](int& i) {
     if (!std::strcmp(argv[i], "--whole-run")) {
       whole_run = true;
-      continue;
+      return true;
     }
-    if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out_prefix = argv[++i];
-    else if (!std::strcmp(argv[i], "--target-factor") && i + 1 < argc) o.target_factor = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--priority-levels") && i + 1 < argc) o.priority_levels = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--min-quality") && i + 1 < argc) o.min_quality = std::atof(argv[++i]);
-    else if (argv[i][0] == '-') {
-      std::fprintf(stderr, "bench_conflict_rule: unknown option or missing value: %s\n", argv[i]);
-      return 2;
-    } else path = argv[i];
-  }
-  Mesh mesh;
-  try {
-    mesh = read_mesh(path);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_conflict_rule: cannot read %s: %s\n", path.c_str(), e.what());
-    return 1;
-  }
-  Context ctx;
-  StageParams p = params_from(o);
-  p.target = o.target_factor * median_edge_length(mesh);
-  DeviceMesh dm;
-  std::vector<int32_t> vertex_new;
-  upload_mesh(ctx, mesh, o, dm, o.spatial_order ? &vertex_new : nullptr);
-  Connectivity c;
-  build_connectivity(ctx, dm, c, p);
+    if (std::strcmp(argv[i], "--out") || i + 1 >= argc) return false;
+    out_prefix = argv[++i];
+    return true;
+  };
+  if (int rc = bench::parse_stage_args("bench_conflict_rule", argc, argv, a, own, false); rc >= 0) return rc;
+  bench::StageBench b;
+  if (!bench::load_stage_bench("bench_conflict_rule", a, b)) return 1;
+  auto& [mesh, ctx, p, dm, vertex_new, c] = b;
+  CollapseOptions& o = a.options;
+  const std::string& path = a.path;
   EdgeState s;
   const uint32_t marked = cost_and_mark(ctx, dm, c, s, p);
   const uint32_t adm = admissible(ctx, dm, c, s, p);

@@ -9,9 +9,10 @@
 //
 //   bench_selection [MESH] [--runs N] [--iteration K] [--target-factor F] [--min-quality Q]
 //                   [--priority-levels L] [--no-early-tests] [--loop SIZE EXIT]
-// Defaults: W1's mesh (robot 514k) and target (2 x median edge length), 7 runs, iteration 0,
-// min_quality 0; --loop: the rounds run in one work-group once a turn list holds at most SIZE
-// edges, back to per-round kernels above EXIT (StageParams::greedy_loop_size, greedy_loop_exit).
+// Defaults (bench_stage_setup.hpp): W1's mesh (robot 514k) and target (2 x median edge length),
+// 7 runs, iteration 0, min_quality 0; --loop: the rounds run in one work-group once a turn list
+// holds at most SIZE edges, back to per-round kernels above EXIT (StageParams::greedy_loop_size,
+// greedy_loop_exit).
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -20,9 +21,7 @@
 #include <string>
 #include <vector>
 
-#include "collapse/stages.hpp"
-#include "tetcollapse/collapse.hpp"
-#include "tetcollapse/io.hpp"
+#include "bench_stage_setup.hpp"
 
 using namespace tc;
 using namespace tc::collapse_detail;
@@ -45,61 +44,45 @@ struct Timing {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string path = std::string(TC_SHARED_MESHES) + "/gen_tetgen_thingi255172_make-robot_514k.msh";
-  int runs = 7, iteration = 0;
-  CollapseOptions o;
-  o.target_factor = 2;
-  o.min_quality = 0;
+  bench::StageBenchArgs a;
+  int iteration = 0;
   bool early = true;
   uint32_t loop_size = StageParams{}.greedy_loop_size, loop_exit = StageParams{}.greedy_loop_exit;
-  for (int i = 1; i < argc; ++i) {
+  auto own = [&](int& i) {
     if (!std::strcmp(argv[i], "--no-early-tests")) {
       early = false;
-      continue;
+      return true;
     }
-    if (!std::strcmp(argv[i], "--runs") && i + 1 < argc) runs = std::max(1, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--iteration") && i + 1 < argc) iteration = std::max(0, std::atoi(argv[++i]));
-    else if (!std::strcmp(argv[i], "--target-factor") && i + 1 < argc) o.target_factor = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--min-quality") && i + 1 < argc) o.min_quality = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--priority-levels") && i + 1 < argc) o.priority_levels = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--loop") && i + 2 < argc) {
-      loop_size = uint32_t(std::atoi(argv[++i]));
-      loop_exit = uint32_t(std::atoi(argv[++i]));
+    if (!std::strcmp(argv[i], "--iteration") && i + 1 < argc) {
+      iteration = std::max(0, std::atoi(argv[++i]));
+      return true;
     }
-    else if (argv[i][0] == '-') {
-      std::fprintf(stderr, "bench_selection: unknown option or missing value: %s\n", argv[i]);
-      return 2;
-    } else path = argv[i];
-  }
-  Mesh mesh;
-  try {
-    mesh = read_mesh(path);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "bench_selection: cannot read %s: %s\n", path.c_str(), e.what());
-    return 1;
-  }
-  Context ctx;
-  StageParams p = params_from(o);
-  p.target = o.target_factor * median_edge_length(mesh);
+    if (std::strcmp(argv[i], "--loop") || i + 2 >= argc) return false;
+    loop_size = uint32_t(std::atoi(argv[++i]));
+    loop_exit = uint32_t(std::atoi(argv[++i]));
+    return true;
+  };
+  if (int rc = bench::parse_stage_args("bench_selection", argc, argv, a, own); rc >= 0) return rc;
+  bench::StageBench b;
+  if (!bench::load_stage_bench("bench_selection", a, b)) return 1;
+  auto& [mesh, ctx, p, dm, vertex_new, c] = b;
+  const std::string& path = a.path;
+  const int runs = a.runs;
   p.match_early_tests = early;
   p.greedy_loop_size = loop_size;
   p.greedy_loop_exit = loop_exit;
-  DeviceMesh dm, next;
-  std::vector<int32_t> vertex_new;  // in the spatial order collapse() uses by default
-  upload_mesh(ctx, mesh, o, dm, o.spatial_order ? &vertex_new : nullptr);
-  Connectivity c;
+  DeviceMesh next;
   EdgeState s;
   DeviceBuffer<int32_t> origin(ctx, 1);
   uint32_t passed_q = 0, tested = 0;
   for (int it = 0; it < iteration; ++it) {  // the earlier iterations, matching
-    build_connectivity(ctx, dm, c, p);
     cost_and_mark(ctx, dm, c, s, p);
     s.verdict_ready = false;
     matching_backup(ctx, dm, s);
     matching_selection(ctx, dm, c, s, p, passed_q, tested);
     collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
+    build_connectivity(ctx, dm, c, p);
   }
-  build_connectivity(ctx, dm, c, p);
   const uint32_t marked = cost_and_mark(ctx, dm, c, s, p);
   std::printf("mesh %s\ndevice %s\niteration %d: %u vertices, %u tets, %u edges, %u marked; target %g, min_quality %g, "
               "priority levels %g, early tests %s\n",
