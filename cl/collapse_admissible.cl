@@ -439,7 +439,7 @@ __kernel void greedy_block(__global const uint* inlist, __global uint* cnt, __gl
                            __global const uint* nb_off, __global const int* nb, __global const int* nb_edge,
                            __global const int* slot, volatile __global uint* vstamp, uint round, __global uint* dlist,
                            __global uchar* state) {
-  uint i = get_global_id(0);
+  uint i = tcc_spread_index();
   if (i >= cnt[4]) return;
   tcc_greedy_block((int)inlist[i], edges, nb_off, nb, nb_edge, slot, vstamp, round, dlist, cnt + 2, state);
 }

@@ -294,7 +294,7 @@ inline void tcc_match_apply(int e, __global const int* edges, __global const int
 __kernel void match_apply(__global const uint* inlist, __global uint* cnt, __global const int* edges,
                           __global const int* slot, volatile __global uint* vstamp, uint round, __global uint* dlist,
                           __global uchar* state, __global int* vaff, __global int* tkill, TCC_MATCH_PARAMS) {
-  uint i = get_global_id(0);
+  uint i = tcc_spread_index();
   if (i >= cnt[4]) return;
   tcc_match_apply((int)inlist[i], edges, slot, vstamp, round, dlist, cnt + 2, state, vaff, tkill, TCC_MATCH_ARGS);
 }

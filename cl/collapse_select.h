@@ -462,6 +462,14 @@ inline void tcc_prefetch_test(uint i, uint n, __global const uint* tlist, __glob
 }
 #endif
 
+/* The entry of a list of unknown length m <= the launch's size that work item takes: the local
+ * id times the number of work-groups plus the group's id (a bijection on the launch), so the
+ * first m entries are spread over every work-group. Indexed by the global id, they would all
+ * fall in the first few groups, which the CPU drivers run on one thread: PoCL hands each thread
+ * a range of consecutive work-groups (W1: match_apply, launched over the turn list for the
+ * ~10% of it taken, ran no faster on two cores than on one). */
+inline uint tcc_spread_index(void) { return (uint)(get_local_id(0) * get_num_groups(0) + get_group_id(0)); }
+
 inline void tcc_greedy_list_vertex(int v, volatile __global uint* vstamp, uint round, __global uint* dlist,
                                    __global uint* dn) {
   if (atomic_xchg(vstamp + v, round) != round) dlist[atomic_inc(dn)] = (uint)v;

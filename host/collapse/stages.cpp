@@ -573,7 +573,7 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kerne
       set_args(loop, "lazy_p1_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(s.dlist),
                B(s.queued), B(c.edges), B(s.cost), B(s.slot[0]), B(s.state), B(s.vaff), cl_uint(p.loop_exit_tests),
                B(s.resume));
-      ctx.launch(loop, ctx.group_size_for(loop), "lazy_p1_loop");
+      ctx.launch_one_group(loop, "lazy_p1_loop");
       uint32_t r[3];
       s.resume.download(r, 3);
       nt = r[0];  // 0: every round done; else the loop stopped before a list with many to test
@@ -772,7 +772,7 @@ uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
     set_args(loop, "greedy_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
              B(prio), B(s.slot[0]), B(s.blocker), B(s.queued), B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state),
              B(s.vaff), U(p.greedy_loop_exit), B(s.resume));
-    ctx.launch(loop, ctx.group_size_for(loop), "greedy_loop");
+    ctx.launch_one_group(loop, "greedy_loop");
   };
   return selection_rounds(ctx, c, s, p, "greedy_round", one_round, in_one_group, passed_q, tested);
 }
@@ -814,7 +814,7 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
     set_args(loop, "match_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
              B(prio), B(s.slot[0]), B(s.slotp), B(s.blocker), B(s.spec), B(s.dround), B(s.queued), B(s.inlist),
              B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff), B(s.tkill), U(p.greedy_loop_exit), B(s.resume));
-    ctx.launch(loop, ctx.group_size_for(loop), "match_loop");
+    ctx.launch_one_group(loop, "match_loop");
   };
   return selection_rounds(ctx, c, s, p, "match_round", one_round, in_one_group, passed_q, tested);
 }
@@ -904,7 +904,7 @@ uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s
   auto tail = [&](uint32_t m, cl_int first, int cur) {
     set_args(loop, "conflict_pass2_loop", U(m), first, cl_int(cur), B(s.work[0]), B(s.work[1]), B(s.work_n),
              B(s.cand_edges), B(s.rivals), B(s.rcount));
-    ctx.launch(loop, ctx.group_size_for(loop), "conflict_pass2_loop");
+    ctx.launch_one_group(loop, "conflict_pass2_loop");
   };
   rounds(
       ctx, s, n, "conflict_pass2_round",

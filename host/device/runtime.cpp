@@ -371,9 +371,20 @@ KernelProfile* kernel_profile() {
 }
 }  // namespace
 
+void Context::launch_one_group(cl::Kernel& kernel, const char* what) {
+  const size_t local = group_size_for(kernel);
+  launch(kernel, local, what, local);
+}
+
 void Context::launch(cl::Kernel& kernel, size_t n, const char* what, size_t local) {
   if (n == 0) return;
-  if (local == 0) local = group_size_for(kernel);
+  if (local == 0) {
+    local = group_size_for(kernel);
+    if (work_group_size_ == 0 && info_.type == "CPU") {
+      const size_t min_groups = 4 * size_t(std::max<uint32_t>(info_.compute_units, 1));
+      while (local > 1 && (n + local - 1) / local < min_groups) local /= 2;
+    }
+  }
   size_t global = (n + local - 1) / local * local;
   KernelProfile* prof = kernel_profile();
   if (prof) finish();  // the time of this launch alone

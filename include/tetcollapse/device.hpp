@@ -96,8 +96,13 @@ class Context {
 
   // Enqueues a 1-D launch of n work items: the global size is n rounded up to a multiple of the
   // work-group size, so kernels must check their global id against n. `what` names the kernel
-  // in error messages. local = 0 means group_size_for(kernel).
+  // in error messages. local = 0 means group_size_for(kernel), on a CPU device with no size set
+  // (set_work_group_size) halved while the launch would have fewer than 4 work-groups per
+  // compute unit: the CPU drivers run a work-group on one thread, so a small launch in one or
+  // two large groups would leave cores idle (W1's chunked scans: 126 items in one group).
   void launch(cl::Kernel& kernel, size_t n, const char* what, size_t local = 0);
+  // Enqueues one work-group of group_size_for(kernel) items (kernels that loop with barriers).
+  void launch_one_group(cl::Kernel& kernel, const char* what);
   void finish();
 
   // Where compiled binaries are cached: $TETCOLLAPSE_CACHE_DIR, else $XDG_CACHE_HOME/tetcollapse,

@@ -136,6 +136,64 @@ TEST_F(RuntimeCtx, LaunchErrorsNameTheCallTheKernelAndTheError) {
   for (uint32_t i = 0; i < 16; ++i) EXPECT_EQ(v[i], i);
 }
 
+// The work-group layout of launches. On a CPU device with no size set, a small launch is split
+// into at least 4 work-groups per compute unit (the drivers run a group on one thread); a
+// launch given its size keeps it; launch_one_group makes one group of group_size_for items.
+// tcc_spread_index (collapse_select.h) is a bijection on the launch that puts the first m
+// entries of a list, for any m, as evenly as it can over every group.
+TEST_F(RuntimeCtx, WorkGroupLayoutOfSmallLaunchesAndTheSpreadIndex) {
+  const char* src = R"(#include "collapse_select.h"
+__kernel void layout(__global uint* out, uint n) {
+  uint i = get_global_id(0);
+  if (i == 0) { out[0] = (uint)get_num_groups(0); out[1] = (uint)get_local_size(0); }
+  if (i < get_global_size(0)) { out[2 + 2 * i] = tcc_spread_index(); out[3 + 2 * i] = (uint)get_group_id(0); }
+})";
+  cl::Program& p = ctx_->build("layout_test", src);
+  cl::Kernel k(p, "layout");
+  const size_t cap = 2 + 2 * 4096;
+  tc::DeviceBuffer<uint32_t> out(*ctx_, cap);
+  k.setArg(0, out.buffer());
+  const bool cpu = ctx_->info().type == "CPU";
+  const size_t cu = std::max<uint32_t>(ctx_->info().compute_units, 1), full = ctx_->group_size_for(k);
+  for (size_t n : {size_t(1), size_t(7), size_t(126), size_t(1000), size_t(4096)}) {
+    k.setArg(1, cl_uint(n));
+    out.fill(0xffffffffu);
+    ctx_->launch(k, n, "layout");
+    std::vector<uint32_t> v = out.download();
+    const size_t groups = v[0], local = v[1], global = groups * local;
+    ASSERT_GE(global, n);
+    ASSERT_LE(global, cap / 2 - 1);
+    size_t want = full;  // halved only while there are too few groups, on a CPU
+    while (cpu && want > 1 && (n + want - 1) / want < 4 * cu) want /= 2;
+    EXPECT_EQ(local, want) << "n " << n;
+    if (cpu && local > 1) {
+      EXPECT_GE(groups, 4 * cu) << "n " << n << ": " << groups << " groups of " << local;
+    }
+    // the spread index: a permutation of 0 .. global-1; the first m of it in every group or
+    // none, for m = groups (one each) and m = 2 x groups (two each, where local >= 2)
+    std::vector<int> seen(global, 0), per_group(groups, 0);
+    for (size_t i = 0; i < global; ++i) {
+      const uint32_t j = v[2 + 2 * i];
+      ASSERT_LT(j, global);
+      ++seen[j];
+      if (j < groups) ++per_group[v[3 + 2 * i]];
+    }
+    for (size_t j = 0; j < global; ++j) EXPECT_EQ(seen[j], 1) << "index " << j << " taken " << seen[j] << " times";
+    for (size_t g = 0; g < groups; ++g) EXPECT_EQ(per_group[g], 1) << "group " << g;
+  }
+  // a launch given its work-group size keeps it; one group on request
+  k.setArg(1, cl_uint(64));
+  const size_t small = std::min<size_t>(full, 8);
+  ctx_->launch(k, 64, "layout", small);
+  std::vector<uint32_t> v = out.download();
+  EXPECT_EQ(v[1], small);
+  EXPECT_EQ(v[0], (64 + small - 1) / small);
+  ctx_->launch_one_group(k, "layout");
+  v = out.download();
+  EXPECT_EQ(v[0], 1u);
+  EXPECT_EQ(v[1], full);
+}
+
 TEST_F(RuntimeCtx, BuildFailureCarriesTheBuildLog) {
   std::string m = message_of([&] { ctx_->build("broken_test", "__kernel void k(__global int* a) { a[0] = undeclared_thing; }"); });
   EXPECT_NE(m.find("clBuildProgram(broken_test): CL_BUILD_PROGRAM_FAILURE"), std::string::npos) << m;
