@@ -210,13 +210,12 @@ inline void tcc_match_decide(int e, __global const int* edges, __global const do
       if (r != TCC_OK) { /* refused: a and b need their next edge */
         reason[e] = r;
         state[e] = TCC_OUT;
-        tcc_greedy_list_vertex(a, vstamp, round, dlist, dn);
-        tcc_greedy_list_vertex(b, vstamp, round, dlist, dn);
+        tcc_refused_ends(a, b, vstamp, round, dlist, dn);
         return;
       }
     }
   }
-  if (atomic_xchg(queued + e, round + 1) != round + 1) tnext[atomic_inc(tn)] = (uint)e;
+  tcc_requeue(e, queued, round, tnext, tn);
 }
 
 __kernel void match_decide(uint n, uint cur, __global const uint* tlist, __global uint* tnext, __global uint* cnt,

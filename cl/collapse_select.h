@@ -475,4 +475,15 @@ inline void tcc_greedy_list_vertex(int v, volatile __global uint* vstamp, uint r
   if (atomic_xchg(vstamp + v, round) != round) dlist[atomic_inc(dn)] = (uint)v;
 }
 
+/* The tails of the greedy and matching decisions: a refused edge (a, b) lists both end points,
+ * whose slots need their next edge; a waiting edge e goes to the next turn list once. */
+inline void tcc_refused_ends(int a, int b, volatile __global uint* vstamp, uint round, __global uint* dlist,
+                             __global uint* dn) {
+  tcc_greedy_list_vertex(a, vstamp, round, dlist, dn);
+  tcc_greedy_list_vertex(b, vstamp, round, dlist, dn);
+}
+inline void tcc_requeue(int e, volatile __global uint* queued, uint round, __global uint* tnext, __global uint* tn) {
+  if (atomic_xchg(queued + e, round + 1) != round + 1) tnext[atomic_inc(tn)] = (uint)e;
+}
+
 #endif
