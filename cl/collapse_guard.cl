@@ -324,11 +324,15 @@ inline void tcc_sg_load_box(__global const double* tbox, uint n, double3* lo, do
   *hi = vload3(2 * n + 1, tbox);
 }
 
+/* Are the box [lo, hi] and the box b (6 doubles: its low corner, then its high corner) apart? */
+inline int tcc_sg_box_apart(double3 lo, double3 hi, __global const double* b) {
+  return lo.x > b[3] || lo.y > b[4] || lo.z > b[5] || b[0] > hi.x || b[1] > hi.y || b[2] > hi.z;
+}
+
 /* Are the box [lo, hi] and the box of new triangle n (tbox, written by sguard_tris) apart? The
  * filter before a triangle pair's test, read before the triangle itself. */
 inline int tcc_sg_tri_box_apart(double3 lo, double3 hi, __global const double* tbox, uint n) {
-  __global const double* b = tbox + 6 * n;
-  return lo.x > b[3] || lo.y > b[4] || lo.z > b[5] || b[0] > hi.x || b[1] > hi.y || b[2] > hi.z;
+  return tcc_sg_box_apart(lo, hi, tbox + 6 * n);
 }
 
 /* The uniform grid of the query boxes (built by the host): cell (i, j, k) of size 1 / ih from
@@ -349,8 +353,7 @@ inline int tcc_sg_cell(double v, double org, double ih, int n) {
 inline int tcc_sg_owner_cell(double3 alo, double3 ahi, int i0, int j0, int k0, __global const double* b,
                              __global const int* qcell, int i, int j, int k) {
   if (max(i0, qcell[0]) != i || max(j0, qcell[1]) != j || max(k0, qcell[2]) != k) return 0;
-  double3 blo = (double3)(b[0], b[1], b[2]), bhi = (double3)(b[3], b[4], b[5]);
-  return !(alo.x > bhi.x || alo.y > bhi.y || alo.z > bhi.z || blo.x > ahi.x || blo.y > ahi.y || blo.z > ahi.z);
+  return !tcc_sg_box_apart(alo, ahi, b);
 }
 
 /* Loop over the queries entered in the grid cells that the box [LO, HI] overlaps: the body
@@ -567,11 +570,9 @@ __kernel void sguard_requery(uint nq, __global const int* qedge, __global const 
   if (q >= nq) return;
   __global const double* b = qbox + 6 * q;
   const double3 lo = (double3)(b[0], b[1], b[2]), hi = (double3)(b[3], b[4], b[5]);
-  for (uint i = 0; i < nu; ++i) {
-    const double3 ulo = vload3(2 * i, boxes), uhi = vload3(2 * i + 1, boxes);
-    if (!(lo.x > uhi.x || lo.y > uhi.y || lo.z > uhi.z || ulo.x > hi.x || ulo.y > hi.y || ulo.z > hi.z)) {
+  for (uint i = 0; i < nu; ++i)
+    if (!tcc_sg_box_apart(lo, hi, boxes + 6 * i)) { /* vstore3(lo, 2 i), vstore3(hi, 2 i + 1) */
       requery[qedge[q]] = 1;
       return;
     }
-  }
 }
