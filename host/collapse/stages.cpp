@@ -875,7 +875,11 @@ uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   }
   // undone in the reverse order of their rounds (then of their index: any order within a round)
   std::vector<uint32_t> order = s.work[0].download_range(0, n), rounds(n);
-  for (uint32_t i = 0; i < n; ++i) s.dround.download(&rounds[i], 1, order[i]);
+  if (n > 0) {  // one read of the span of dround they cover (a read each cost ~35 us on PoCL)
+    const auto [lo, hi] = std::minmax_element(order.begin(), order.end());
+    const std::vector<uint32_t> span = s.dround.download_range(*lo, size_t(*hi - *lo) + 1);
+    for (uint32_t i = 0; i < n; ++i) rounds[i] = span[order[i] - *lo];
+  }
   std::vector<uint32_t> idx(n);
   std::iota(idx.begin(), idx.end(), 0u);
   std::sort(idx.begin(), idx.end(), [&](uint32_t a, uint32_t b) {
