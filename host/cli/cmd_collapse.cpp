@@ -240,9 +240,9 @@ void register_collapse(CLI::App& app, int& exit_code) {
                  "atomic-min (Gautron and Kenzel 2023; needs 64-bit atomics on the device)")
       ->check(CLI::IsMember({"greedy", "two-pass", "atomic-min", "matching"}));
   app.add_option("--priority-levels", c->priority_levels,
-                 "Matching and greedy conflicts: edges are ordered by their cost in steps of target / N, and within a\n"
-                 "step in a fixed pseudo-random order (default 64; 0: exact cost order, many more\n"
-                 "parallel rounds)")
+                 "Matching and greedy conflicts: edges are ordered by their cost in steps of target / N,\n"
+                 "and within a step in a fixed pseudo-random order (default 64; 0: exact cost order, many\n"
+                 "more parallel rounds)")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--no-spatial-order", c->no_spatial_order,
                "Parallel method: keep the input's numbering on the device (default: vertices along a\n"

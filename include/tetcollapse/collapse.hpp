@@ -58,8 +58,9 @@ struct IterationStats {
   // Of those, the edges tested: link condition and volume test evaluated (greedy selection: the
   // volume test, which most of them end with; with the atomic-min conflicts: every marked
   // edge; matching selection: the tests run, up to two per edge: an early volume test while it
-  // waits, and the full test when its turn comes, on the mesh as it is then). When the surface guard refuses a collapse, the edges are selected again (the lazy
-  // filter then tests only edges not tested before): marked and passed_q are counted before
+  // waits, and the full test when its turn comes, on the mesh as it is then). When the surface
+  // guard refuses a collapse, the edges are selected again (the lazy filter then tests only
+  // edges not tested before): marked and passed_q are counted before
   // the first selection, tested adds up over the selections and selection rounds, and
   // admissible, after_pass1 and after_pass2 are the last selection's.
   int64_t tested = 0;
@@ -108,11 +109,11 @@ struct CollapseOptions {
   //   order would take, each tested on the mesh with the collapses taken before it applied,
   //   skipping only those that share an end point with an edge taken before: its collapses may
   //   share tets (each is tested on the result of the earlier ones), so an iteration takes about
-  //   four times as many as Greedy's and a run needs about half the iterations
+  //   four times as many as Greedy's and a run needs about a third of the iterations
   //   (cl/collapse_matching.cl). A waiting edge gets one early volume test, and a refusal there is
   //   final for the iteration. The surface guard tests the result; the collapses it refuses are
-  //   undone with those taken after them within reach. W1 (bench/README.md): 19 iterations
-  //   against 30, 1.2x the speed of Greedy, 1-3% more tets at the end.
+  //   undone with those taken after them within reach. W1 (bench/README.md): 9 iterations
+  //   against 30, 1.36-1.41x the speed of Greedy on a 2-core CPU, 2% more tets at the end.
   // Greedy: one selection under the conflicts of both of the paper's passes: the
   //   edges that taking the marked edges one after another in cost order would take, skipping
   //   each that fails the tests or touches a tet of an edge taken before. Like the two passes it
@@ -126,10 +127,10 @@ struct CollapseOptions {
   //   collapses when it holds the minimum in all of them; needs cl_khr_int64_extended_atomics.
   enum Conflicts { TwoPass, AtomicMin, Greedy, Matching };
   Conflicts conflicts = Matching;
-  // Matching and Greedy: the order is the cost in steps of target_length / priority_levels and, within a
-  // step, a fixed pseudo-random order of the edges (a bijective hash of the edge index). The
-  // exact cost order (0) makes the parallel rounds follow chains of slowly growing cost: W1's
-  // first iteration then takes ~200 rounds instead of ~25, for 2% more collapses.
+  // Matching and Greedy: the order is the cost in steps of target_length / priority_levels and,
+  // within a step, a fixed pseudo-random order of the edges (a bijective hash of the edge
+  // index). The exact cost order (0) makes the parallel rounds follow chains of slowly growing
+  // cost: W1's first iteration then takes ~200 rounds instead of ~25, for 2% more collapses.
   double priority_levels = 64;
 
   // Edges with a cost below target_length are marked. <= 0: target_factor x the input's median
