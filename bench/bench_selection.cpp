@@ -8,11 +8,12 @@
 // N repetitions and the counts (taken, tests), which a change that keeps the decisions keeps.
 //
 //   bench_selection [MESH] [--runs N] [--iteration K] [--target-factor F] [--min-quality Q]
-//                   [--priority-levels L] [--no-early-tests] [--loop SIZE EXIT]
+//                   [--priority-levels L] [--no-early-tests] [--loop SIZE EXIT] [--waiting-ab]
 // Defaults (bench_stage_setup.hpp): W1's mesh (robot 514k) and target (2 x median edge length),
 // 7 runs, iteration 0, min_quality 0; --loop: the rounds run in one work-group once a turn list
 // holds at most SIZE edges, back to per-round kernels above EXIT (StageParams::greedy_loop_size,
-// greedy_loop_exit).
+// greedy_loop_exit); --waiting-ab: each selection also without its waiting lists
+// (StageParams::waiting_lists) in the same repetitions, the order switched each time.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -46,11 +47,15 @@ struct Timing {
 int main(int argc, char** argv) {
   bench::StageBenchArgs a;
   int iteration = 0;
-  bool early = true;
+  bool early = true, waiting_ab = false;
   uint32_t loop_size = StageParams{}.greedy_loop_size, loop_exit = StageParams{}.greedy_loop_exit;
   auto own = [&](int& i) {
     if (!std::strcmp(argv[i], "--no-early-tests")) {
       early = false;
+      return true;
+    }
+    if (!std::strcmp(argv[i], "--waiting-ab")) {
+      waiting_ab = true;
       return true;
     }
     if (!std::strcmp(argv[i], "--iteration") && i + 1 < argc) {
@@ -95,28 +100,37 @@ int main(int argc, char** argv) {
   nbr0.copy_from(c.tet_nbr, size_t(dm.nt) * 4);
   pts0.copy_from(dm.points, size_t(dm.nv) * 3);
   vf0.copy_from(dm.vfields, size_t(dm.nv) * dm.vfield_comps);
-  Timing greedy, matching;
-  for (int r = 0; r < runs; ++r) {  // alternately, so that both see the same load
+  // with --waiting-ab each selection also without its waiting lists, the order switched in every
+  // repetition
+  Timing greedy, matching, greedy_nw, matching_nw;
+  auto time_one = [&](Timing& t, bool match, bool waiting) {
+    p.waiting_lists = waiting;
     s.counters.fill(0u);
     s.counters.upload(&marked, 1, 0);
     s.verdict_ready = false;
-    double t0 = now();
-    greedy.taken = greedy_selection(ctx, dm, c, s, p, passed_q, greedy.tested);
+    const double t0 = now();
+    t.taken = match ? matching_selection(ctx, dm, c, s, p, passed_q, t.tested)
+                    : greedy_selection(ctx, dm, c, s, p, passed_q, t.tested);
     ctx.finish();
-    greedy.t.push_back(now() - t0);
-    s.counters.fill(0u);
-    s.counters.upload(&marked, 1, 0);
-    s.verdict_ready = false;
-    t0 = now();
-    matching.taken = matching_selection(ctx, dm, c, s, p, passed_q, matching.tested);
-    ctx.finish();
-    matching.t.push_back(now() - t0);
+    t.t.push_back(now() - t0);
+    if (!match) return;
     dm.tets.copy_from(tets0, size_t(dm.nt) * 4);
     c.tet_nbr.copy_from(nbr0, size_t(dm.nt) * 4);
     dm.points.copy_from(pts0, size_t(dm.nv) * 3);
     dm.vfields.copy_from(vf0, size_t(dm.nv) * dm.vfield_comps);
+  };
+  for (int r = 0; r < runs; ++r) {  // alternately, so that all see the same load
+    const bool flip = waiting_ab && r % 2;
+    for (bool waiting : {!flip, flip}) {
+      if (!waiting_ab && !waiting) continue;
+      time_one(waiting ? greedy : greedy_nw, false, waiting);
+      time_one(waiting ? matching : matching_nw, true, waiting);
+    }
   }
-  for (auto [name, t] : {std::pair<const char*, Timing*>{"greedy", &greedy}, {"matching", &matching}}) {
+  std::vector<std::pair<const char*, Timing*>> rows = {{"greedy", &greedy}, {"matching", &matching}};
+  if (waiting_ab)
+    rows.insert(rows.end(), {{"greedy, no waiting lists,", &greedy_nw}, {"matching, no waiting lists,", &matching_nw}});
+  for (auto [name, t] : rows) {
     const double med = t->median();
     std::printf("%-8s selection: median %.4f s, min %.4f s over %d runs; %u taken, %u tests; %.1f us per collapse\n", name,
                 med, t->t.front(), runs, t->taken, t->tested, 1e6 * med / std::max(1u, t->taken));

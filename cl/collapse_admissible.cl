@@ -178,7 +178,9 @@ inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* sta
  *              edge at a and b OUT and lists their other end points where such an edge was
  *              first; OUT lists a and b;
  *   recompute  slot[v] anew for the listed vertices (duplicates compute the same value);
- *   turns      the edges now first at both end points, each once (queued[e] = round).
+ *   turns      the edges now first at both end points, each once (queued[e] = round); in the
+ *              greedy and matching selections also the edges waiting on the listed vertices
+ *              (tcc_wake, collapse_select.h).
  * Only the vertices where something was decided are looked at, so a pass costs about the
  * number of candidates times the vertex degree, where rescanning every undecided candidate in
  * every round (pass1_claim + conflict_pass1_decide) costs that times the number of rounds (about
@@ -258,10 +260,12 @@ __kernel void lazy_p1_recompute(uint n, __global const uint* dlist, __global con
 
 __kernel void lazy_p1_turns(uint n, __global const uint* dlist, __global const int* edges, __global const int* slot,
                             __global uint* tlist, __global uint* cnt, uint which, __global uint* queued, uint round,
-                            __global const uchar* verdict) {
+                            __global const uchar* verdict, int waiters, __global int* whead,
+                            __global const int* wnext) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  tcc_p1_turn((int)dlist[i], edges, slot, tlist, cnt + which, queued, round, verdict, cnt + 3);
+  tcc_p1_turn((int)dlist[i], edges, slot, tlist, cnt + which, queued, round, verdict, cnt + 3, waiters ? whead : 0,
+              wnext);
 }
 
 /* The remaining rounds in one work-group, once the turn list is short: a round then costs
@@ -284,7 +288,7 @@ __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __glo
       tcc_p1_decide((int)tl[i], edges, state, vaff, slot, dlist, cnt + 2, TCC_TEST_ARGS);
     barrier(CLK_GLOBAL_MEM_FENCE);
     tcc_p1_vertex_part(cnt[2], dlist, nb_off, nb_edge, state, cost, slot, edges, tnext, cnext, queued, round, verdict,
-                       cnt + 3, 0);
+                       cnt + 3, 0, 0, 0);
     n = *cnext;
     const uint untested = cnt[3];
     barrier(CLK_GLOBAL_MEM_FENCE);
@@ -332,16 +336,20 @@ __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __glo
  *   greedy_decide  each turn-list edge: the volume test (tcc_lazy_volume; a refusal is OUT at
  *                  once, which frees the way for the edges after it without waiting for its
  *                  turn); then the slots over N(a) and N(b): one holding an edge before e
- *                  (blocker[e]) makes e wait, and while that edge is undecided the next rounds
- *                  only check its state (no scan); else e is first within reach: the link
+ *                  (blocker[e]) makes e wait; else e is first within reach: the link
  *                  condition (tcc_lazy_decide), IN (listed for greedy_block) or OUT. A waiting
- *                  edge goes to the next turn list. Edges deciding in one round are pairwise
+ *                  edge waits on the vertex whose slot holds its blocker (tcc_wait_on,
+ *                  collapse_select.h), and lazy_p1_turns puts it in the turn list of the round
+ *                  after its blocker decided (without the waiting lists, StageParams::
+ *                  waiting_lists: in every next turn list, where it only checks the blocker's
+ *                  state until then, no scan). Edges deciding in one round are pairwise
  *                  free of conflicts (each comes first within reach of the other), so their
  *                  writes do not race;
  *   greedy_block   every undecided edge within reach of an edge taken this round is OUT, and
  *                  the vertices whose slot it held are listed (vstamp: once per round);
  *   lazy_p1_recompute and lazy_p1_turns (above) over the listed vertices: their slots anew, and
- *                  the edges now first at both end points go to the next turn list.
+ *                  the edges now first at both end points, or waiting on them, go to the next
+ *                  turn list.
  * Slots change only in lazy_p1_recompute, so every kernel reads the round's slots. States
  * change in greedy_decide (of its own edges) and greedy_block; the two reads of another edge's
  * state in the same kernel are benign: greedy_decide's of its blocker (decided or not, the
@@ -369,7 +377,8 @@ inline void tcc_greedy_decide(int e, __global const int* edges, __global const d
                               __global const int* slot, __global int* blocker, __global uint* tnext,
                               __global uint* tn, volatile __global uint* queued, uint round, __global uint* inlist,
                               __global uint* in_n, volatile __global uint* vstamp, __global uint* dlist,
-                              __global uint* dn, __global uchar* state, __global int* vaff, TCC_TEST_PARAMS) {
+                              __global uint* dn, __global uchar* state, __global int* vaff, __global int* whead,
+                              __global int* wnext, TCC_TEST_PARAMS) {
   if (state[e] != TCC_UNDECIDED) return; /* OUT by greedy_block */
   int a = edges[2 * e], b = edges[2 * e + 1];
   int f = blocker[e];
@@ -377,18 +386,24 @@ inline void tcc_greedy_decide(int e, __global const int* edges, __global const d
   if (!wait) {
     if (tcc_lazy_volume(e, a, b, tcc_lazy_dir(e, a, b, TCC_TEST_ARGS), TCC_TEST_ARGS)) {
       f = -1; /* the first slot over N(a) and N(b) holding an edge before e, if any */
+      int fz = -1;
       for (int s = 0; s < 2 && f < 0; ++s) {
         int x = s == 0 ? a : b;
         for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) {
           int g = slot[nb[j]];
           if (g >= 0 && g != e && tcc_before(prio, g, e)) {
             f = g;
+            fz = nb[j];
             break;
           }
         }
       }
       blocker[e] = f;
       wait = f >= 0;
+      if (wait && whead) { /* woken when slot[fz] decides (tcc_wake) */
+        tcc_wait_on(e, fz, whead, wnext);
+        return;
+      }
     }
     if (!wait) {
       if (tcc_lazy_decide(e, edges, state, vaff, TCC_TEST_ARGS)) {
@@ -399,6 +414,8 @@ inline void tcc_greedy_decide(int e, __global const int* edges, __global const d
       return;
     }
   }
+  /* without waiting lists; with them not expected (an edge is on a list until its blocker
+   * decides) */
   tcc_requeue(e, queued, round, tnext, tn);
 }
 
@@ -406,14 +423,15 @@ __kernel void greedy_decide(uint n, uint cur, __global const uint* tlist, __glob
                             __global const int* edges, __global const double* prio, __global const int* slot,
                             __global int* blocker, volatile __global uint* queued, uint round, __global uint* inlist,
                             volatile __global uint* vstamp, __global uint* dlist, __global uchar* state,
-                            __global int* vaff, TCC_TEST_PARAMS) {
+                            __global int* vaff, int waiting, __global int* whead, __global int* wnext,
+                            TCC_TEST_PARAMS) {
   uint i = get_global_id(0);
   if (i >= n) return;
 #ifdef TCC_PREFETCH_OK
   tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets);
 #endif
   tcc_greedy_decide((int)tlist[i], edges, prio, slot, blocker, tnext, cnt + (1 - cur), queued, round, inlist, cnt + 4,
-                    vstamp, dlist, cnt + 2, state, vaff, TCC_TEST_ARGS);
+                    vstamp, dlist, cnt + 2, state, vaff, waiting ? whead : 0, wnext, TCC_TEST_ARGS);
 }
 
 /* The edge e taken: every undecided edge with an end point in N[a] or N[b] is OUT; the vertices
@@ -456,22 +474,24 @@ __kernel void greedy_loop(uint n, int cur, uint round, __global uint* t0, __glob
                           __global const int* edges, __global const double* prio, __global int* slot,
                           __global int* blocker, volatile __global uint* queued, __global uint* inlist,
                           volatile __global uint* vstamp, __global uint* dlist, __global uchar* state,
-                          __global int* vaff, uint max_n, __global uint* resume, TCC_TEST_PARAMS) {
+                          __global int* vaff, uint max_n, __global uint* resume, int waiting, __global int* whead,
+                          __global int* wnext, TCC_TEST_PARAMS) {
   const uint lid = get_local_id(0), ls = get_local_size(0);
+  if (!waiting) whead = 0;
   while (n > 0) {
     __global uint* tl = cur ? t1 : t0;
     __global uint* tnext = cur ? t0 : t1;
     __global uint* cnext = cnt + (1 - cur);
     for (uint i = lid; i < n; i += ls)
       tcc_greedy_decide((int)tl[i], edges, prio, slot, blocker, tnext, cnext, queued, round, inlist, cnt + 4, vstamp,
-                        dlist, cnt + 2, state, vaff, TCC_TEST_ARGS);
+                        dlist, cnt + 2, state, vaff, whead, wnext, TCC_TEST_ARGS);
     barrier(CLK_GLOBAL_MEM_FENCE);
     const uint nin = cnt[4];
     for (uint i = lid; i < nin; i += ls)
       tcc_greedy_block((int)inlist[i], edges, nb_off, nb, nb_edge, slot, vstamp, round, dlist, cnt + 2, state);
     barrier(CLK_GLOBAL_MEM_FENCE);
     tcc_p1_vertex_part(cnt[2], dlist, nb_off, nb_edge, state, prio, slot, edges, tnext, cnext, queued, round, verdict,
-                       cnt + 3, 0);
+                       cnt + 3, 0, whead, wnext);
     if (tcc_loop_next(&n, &cur, &round, max_n, cnt, resume)) return;
   }
 }

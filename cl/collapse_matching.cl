@@ -19,8 +19,10 @@
  *   match_decide  each turn-list edge e = (a, b): while a candidate before it is within reach
  *                 (blocker[e], as in the greedy selection) it waits, after one volume test on
  *                 the mesh as it is (spec[e]: a refusal is OUT at once, which frees the way for
- *                 the edges after it); else its tests (Q, volume, link) on the mesh as it is, IN
- *                 or OUT. Read-only on the mesh;
+ *                 the edges after it), on the waiting list of the vertex whose slot holds the
+ *                 blocker (tcc_wait_on: back in a turn list when that edge decides); else its
+ *                 tests (Q, volume, link) on the mesh as it is, IN or OUT. Read-only on the
+ *                 mesh;
  *   match_apply   each edge taken this round is collapsed in place: the tets holding both end
  *                 points flagged in tdead and tet_nbr glued across them (collapse_update.cl),
  *                 the removed vertex renamed to the survivor in the tets of its ring, the
@@ -159,8 +161,8 @@ inline void tcc_match_decide(int e, __global const int* edges, __global const do
                              __global uint* tnext, __global uint* tn, volatile __global uint* queued, uint round,
                              __global uint* inlist, __global uint* in_n, volatile __global uint* vstamp,
                              __global uint* dlist, __global uint* dn, __global uchar* state,
-                             __global const int* vaff, TCC_TEST_PARAMS, double eps_r, double eps_f,
-                             __global const uchar* tdead) {
+                             __global const int* vaff, __global int* whead, __global int* wnext, TCC_TEST_PARAMS,
+                             double eps_r, double eps_f, __global const uchar* tdead) {
   if (state[e] != TCC_UNDECIDED) return; /* OUT by match_apply: an end point was taken */
   int a = edges[2 * e], b = edges[2 * e + 1];
   int f = blocker[e];
@@ -171,7 +173,7 @@ inline void tcc_match_decide(int e, __global const int* edges, __global const do
      * and whether a taken edge changed the star (vaff of a vertex of N(a) U N(b): its
      * star changed) */
     f = -1;
-    int touched = 0;
+    int fz = -1, touched = 0;
     const double pe = prio[e];
     double pf = 0.0;
     for (int s = 0; s < 2; ++s) {
@@ -186,6 +188,7 @@ inline void tcc_match_decide(int e, __global const int* edges, __global const do
         if (f < 0 || pf < pz || (pf == pz && f < g)) {
           f = g;
           pf = pz;
+          fz = z;
         }
       }
     }
@@ -214,7 +217,13 @@ inline void tcc_match_decide(int e, __global const int* edges, __global const do
         return;
       }
     }
+    if (wait && whead) { /* woken when slot[fz] decides (tcc_wake) */
+      tcc_wait_on(e, fz, whead, wnext);
+      return;
+    }
   }
+  /* without waiting lists; with them not expected (an edge is on a list until its blocker
+   * decides) */
   tcc_requeue(e, queued, round, tnext, tn);
 }
 
@@ -223,14 +232,15 @@ __kernel void match_decide(uint n, uint cur, __global const uint* tlist, __globa
                            __global const double* slotp, __global int* blocker, __global uchar* spec, __global uint* dround,
                            volatile __global uint* queued, uint round,
                            __global uint* inlist, volatile __global uint* vstamp, __global uint* dlist,
-                           __global uchar* state, __global int* vaff, TCC_MATCH_PARAMS) {
+                           __global uchar* state, __global int* vaff, int waiting, __global int* whead,
+                           __global int* wnext, TCC_MATCH_PARAMS) {
   uint i = get_global_id(0);
   if (i >= n) return;
 #ifdef TCC_PREFETCH_OK
   tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets);
 #endif
   tcc_match_decide((int)tlist[i], edges, prio, slot, slotp, blocker, spec, dround, tnext, cnt + (1 - cur), queued, round, inlist,
-                   cnt + 4, vstamp, dlist, cnt + 2, state, vaff, TCC_MATCH_ARGS);
+                   cnt + 4, vstamp, dlist, cnt + 2, state, vaff, waiting ? whead : 0, wnext, TCC_MATCH_ARGS);
 }
 
 /* Removed tet d = (x, y, c, d') of the collapse of y onto x: the tet X across its face opposite y
@@ -304,22 +314,24 @@ __kernel void match_loop(uint n, int cur, uint round, __global uint* t0, __globa
                          __global double* slotp, __global int* blocker, __global uchar* spec, __global uint* dround,
                          volatile __global uint* queued, __global uint* inlist, volatile __global uint* vstamp,
                          __global uint* dlist, __global uchar* state, __global int* vaff, __global int* tkill,
-                         uint max_n, __global uint* resume, TCC_MATCH_PARAMS) {
+                         uint max_n, __global uint* resume, int waiting, __global int* whead,
+                         __global int* wnext, TCC_MATCH_PARAMS) {
   const uint lid = get_local_id(0), ls = get_local_size(0);
+  if (!waiting) whead = 0;
   while (n > 0) {
     __global uint* tl = cur ? t1 : t0;
     __global uint* tnext = cur ? t0 : t1;
     __global uint* cnext = cnt + (1 - cur);
     for (uint i = lid; i < n; i += ls)
       tcc_match_decide((int)tl[i], edges, prio, slot, slotp, blocker, spec, dround, tnext, cnext, queued, round, inlist,
-                       cnt + 4, vstamp, dlist, cnt + 2, state, vaff, TCC_MATCH_ARGS);
+                       cnt + 4, vstamp, dlist, cnt + 2, state, vaff, whead, wnext, TCC_MATCH_ARGS);
     barrier(CLK_GLOBAL_MEM_FENCE);
     const uint nin = cnt[4];
     for (uint i = lid; i < nin; i += ls)
       tcc_match_apply((int)inlist[i], edges, slot, vstamp, round, dlist, cnt + 2, state, vaff, tkill, TCC_MATCH_ARGS);
     barrier(CLK_GLOBAL_MEM_FENCE);
     tcc_p1_vertex_part(cnt[2], dlist, nb_off, nb_edge, state, prio, slot, edges, tnext, cnext, queued, round, verdict,
-                       cnt + 3, slotp);
+                       cnt + 3, slotp, whead, wnext);
     if (tcc_loop_next(&n, &cur, &round, max_n, cnt, resume)) return;
   }
 }

@@ -525,14 +525,16 @@ namespace {
 // are the kernels lazy_p1_recompute and lazy_p1_turns, made once by the caller. With slotp (the
 // matching selection) the slots' priorities are kept there too.
 void vertex_part(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kernel& recompute, cl::Kernel& turns,
-                 const DeviceBuffer<double>& order, int cur, cl_uint round, DeviceBuffer<double>* slotp = nullptr) {
+                 const DeviceBuffer<double>& order, int cur, cl_uint round, DeviceBuffer<double>* slotp = nullptr,
+                 bool waiting = false) {
   uint32_t nd = 0;
   s.work_n.download(&nd, 1, 2);
   set_args(recompute, "lazy_p1_recompute", U(nd), B(s.dlist), B(c.nb_off), B(c.nb_edge), B(s.state), B(order),
            B(s.slot[0]), slotp ? B(*slotp) : B(order), cl_int(slotp ? 1 : 0));
   ctx.launch(recompute, nd, "lazy_p1_recompute");
   set_args(turns, "lazy_p1_turns", U(nd), B(s.dlist), B(c.edges), B(s.slot[0]), B(s.work[1 - cur]), B(s.work_n),
-           cl_uint(1 - cur), B(s.queued), round + 1, B(s.verdict));
+           cl_uint(1 - cur), B(s.queued), round + 1, B(s.verdict), cl_int(waiting ? 1 : 0),
+           waiting ? B(s.whead) : B(s.slot[0]), waiting ? B(s.wnext) : B(s.slot[0]));
   ctx.launch(turns, nd, "lazy_p1_turns");
 }
 
@@ -693,6 +695,9 @@ void selection_buffers(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   ensure(s.work[1], ctx, c.ne);
   ensure(s.work_n, ctx, 5);
   ensure(s.resume, ctx, 3);
+  ensure(s.whead, ctx, std::max<size_t>(dm.nv, 1));  // the waiting lists (tcc_wait_on, collapse_select.h)
+  ensure(s.wnext, ctx, c.ne);
+  s.whead.fill(-1);
   s.blocker.fill(-1);
   s.queued.fill(0xffffffffu);
   s.vstamp.fill(0xffffffffu);
@@ -754,24 +759,25 @@ uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
   cl::Kernel decide = stage_kernel(ctx, p, A, "greedy_decide"), loop = stage_kernel(ctx, p, A, "greedy_loop");
   // the priority first: lazy_init claims the first slots in its order
   const DeviceBuffer<double>& prio = selection_priority(ctx, c, s, p);
-  lazy_start(ctx, dm, c, s, p, prio, {{&decide, 16}, {&loop, 18}});
+  lazy_start(ctx, dm, c, s, p, prio, {{&decide, 19}, {&loop, 21}});
   selection_buffers(ctx, dm, c, s);
+  const cl_int W = p.waiting_lists ? 1 : 0;
   cl::Kernel block = ctx.kernel(A, "greedy_block"), recompute = ctx.kernel(A, "lazy_p1_recompute"),
              turns = ctx.kernel(A, "lazy_p1_turns");
   auto one_round = [&](uint32_t nt, int cur, cl_uint round) {
     set_args_from(decide, 0, "greedy_decide", U(nt), cl_uint(cur), B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n),
                   B(c.edges), B(prio), B(s.slot[0]), B(s.blocker), B(s.queued), round, B(s.inlist), B(s.vstamp),
-                  B(s.dlist), B(s.state), B(s.vaff));
+                  B(s.dlist), B(s.state), B(s.vaff), W, B(s.whead), B(s.wnext));
     ctx.launch(decide, nt, "greedy_decide");
     set_args(block, "greedy_block", B(s.inlist), B(s.work_n), B(c.edges), B(c.nb_off), B(c.nb), B(c.nb_edge),
              B(s.slot[0]), B(s.vstamp), round, B(s.dlist), B(s.state));
     ctx.launch(block, nt, "greedy_block");  // over the round's taken edges (cnt[4] <= nt)
-    vertex_part(ctx, s, c, recompute, turns, prio, cur, round);
+    vertex_part(ctx, s, c, recompute, turns, prio, cur, round, nullptr, p.waiting_lists);
   };
   auto in_one_group = [&](uint32_t nt, int cur, cl_uint round) {
     set_args(loop, "greedy_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
              B(prio), B(s.slot[0]), B(s.blocker), B(s.queued), B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state),
-             B(s.vaff), U(p.greedy_loop_exit), B(s.resume));
+             B(s.vaff), U(p.greedy_loop_exit), B(s.resume), W, B(s.whead), B(s.wnext));
     ctx.launch_one_group(loop, "greedy_loop");
   };
   return selection_rounds(ctx, c, s, p, "greedy_round", one_round, in_one_group, passed_q, tested);
@@ -785,7 +791,7 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
   // the priority first: lazy_init claims the first slots in its order
   const DeviceBuffer<double>& prio = selection_priority(ctx, c, s, p);
   // the test's arguments (TCC_MATCH_PARAMS): the lazy filter's, then the live test's
-  constexpr cl_uint kDecide = 19, kApply = 10, kLoop = 22, kTestArgs = 24;
+  constexpr cl_uint kDecide = 22, kApply = 10, kLoop = 25, kTestArgs = 24;
   lazy_start(ctx, dm, c, s, p, prio, {{&decide, kDecide}, {&apply, kApply}, {&loop, kLoop}}, true);
   s.in_place = true;
   ensure(s.tdead, ctx, std::max<size_t>(dm.nt, 1));
@@ -799,21 +805,23 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
   s.spec.fill(p.match_early_tests ? 0 : 1);  // 1: the early test counts as done
   ensure(s.slotp, ctx, dm.nv);
   run(ctx, A, "slot_priority", dm.nv, "", U(dm.nv), B(s.slot[0]), B(prio), B(s.slotp));
+  const cl_int W = p.waiting_lists ? 1 : 0;
   cl::Kernel recompute = ctx.kernel(A, "lazy_p1_recompute"), turns = ctx.kernel(A, "lazy_p1_turns");
   auto one_round = [&](uint32_t nt, int cur, cl_uint round) {
     set_args_from(decide, 0, "match_decide", U(nt), cl_uint(cur), B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n),
                   B(c.edges), B(prio), B(s.slot[0]), B(s.slotp), B(s.blocker), B(s.spec), B(s.dround), B(s.queued),
-                  round, B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff));
+                  round, B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff), W, B(s.whead), B(s.wnext));
     ctx.launch(decide, nt, "match_decide");
     set_args_from(apply, 0, "match_apply", B(s.inlist), B(s.work_n), B(c.edges), B(s.slot[0]), B(s.vstamp), round,
                   B(s.dlist), B(s.state), B(s.vaff), B(s.tkill));
     ctx.launch(apply, nt, "match_apply");  // over the round's taken edges (cnt[4] <= nt)
-    vertex_part(ctx, s, c, recompute, turns, prio, cur, round, &s.slotp);
+    vertex_part(ctx, s, c, recompute, turns, prio, cur, round, &s.slotp, p.waiting_lists);
   };
   auto in_one_group = [&](uint32_t nt, int cur, cl_uint round) {
     set_args(loop, "match_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
              B(prio), B(s.slot[0]), B(s.slotp), B(s.blocker), B(s.spec), B(s.dround), B(s.queued), B(s.inlist),
-             B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff), B(s.tkill), U(p.greedy_loop_exit), B(s.resume));
+             B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff), B(s.tkill), U(p.greedy_loop_exit), B(s.resume), W,
+             B(s.whead), B(s.wnext));
     ctx.launch_one_group(loop, "match_loop");
   };
   return selection_rounds(ctx, c, s, p, "match_round", one_round, in_one_group, passed_q, tested);

@@ -69,6 +69,7 @@ struct EdgeState {
   // for, per vertex the round it was last listed, the edges taken in a round
   DeviceBuffer<double> prio, slotp;  // slotp: the priority of each vertex's slot (matching)
   DeviceBuffer<int32_t> blocker;
+  DeviceBuffer<int32_t> whead, wnext;  // the selections' waiting lists: per vertex, per edge
   DeviceBuffer<uint32_t> vstamp, inlist;
   // matching selection (matching_selection): per edge whether its early test ran and the round
   // it was taken in, per tet whether a collapse removed it and which; the positions and fields
@@ -159,6 +160,10 @@ struct StageParams {
   // more than greedy_loop_exit. Results do not depend on the last two.
   double priority_levels = 64;
   uint32_t greedy_loop_size = 512, greedy_loop_exit = 2048;
+  // Greedy and matching selections: an edge waiting for its blocker waits on the blocker's
+  // vertex and is woken when the blocker decides (tcc_wait_on, cl/collapse_select.h), instead of
+  // going to every turn list until then. Results do not depend on it.
+  bool waiting_lists = true;
   // Matching selection: a waiting edge's early volume test (cl/collapse_matching.cl, spec).
   bool match_early_tests = true;
 };

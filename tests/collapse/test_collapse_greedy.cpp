@@ -120,7 +120,7 @@ std::vector<uint32_t> host_greedy(const GreedyStage& st, uint32_t nv) {
 // The device takes exactly the host's edges, with 64 steps and in the exact order; and the same
 // edges with the same counts (tested, taken) and refusals whether its rounds run as separate
 // launches or in one work-group (the loop thresholds at both extremes), for every work-group
-// size.
+// size, and with or without the waiting lists.
 TEST(CollapseGreedy, TakesWhatTakingTheEdgesInOrderWouldTake) {
   Context ctx;
   int64_t link_refusals = 0, volume_refusals = 0;
@@ -152,20 +152,23 @@ TEST(CollapseGreedy, TakesWhatTakingTheEdgesInOrderWouldTake) {
       const uint32_t taken = st.taken, tested = st.tested;
       const std::vector<uint8_t> reasons = st.greedy_reason;
       for (size_t wg : {0, 1, 16})
-        for (auto [size, exit] : {std::pair<uint32_t, uint32_t>{0, 0}, {UINT32_MAX, UINT32_MAX}, {4, 8}}) {
-          ctx.set_work_group_size(wg);
-          StageParams q = p;
-          q.greedy_loop_size = size;
-          q.greedy_loop_exit = exit;
-          q.target = in.target;
-          st.select(ctx, q);
-          const std::string what =
-              "work-group size " + std::to_string(wg) + ", loop size " + std::to_string(size) + ", exit " + std::to_string(exit);
-          EXPECT_EQ(st.fin, expect) << what;
-          EXPECT_EQ(st.taken, taken) << what;
-          EXPECT_EQ(st.tested, tested) << what;
-          EXPECT_EQ(st.greedy_reason, reasons) << what;
-        }
+        for (auto [size, exit] : {std::pair<uint32_t, uint32_t>{0, 0}, {UINT32_MAX, UINT32_MAX}, {4, 8}})
+          for (bool waiting : {true, false}) {
+            if (!waiting && wg != 0) continue;  // without the waiting lists: at the default size only
+            ctx.set_work_group_size(wg);
+            StageParams q = p;
+            q.greedy_loop_size = size;
+            q.greedy_loop_exit = exit;
+            q.waiting_lists = waiting;
+            q.target = in.target;
+            st.select(ctx, q);
+            const std::string what = "work-group size " + std::to_string(wg) + ", loop size " + std::to_string(size) +
+                                     ", exit " + std::to_string(exit) + (waiting ? "" : ", no waiting lists");
+            EXPECT_EQ(st.fin, expect) << what;
+            EXPECT_EQ(st.taken, taken) << what;
+            EXPECT_EQ(st.tested, tested) << what;
+            EXPECT_EQ(st.greedy_reason, reasons) << what;
+          }
       ctx.set_work_group_size(0);
     }
   }

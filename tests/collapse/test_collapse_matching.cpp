@@ -93,10 +93,12 @@ struct MatchStage {
   std::vector<double> prio;
 
   MatchStage(Context& ctx, const Mesh& m, const CollapseOptions& o, double target, bool early,
-             uint32_t loop_size = StageParams{}.greedy_loop_size, uint32_t loop_exit = StageParams{}.greedy_loop_exit) {
+             uint32_t loop_size = StageParams{}.greedy_loop_size, uint32_t loop_exit = StageParams{}.greedy_loop_exit,
+             bool waiting_lists = true) {
     p = params_from(o);
     p.target = target;
     p.match_early_tests = early;
+    p.waiting_lists = waiting_lists;
     p.greedy_loop_size = loop_size;
     p.greedy_loop_exit = loop_exit;
     upload_mesh(ctx, m, o, dm);
@@ -186,10 +188,11 @@ TEST(CollapseMatching, TakesWhatTakingTheEdgesInOrderWouldTake) {
   }
 }
 
-// With the early tests (the default), the decisions, counts, refusals and the mesh the collapses
-// leave are the same whether the rounds run as separate launches or in one work-group, for every
-// work-group size; the taken edges form a matching, and each of them, tested in the order of
-// its round on the host, passes.
+// With the early tests (the default), the decisions, their rounds, counts, refusals and the mesh
+// the collapses leave are the same whether the rounds run as separate launches or in one
+// work-group, for every work-group size, and with or without the waiting lists (a waiting edge
+// woken when its blocker decides, or sent to every turn list until then); the taken edges form
+// a matching, and each of them, tested in the order of its round on the host, passes.
 TEST(CollapseMatching, SameAtEveryWorkGroupSizeAndLoopThreshold) {
   Context ctx;
   for (const Input& in : inputs()) {
@@ -217,22 +220,24 @@ TEST(CollapseMatching, SameAtEveryWorkGroupSizeAndLoopThreshold) {
       sm.collapse(ref.edges[2 * e], ref.edges[2 * e + 1], ref.dir[e]);
     }
     for (size_t wg : {1, 16, 0})
-      for (auto [size, exit] : {std::pair<uint32_t, uint32_t>{0, 0}, {UINT32_MAX, UINT32_MAX}, {4, 8}}) {
-        ctx.set_work_group_size(wg);
-        MatchStage st(ctx, in.mesh, in.options, in.target, true, size, exit);
-        const std::string what =
-            "work-group size " + std::to_string(wg) + ", loop size " + std::to_string(size) + ", exit " + std::to_string(exit);
-        EXPECT_EQ(st.fin, ref.fin) << what;
-        EXPECT_EQ(st.dir, ref.dir) << what;
-        EXPECT_EQ(st.reason, ref.reason) << what;
-        for (uint32_t e = 0; e < st.ne; ++e)
-          if (ref.fin[e]) {
-            EXPECT_EQ(st.dround[e], ref.dround[e]) << what << ", round of edge " << e;
-          }
-        EXPECT_EQ(st.taken, ref.taken) << what;
-        EXPECT_EQ(st.tested, ref.tested) << what;
-        expect_same_mesh(st.result(ctx, in.mesh), ref_mesh, what);
-      }
+      for (auto [size, exit] : {std::pair<uint32_t, uint32_t>{0, 0}, {UINT32_MAX, UINT32_MAX}, {4, 8}})
+        for (bool waiting : {true, false}) {
+          if (!waiting && wg != 0) continue;  // without the waiting lists: at the default size only
+          ctx.set_work_group_size(wg);
+          MatchStage st(ctx, in.mesh, in.options, in.target, true, size, exit, waiting);
+          const std::string what = "work-group size " + std::to_string(wg) + ", loop size " + std::to_string(size) +
+                                   ", exit " + std::to_string(exit) + (waiting ? "" : ", no waiting lists");
+          EXPECT_EQ(st.fin, ref.fin) << what;
+          EXPECT_EQ(st.dir, ref.dir) << what;
+          EXPECT_EQ(st.reason, ref.reason) << what;
+          for (uint32_t e = 0; e < st.ne; ++e)
+            if (ref.fin[e]) {
+              EXPECT_EQ(st.dround[e], ref.dround[e]) << what << ", round of edge " << e;
+            }
+          EXPECT_EQ(st.taken, ref.taken) << what;
+          EXPECT_EQ(st.tested, ref.tested) << what;
+          expect_same_mesh(st.result(ctx, in.mesh), ref_mesh, what);
+        }
     ctx.set_work_group_size(0);
   }
 }
