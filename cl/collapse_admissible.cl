@@ -260,11 +260,11 @@ __kernel void lazy_p1_recompute(uint n, __global const uint* dlist, __global con
 
 __kernel void lazy_p1_turns(uint n, __global const uint* dlist, __global const int* edges, __global const int* slot,
                             __global uint* tlist, __global uint* cnt, uint which, __global uint* queued, uint round,
-                            __global const uchar* verdict, int waiters, __global int* whead,
+                            __global const uchar* verdict, int waiting, __global int* whead,
                             __global const int* wnext) {
   uint i = get_global_id(0);
   if (i >= n) return;
-  tcc_p1_turn((int)dlist[i], edges, slot, tlist, cnt + which, queued, round, verdict, cnt + 3, waiters ? whead : 0,
+  tcc_p1_turn((int)dlist[i], edges, slot, tlist, cnt + which, queued, round, verdict, cnt + 3, waiting ? whead : 0,
               wnext);
 }
 

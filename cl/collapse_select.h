@@ -393,6 +393,14 @@ inline void tcc_p1_recompute(int v, __global const uint* nb_off, __global const 
   if (slotp) slotp[v] = m >= 0 ? cost[m] : INFINITY;
 }
 
+/* Appends e to a turn list (tlist, its length *tn) unless it is there already: queued[e] holds
+ * the stamp of the last list e went to. Returns whether it appended. */
+inline int tcc_queue_once(int e, volatile __global uint* queued, uint stamp, __global uint* tlist, __global uint* tn) {
+  if (atomic_xchg(queued + e, stamp) == stamp) return 0;
+  tlist[atomic_inc(tn)] = (uint)e;
+  return 1;
+}
+
 /* Waiting lists of the greedy and matching selections (StageParams::waiting_lists): an edge e
  * whose blocker, an edge before it, is slot[z] for a z within reach waits on z's list (whead[z],
  * then wnext) instead of going to every next turn list until the blocker decides. slot[z]
@@ -414,8 +422,7 @@ inline void tcc_wake(int v, __global int* whead, __global const int* wnext, __gl
   if (!whead) return;
   int w = whead[v];
   whead[v] = -1;
-  for (; w >= 0; w = wnext[w])
-    if (atomic_xchg(queued + w, round) != round) tlist[atomic_inc(tn)] = (uint)w;
+  for (; w >= 0; w = wnext[w]) tcc_queue_once(w, queued, round, tlist, tn);
 }
 
 inline void tcc_p1_turn(int v, __global const int* edges, __global const int* slot, __global uint* tlist,
@@ -424,9 +431,8 @@ inline void tcc_p1_turn(int v, __global const int* edges, __global const int* sl
   tcc_wake(v, whead, wnext, tlist, tn, queued, round);
   int m = slot[v];
   if (m < 0 || slot[edges[2 * m]] != m || slot[edges[2 * m + 1]] != m) return;
-  if (atomic_xchg(queued + m, round) == round) return; /* listed from its other end point */
-  tlist[atomic_inc(tn)] = (uint)m;
-  if (verdict[m] == TCC_VERDICT_UNKNOWN) atomic_inc(untested);
+  /* not when listed from its other end point */
+  if (tcc_queue_once(m, queued, round, tlist, tn) && verdict[m] == TCC_VERDICT_UNKNOWN) atomic_inc(untested);
 }
 
 /* The vertex part of a round run in one work-group (lazy_p1_loop, greedy_loop): the slots of
@@ -510,7 +516,7 @@ inline void tcc_refused_ends(int a, int b, volatile __global uint* vstamp, uint 
   tcc_greedy_list_vertex(b, vstamp, round, dlist, dn);
 }
 inline void tcc_requeue(int e, volatile __global uint* queued, uint round, __global uint* tnext, __global uint* tn) {
-  if (atomic_xchg(queued + e, round + 1) != round + 1) tnext[atomic_inc(tn)] = (uint)e;
+  tcc_queue_once(e, queued, round + 1, tnext, tn);
 }
 
 #endif
