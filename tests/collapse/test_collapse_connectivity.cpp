@@ -174,10 +174,11 @@ TEST(CollapseConnectivity, TetNeighboursOfAFaceInThreeTets) {
 }
 
 // The private lists of the connectivity kernels capped at 4 entries (a ring, N(v), the faces a
-// vertex matches), so that most vertices take the fallbacks: insertion sort and gather in the
-// global scratch (conn_ring_sort_and_gather), the ring scan per face (conn_tet_neighbours).
+// vertex matches) and the gather's bitmap at 32 ids, so that most vertices take the fallbacks:
+// insertion sort and gather in the global scratch (conn_ring_sort_and_gather), the ring scan per
+// face (conn_tet_neighbours).
 TEST(CollapseConnectivity, SmallListCapsTakeTheFallbacks) {
-  test::EnvVar cap("TETCOLLAPSE_CL_OPTIONS", "-DTCC_MAX_NB=4 -DTCC_MAX_MIN_FACES=4");
+  test::EnvVar cap("TETCOLLAPSE_CL_OPTIONS", "-DTCC_MAX_NB=4 -DTCC_MAX_MIN_FACES=4 -DTCC_GATHER_BITS=32");
   Context ctx;
   {
     SCOPED_TRACE("cube");
