@@ -381,12 +381,11 @@ inline void tcc_greedy_decide(int e, __global const int* edges, __global const d
                               __global int* wnext, TCC_TEST_PARAMS) {
   if (state[e] != TCC_UNDECIDED) return; /* OUT by greedy_block */
   int a = edges[2 * e], b = edges[2 * e + 1];
-  int f = blocker[e];
+  int f = blocker[e], fz = -1; /* fz: the vertex whose slot holds a blocker found now */
   int wait = f >= 0 && state[f] == TCC_UNDECIDED;
   if (!wait) {
     if (tcc_lazy_volume(e, a, b, tcc_lazy_dir(e, a, b, TCC_TEST_ARGS), TCC_TEST_ARGS)) {
       f = -1; /* the first slot over N(a) and N(b) holding an edge before e, if any */
-      int fz = -1;
       for (int s = 0; s < 2 && f < 0; ++s) {
         int x = s == 0 ? a : b;
         for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) {
@@ -400,10 +399,6 @@ inline void tcc_greedy_decide(int e, __global const int* edges, __global const d
       }
       blocker[e] = f;
       wait = f >= 0;
-      if (wait && whead) { /* woken when slot[fz] decides (tcc_wake) */
-        tcc_wait_on(e, fz, whead, wnext);
-        return;
-      }
     }
     if (!wait) {
       if (tcc_lazy_decide(e, edges, state, vaff, TCC_TEST_ARGS)) {
@@ -414,9 +409,7 @@ inline void tcc_greedy_decide(int e, __global const int* edges, __global const d
       return;
     }
   }
-  /* without waiting lists; with them not expected (an edge is on a list until its blocker
-   * decides) */
-  tcc_requeue(e, queued, round, tnext, tn);
+  tcc_wait(e, fz, whead, wnext, queued, round, tnext, tn);
 }
 
 __kernel void greedy_decide(uint n, uint cur, __global const uint* tlist, __global uint* tnext, __global uint* cnt,

@@ -165,7 +165,7 @@ inline void tcc_match_decide(int e, __global const int* edges, __global const do
                              double eps_r, double eps_f, __global const uchar* tdead) {
   if (state[e] != TCC_UNDECIDED) return; /* OUT by match_apply: an end point was taken */
   int a = edges[2 * e], b = edges[2 * e + 1];
-  int f = blocker[e];
+  int f = blocker[e], fz = -1; /* fz: the vertex whose slot holds a blocker found now */
   int wait = f >= 0 && state[f] == TCC_UNDECIDED;
   if (!wait) {
     /* the blocker: the last, in priority order, of the slots over N(a) and N(b) holding an edge
@@ -173,7 +173,7 @@ inline void tcc_match_decide(int e, __global const int* edges, __global const do
      * and whether a taken edge changed the star (vaff of a vertex of N(a) U N(b): its
      * star changed) */
     f = -1;
-    int fz = -1, touched = 0;
+    int touched = 0;
     const double pe = prio[e];
     double pf = 0.0;
     for (int s = 0; s < 2; ++s) {
@@ -217,14 +217,8 @@ inline void tcc_match_decide(int e, __global const int* edges, __global const do
         return;
       }
     }
-    if (wait && whead) { /* woken when slot[fz] decides (tcc_wake) */
-      tcc_wait_on(e, fz, whead, wnext);
-      return;
-    }
   }
-  /* without waiting lists; with them not expected (an edge is on a list until its blocker
-   * decides) */
-  tcc_requeue(e, queued, round, tnext, tn);
+  tcc_wait(e, fz, whead, wnext, queued, round, tnext, tn);
 }
 
 __kernel void match_decide(uint n, uint cur, __global const uint* tlist, __global uint* tnext, __global uint* cnt,

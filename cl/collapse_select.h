@@ -519,4 +519,15 @@ inline void tcc_requeue(int e, volatile __global uint* queued, uint round, __glo
   tcc_queue_once(e, queued, round + 1, tnext, tn);
 }
 
+/* The waiting edge e of the greedy and matching selections (tcc_greedy_decide, tcc_match_decide),
+ * whose blocker is slot[fz] (fz -1: the blocker found at an earlier visit, still undecided): on
+ * fz's waiting list, woken when slot[fz] decides (tcc_wake), or without waiting lists (whead 0)
+ * in the next turn list. With the lists fz is not expected to be -1 (an edge is on a list until
+ * its blocker decides); the turn list is then the correct fallback. */
+inline void tcc_wait(int e, int fz, __global int* whead, __global int* wnext, volatile __global uint* queued,
+                     uint round, __global uint* tnext, __global uint* tn) {
+  if (whead && fz >= 0) tcc_wait_on(e, fz, whead, wnext);
+  else tcc_requeue(e, queued, round, tnext, tn);
+}
+
 #endif
