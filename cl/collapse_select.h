@@ -176,6 +176,61 @@ inline int tcc_live_common(int a, int b, __global const int* tets, __global cons
   return ncn;
 }
 
+/* Live, for a ring(a) of at most TCC_LIVE_LINK_RING tets: N(a) n N(b) when it is lk(ab)'s
+ * vertices (pc, pd: the np edges of lk(ab)), into cn; -1 when it is not (a common neighbour off
+ * lk(ab): the link test's (i) refuses), or does not fit. The same verdicts as tcc_live_common
+ * followed by (i), without its lists: N(a) n N(b) always holds lk(ab)'s vertices, so (i) only asks
+ * whether a vertex of a tet of ring(b) without a, off lk(ab), is in N(a). Such a vertex is looked
+ * up in a 256-bit filter of the vertices of ring(a) (their ids mod 256), and only a hit is checked
+ * against the tets of ring(a). The caller takes it for a ring(a) of at most TCC_MAX_LINK / 3 tets
+ * too: then |N(a)| <= TCC_MAX_LINK, and tcc_live_common's refusal of a longer list of N(a) cannot
+ * happen. */
+#ifndef TCC_LIVE_LINK_RING
+#define TCC_LIVE_LINK_RING 32
+#endif
+inline int tcc_live_link_common(int a, int b, const int* pc, const int* pd, int np, __global const int* tets,
+                                __global const uint* vt_off, __global const int* vt, __global const uchar* tdead,
+                                int* cn) {
+  const int live = 1; /* for TCC_DEAD */
+  uint bits[8] = {0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u};
+  for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
+    const int t = vt[i];
+    if (tdead[t]) continue;
+    const int4 q = vload4(t, tets);
+    bits[(q.x >> 5) & 7] |= 1u << (q.x & 31);
+    bits[(q.y >> 5) & 7] |= 1u << (q.y & 31);
+    bits[(q.z >> 5) & 7] |= 1u << (q.z & 31);
+    bits[(q.w >> 5) & 7] |= 1u << (q.w & 31);
+  }
+  const int small = np <= 8;
+  int p8[8], d8[8];
+  for (int k = 0; k < 8; ++k) {
+    p8[k] = k < np ? pc[k] : -1;
+    d8[k] = k < np ? pd[k] : -1;
+  }
+  for (uint i = vt_off[b]; i < vt_off[b + 1]; ++i) {
+    const int t = vt[i];
+    if (tdead[t]) continue;
+    const int4 q4 = vload4(t, tets);
+    if ((q4.x == a) | (q4.y == a) | (q4.z == a) | (q4.w == a)) continue; /* a tet of the edge: lk(ab) */
+    const int q[4] = {q4.x, q4.y, q4.z, q4.w};
+    for (int k = 0; k < 4; ++k) {
+      const int v = q[k];
+      if (v == b || !(bits[(v >> 5) & 7] & (1u << (v & 31)))) continue;
+      if (small ? (TCC_ANY8(p8, v) | TCC_ANY8(d8, v)) : (tcc_in(pc, np, v) || tcc_in(pd, np, v))) continue;
+      if (tcc_ring_has(tets, vt_off, vt, a, v, v, -1, live, tdead)) return -1; /* in N(a), off lk(ab) */
+    }
+  }
+  int ncn = 0;
+  for (int k = 0; k < 2 * np; ++k) {
+    const int v = k < np ? pc[k] : pd[k - np];
+    if (tcc_in(cn, ncn, v)) continue;
+    if (ncn == TCC_MAX_LINK) return -1;
+    cn[ncn++] = v;
+  }
+  return ncn;
+}
+
 /* The link condition of the edge (a, b), a < b: TCC_OK or TCC_REFUSED_LINK. Live (see the top):
  * N(a), N(b) and the S-edges from the rings; an edge that no tet holds any more is refused. */
 inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global const int* tets,
@@ -189,10 +244,7 @@ inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global con
    * edges of lk(ab), one per tet of the edge */
   int cn[TCC_MAX_LINK + 1], cea[TCC_MAX_LINK + 1], ceb[TCC_MAX_LINK + 1], pc[TCC_MAX_LINK], pd[TCC_MAX_LINK];
   int ncn = 0, np = 0;
-  if (live) {
-    ncn = tcc_live_common(a, b, tets, vt_off, vt, tdead, cn);
-    if (ncn < 0) return TCC_REFUSED_LINK;
-  } else {
+  if (!live) {
     /* a merge of the sorted N(a) and N(b) without branches on their values */
     uint i = nb_off[a], ie = nb_off[a + 1], j = nb_off[b], je = nb_off[b + 1];
     while (i < ie && j < je) {
@@ -219,6 +271,13 @@ inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global con
     ++np;
   }
   if (live && np == 0) return TCC_REFUSED_LINK; /* earlier collapses removed every tet of the edge */
+  if (live) {
+    const uint ring = vt_off[a + 1] - vt_off[a];
+    ncn = ring <= TCC_LIVE_LINK_RING && 3 * ring <= TCC_MAX_LINK
+              ? tcc_live_link_common(a, b, pc, pd, np, tets, vt_off, vt, tdead, cn)
+              : tcc_live_common(a, b, tets, vt_off, vt, tdead, cn);
+    if (ncn < 0) return TCC_REFUSED_LINK;
+  }
   /* cn, pc and pd padded to 8 when they fit (the usual case), for TCC_ANY8 */
   const int small = ncn <= 8 && np <= 8;
   int c8[8], p8[8], d8[8];

@@ -166,12 +166,10 @@ void expect_same_mesh(const Mesh& a, const Mesh& b, const std::string& what) {
   for (size_t l = 0; l < a.tet_labels.size(); ++l) EXPECT_EQ(a.tet_labels[l].values, b.tet_labels[l].values) << what;
 }
 
-}  // namespace
-
 // Without the early tests the device takes exactly the host's edges in the same directions, and
 // its in-place collapses leave exactly the host's mesh (positions, tets and their vertex order,
 // labels), for every input.
-TEST(CollapseMatching, TakesWhatTakingTheEdgesInOrderWouldTake) {
+void expect_takes_what_the_host_takes() {
   Context ctx;
   for (const Input& in : inputs()) {
     SCOPED_TRACE(in.name);
@@ -186,6 +184,18 @@ TEST(CollapseMatching, TakesWhatTakingTheEdgesInOrderWouldTake) {
     EXPECT_EQ(got, expect);
     expect_same_mesh(st.result(ctx, in.mesh), host, "the result");
   }
+}
+
+}  // namespace
+
+TEST(CollapseMatching, TakesWhatTakingTheEdgesInOrderWouldTake) { expect_takes_what_the_host_takes(); }
+
+// The live link test (tcc_link_test) finds N(a) n N(b) through a filter of ring(a)'s vertices
+// when ring(a) has at most TCC_LIVE_LINK_RING tets (32), else through tcc_live_common's lists.
+// With the cap at 8, both ways run on the same inputs, and the host still agrees on every edge.
+TEST(CollapseMatching, LiveLinkTestAgreesWithTheHostOnBothPaths) {
+  test::EnvVar cap("TETCOLLAPSE_CL_OPTIONS", "-DTCC_LIVE_LINK_RING=8");
+  expect_takes_what_the_host_takes();
 }
 
 // With the early tests (the default), the decisions, their rounds, counts, refusals and the mesh
