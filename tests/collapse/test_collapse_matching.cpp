@@ -191,11 +191,26 @@ void expect_takes_what_the_host_takes() {
 TEST(CollapseMatching, TakesWhatTakingTheEdgesInOrderWouldTake) { expect_takes_what_the_host_takes(); }
 
 // The live link test (tcc_link_test) finds N(a) n N(b) through a filter of ring(a)'s vertices
-// when ring(a) has at most TCC_LIVE_LINK_RING tets (32), else through tcc_live_common's lists.
-// With the cap at 8, both ways run on the same inputs, and the host still agrees on every edge.
-TEST(CollapseMatching, LiveLinkTestAgreesWithTheHostOnBothPaths) {
-  test::EnvVar cap("TETCOLLAPSE_CL_OPTIONS", "-DTCC_LIVE_LINK_RING=8");
-  expect_takes_what_the_host_takes();
+// when ring(a) has at most TCC_LIVE_LINK_RING tets (32) and TCC_MAX_LINK / 3, else through
+// tcc_live_common's lists; by default both ways run on these inputs. Each way alone decides every
+// live test here, and the host still agrees on every edge: with the cap at 0 the lists, with the
+// caps at 100 tets the filter (no ring of these inputs is larger).
+TEST(CollapseMatching, LiveLinkTestAgreesWithTheHostOnEachPathAlone) {
+  for (const Input& in : inputs()) {  // the rings a test reads are those of the input
+    std::vector<int> ring(size_t(in.mesh.num_vertices()), 0);
+    for (int32_t v : in.mesh.tets) ++ring[size_t(v)];
+    ASSERT_LE(*std::max_element(ring.begin(), ring.end()), 100) << in.name;
+  }
+  {
+    test::EnvVar cap("TETCOLLAPSE_CL_OPTIONS", "-DTCC_LIVE_LINK_RING=0");
+    SCOPED_TRACE("tcc_live_common only");
+    expect_takes_what_the_host_takes();
+  }
+  {
+    test::EnvVar cap("TETCOLLAPSE_CL_OPTIONS", "-DTCC_LIVE_LINK_RING=100 -DTCC_MAX_LINK=300");
+    SCOPED_TRACE("tcc_live_link_common only");
+    expect_takes_what_the_host_takes();
+  }
 }
 
 // With the early tests (the default), the decisions, their rounds, counts, refusals and the mesh
