@@ -188,9 +188,14 @@ inline int tcc_live_common(int a, int b, __global const int* tets, __global cons
 #ifndef TCC_LIVE_LINK_RING
 #define TCC_LIVE_LINK_RING 32
 #endif
-inline int tcc_live_link_common(int a, int b, const int* pc, const int* pd, int np, __global const int* tets,
-                                __global const uint* vt_off, __global const int* vt, __global const uchar* tdead,
-                                int* cn) {
+/* Is x a vertex of lk(ab)? pc, pd: its np edges; p8, d8: the same padded to 8 with -1 (used when
+ * np <= 8, for TCC_ANY8). */
+inline int tcc_in_lk(int x, const int* pc, const int* pd, int np, const int* p8, const int* d8) {
+  return np <= 8 ? (TCC_ANY8(p8, x) | TCC_ANY8(d8, x)) : (tcc_in(pc, np, x) || tcc_in(pd, np, x));
+}
+inline int tcc_live_link_common(int a, int b, const int* pc, const int* pd, int np, const int* p8, const int* d8,
+                                __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                                __global const uchar* tdead, int* cn) {
   const int live = 1; /* for TCC_DEAD */
   uint bits[8] = {0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u};
   for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
@@ -202,12 +207,6 @@ inline int tcc_live_link_common(int a, int b, const int* pc, const int* pd, int 
     bits[(q.z >> 5) & 7] |= 1u << (q.z & 31);
     bits[(q.w >> 5) & 7] |= 1u << (q.w & 31);
   }
-  const int small = np <= 8;
-  int p8[8], d8[8];
-  for (int k = 0; k < 8; ++k) {
-    p8[k] = k < np ? pc[k] : -1;
-    d8[k] = k < np ? pd[k] : -1;
-  }
   for (uint i = vt_off[b]; i < vt_off[b + 1]; ++i) {
     const int t = vt[i];
     if (tdead[t]) continue;
@@ -217,7 +216,7 @@ inline int tcc_live_link_common(int a, int b, const int* pc, const int* pd, int 
     for (int k = 0; k < 4; ++k) {
       const int v = q[k];
       if (v == b || !(bits[(v >> 5) & 7] & (1u << (v & 31)))) continue;
-      if (small ? (TCC_ANY8(p8, v) | TCC_ANY8(d8, v)) : (tcc_in(pc, np, v) || tcc_in(pd, np, v))) continue;
+      if (tcc_in_lk(v, pc, pd, np, p8, d8)) continue;
       if (tcc_ring_has(tets, vt_off, vt, a, v, v, -1, live, tdead)) return -1; /* in N(a), off lk(ab) */
     }
   }
@@ -271,21 +270,21 @@ inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global con
     ++np;
   }
   if (live && np == 0) return TCC_REFUSED_LINK; /* earlier collapses removed every tet of the edge */
-  if (live) {
-    const uint ring = vt_off[a + 1] - vt_off[a];
-    ncn = ring <= TCC_LIVE_LINK_RING && 3 * ring <= TCC_MAX_LINK
-              ? tcc_live_link_common(a, b, pc, pd, np, tets, vt_off, vt, tdead, cn)
-              : tcc_live_common(a, b, tets, vt_off, vt, tdead, cn);
-    if (ncn < 0) return TCC_REFUSED_LINK;
-  }
-  /* cn, pc and pd padded to 8 when they fit (the usual case), for TCC_ANY8 */
-  const int small = ncn <= 8 && np <= 8;
+  /* pc and pd, then cn, padded to 8 when they fit (the usual case), for TCC_ANY8 */
   int c8[8], p8[8], d8[8];
   for (int k = 0; k < 8; ++k) {
-    c8[k] = k < ncn ? cn[k] : -1;
     p8[k] = k < np ? pc[k] : -1;
     d8[k] = k < np ? pd[k] : -1;
   }
+  if (live) {
+    const uint ring = vt_off[a + 1] - vt_off[a];
+    ncn = ring <= TCC_LIVE_LINK_RING && 3 * ring <= TCC_MAX_LINK
+              ? tcc_live_link_common(a, b, pc, pd, np, p8, d8, tets, vt_off, vt, tdead, cn)
+              : tcc_live_common(a, b, tets, vt_off, vt, tdead, cn);
+    if (ncn < 0) return TCC_REFUSED_LINK;
+  }
+  const int small = ncn <= 8 && np <= 8;
+  for (int k = 0; k < 8; ++k) c8[k] = k < ncn ? cn[k] : -1;
 #define TCC_IN_CN(x) (small ? TCC_ANY8(c8, x) : tcc_in(cn, ncn, (x)))
   int ok = 1;
   const uint smask = TCC_BOUNDARY | TCC_INTERFACE;
@@ -307,7 +306,7 @@ inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global con
     for (int k = 0; k < 8; ++k) ok &= (c8[k] < 0) | TCC_ANY8(p8, c8[k]) | TCC_ANY8(d8, c8[k]);
   } else {
     for (int k = 0; k < ncn && ok; ++k)
-      if (!tcc_in(pc, np, cn[k]) && !tcc_in(pd, np, cn[k])) ok = 0;
+      if (!tcc_in_lk(cn[k], pc, pd, np, p8, d8)) ok = 0;
   }
   if (ok && !tcc_w_join_ok(fa, fb, fe)) ok = 0;
   /* (ii) with w: S-edges (a,c) and (b,c) need the S-face (a,b,c), of the kinds they share
