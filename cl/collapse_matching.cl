@@ -154,6 +154,31 @@ inline uchar tcc_match_test(int e, int a, int b, int live, int full, int* dir, T
                        eflags, 1, tdead);
 }
 
+#ifdef TCC_PREFETCH_OK
+/* The blocker scan's loads of the next items (CPU devices, as tcc_prefetch_test): three items
+ * ahead the lists N(a), N(b); one ahead the slot, its priority and vaff of each vertex in them. */
+inline void tcc_prefetch_blockers(uint i, uint n, __global const uint* tlist, __global const int* edges,
+                                  __global const uint* nb_off, __global const int* nb, __global const double* slotp,
+                                  __global const int* slot, __global const int* vaff) {
+  if (i + 3 < n) {
+    int e3 = (int)tlist[i + 3];
+    for (int s = 0; s < 2; ++s) __builtin_prefetch(nb + nb_off[edges[2 * e3 + s]]);
+  }
+  if (i + 1 < n) {
+    int e1 = (int)tlist[i + 1];
+    for (int s = 0; s < 2; ++s) {
+      int x = edges[2 * e1 + s];
+      for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) {
+        int z = nb[j];
+        __builtin_prefetch(slotp + z);
+        __builtin_prefetch(slot + z);
+        __builtin_prefetch(vaff + z);
+      }
+    }
+  }
+}
+#endif
+
 inline void tcc_match_decide(int e, __global const int* edges, __global const double* prio,
                              __global const int* slot, __global const double* slotp, __global int* blocker,
                              __global uchar* spec,
@@ -231,7 +256,8 @@ __kernel void match_decide(uint n, uint cur, __global const uint* tlist, __globa
   uint i = get_global_id(0);
   if (i >= n) return;
 #ifdef TCC_PREFETCH_OK
-  tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets);
+  tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets, pts);
+  tcc_prefetch_blockers(i, n, tlist, edges, nb_off, nb, slotp, slot, vaff);
 #endif
   tcc_match_decide((int)tlist[i], edges, prio, slot, slotp, blocker, spec, dround, tnext, cnt + (1 - cur), queued, round, inlist,
                    cnt + 4, vstamp, dlist, cnt + 2, state, vaff, waiting ? whead : 0, wnext, TCC_MATCH_ARGS);
@@ -294,11 +320,46 @@ inline void tcc_match_apply(int e, __global const int* edges, __global const int
   }
 }
 
+#ifdef TCC_PREFETCH_OK
+/* The loads of the next items of a work item of match_apply (CPU devices, as tcc_prefetch_test;
+ * the next item is `step` entries on, tcc_spread_index): two items ahead the rings' lists and the
+ * edge lists N(a), N(b); one ahead the rings' tets, their tdead and the edges' states. */
+inline void tcc_prefetch_apply(uint i, uint n, uint step, __global const uint* inlist, __global const int* edges,
+                               __global const uint* vt_off, __global const int* vt, __global const int* tets,
+                               __global const uchar* tdead, __global const uint* nb_off,
+                               __global const int* nb_edge, __global const uchar* state) {
+  if (i + 2 * step < n) {
+    int e2 = (int)inlist[i + 2 * step];
+    for (int s = 0; s < 2; ++s) {
+      int x = edges[2 * e2 + s];
+      __builtin_prefetch(vt + vt_off[x]);
+      __builtin_prefetch(nb_edge + nb_off[x]);
+    }
+  }
+  if (i + step < n) {
+    int e1 = (int)inlist[i + step];
+    for (int s = 0; s < 2; ++s) {
+      int x = edges[2 * e1 + s];
+      for (uint k = vt_off[x]; k < vt_off[x + 1]; ++k) {
+        int t = vt[k];
+        __builtin_prefetch(tets + 4 * t);
+        __builtin_prefetch(tdead + t);
+      }
+      for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) __builtin_prefetch(state + nb_edge[j]);
+    }
+  }
+}
+#endif
+
 __kernel void match_apply(__global const uint* inlist, __global uint* cnt, __global const int* edges,
                           __global const int* slot, volatile __global uint* vstamp, uint round, __global uint* dlist,
                           __global uchar* state, __global int* vaff, __global int* tkill, TCC_MATCH_PARAMS) {
   uint i = tcc_spread_index();
-  if (i >= cnt[4]) return;
+  const uint n = cnt[4];
+  if (i >= n) return;
+#ifdef TCC_PREFETCH_OK
+  tcc_prefetch_apply(i, n, get_num_groups(0), inlist, edges, vt_off, vt, tets, tdead, nb_off, nb_edge, state);
+#endif
   tcc_match_apply((int)inlist[i], edges, slot, vstamp, round, dlist, cnt + 2, state, vaff, tkill, TCC_MATCH_ARGS);
 }
 

@@ -538,7 +538,8 @@ inline int tcc_loop_next(uint* n, int* cur, uint* round, uint max_n, __global ui
  * in turn (W1, lazy pass 1: the test's share of the CPU samples 23% -> 21%): three items ahead
  * the rings' lists, two ahead the rings' tets. */
 inline void tcc_prefetch_test(uint i, uint n, __global const uint* tlist, __global const int* edges,
-                              __global const uint* vt_off, __global const int* vt, __global const int* tets) {
+                              __global const uint* vt_off, __global const int* vt, __global const int* tets,
+                              __global const double* pts) {
   if (i + 3 < n) {
     int e3 = (int)tlist[i + 3];
     for (int s = 0; s < 2; ++s) __builtin_prefetch(vt + vt_off[edges[2 * e3 + s]]);
@@ -548,6 +549,19 @@ inline void tcc_prefetch_test(uint i, uint n, __global const uint* tlist, __glob
     for (int s = 0; s < 2; ++s) {
       int x = edges[2 * e2 + s];
       for (uint k = vt_off[x]; k < vt_off[x + 1]; ++k) __builtin_prefetch(tets + 4 * vt[k]);
+    }
+  }
+  if (i + 1 < n) {
+    int e1 = (int)tlist[i + 1];
+    for (int s = 0; s < 2; ++s) {
+      int x = edges[2 * e1 + s];
+      for (uint k = vt_off[x]; k < vt_off[x + 1]; ++k) {
+        int4 q = vload4(vt[k], tets);
+        __builtin_prefetch(pts + 3 * q.x);
+        __builtin_prefetch(pts + 3 * q.y);
+        __builtin_prefetch(pts + 3 * q.z);
+        __builtin_prefetch(pts + 3 * q.w);
+      }
     }
   }
 }
