@@ -155,11 +155,16 @@ inline uchar tcc_match_test(int e, int a, int b, int live, int full, int* dir, T
 }
 
 #ifdef TCC_PREFETCH_OK
-/* The blocker scan's loads of the next items (CPU devices, as tcc_prefetch_test): three items
- * ahead the lists N(a), N(b); one ahead the slot, its priority and vaff of each vertex in them. */
+/* The blocker scan's loads of the next items (CPU devices, as tcc_prefetch_test): four items
+ * ahead the entries of nb_off, three ahead the lists N(a), N(b); one ahead the slot, its priority
+ * and vaff of each vertex in them. */
 inline void tcc_prefetch_blockers(uint i, uint n, __global const uint* tlist, __global const int* edges,
                                   __global const uint* nb_off, __global const int* nb, __global const double* slotp,
                                   __global const int* slot, __global const int* vaff) {
+  if (i + 4 < n) {
+    int e4 = (int)tlist[i + 4];
+    for (int s = 0; s < 2; ++s) __builtin_prefetch(nb_off + edges[2 * e4 + s]);
+  }
   if (i + 3 < n) {
     int e3 = (int)tlist[i + 3];
     for (int s = 0; s < 2; ++s) __builtin_prefetch(nb + nb_off[edges[2 * e3 + s]]);
