@@ -178,6 +178,7 @@ void tail_seed(Context& ctx, DeviceMesh& dm, Connectivity& conn, EdgeState& st, 
   seed.vflags = conn.vflags.download_range(0, dm.nv);
   seed.vclass = conn.vclass.download_range(0, dm.nv);
   seed.tet_nbr = conn.tet_nbr.download_range(0, 4 * size_t(dm.nt));
+  seed.edges = conn.edges.download_range(0, 2 * size_t(conn.ne));
   if (reuse && (options.conflicts == CollapseOptions::Greedy || options.conflicts == CollapseOptions::Matching)) {
     carry_verdicts(ctx, dm, conn, st);
     seed.touched = tail_touched(ctx, dm, conn, st);

@@ -111,6 +111,14 @@ SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const T
     // untouched: a value no iteration's prev or cur (it_, it_ + 1) takes
     for (size_t v = 0; v < touched_.size(); ++v) touched_[v] = seed->touched[v] ? 0u : 0xffffffffu;
   }
+  if (seed) {
+    seed_edges_ = seed->edges;
+    const int32_t nv = sm_.num_vertices();
+    bool ok = seed_edges_.size() % 2 == 0;
+    for (size_t i = 0; ok && i < seed_edges_.size(); i += 2)
+      ok = 0 <= seed_edges_[i] && seed_edges_[i] < seed_edges_[i + 1] && seed_edges_[i + 1] < nv;
+    if (!ok) throw std::invalid_argument("SequentialRun: the seed's edges need pairs a < b of vertices of the mesh");
+  }
   target_ = options.target_length;
 }
 
@@ -128,10 +136,18 @@ bool SequentialRun::step() {
 
   // 1. edges and costs
   edges_.clear();
-  const int32_t nv = sm_.num_vertices();
-  for (int32_t v = 0; v < nv; ++v) {
-    sm_.neighbours(v, nb_, true);
-    for (int32_t u : nb_) edges_.push_back({sm_.length(v, u), v, u, 0});
+  if (!seed_edges_.empty()) {  // the device's, of this mesh (TailSeed::edges)
+    for (size_t i = 0; i + 1 < seed_edges_.size(); i += 2) {
+      const int32_t a = seed_edges_[i], b = seed_edges_[i + 1];
+      edges_.push_back({sm_.length(a, b), a, b, 0});
+    }
+    seed_edges_ = {};
+  } else {
+    const int32_t nv = sm_.num_vertices();
+    for (int32_t v = 0; v < nv; ++v) {
+      sm_.neighbours(v, nb_, true);
+      for (int32_t u : nb_) edges_.push_back({sm_.length(v, u), v, u, 0});
+    }
   }
   s.edges = int64_t(edges_.size());
   const double t1 = seconds_since(t0);

@@ -213,8 +213,8 @@ TEST(CollapseHostTail, MaskAndTrianglesCarried) {
   EXPECT_TRUE(test::triangles_off_surface(m).empty()) << "triangles that are not boundary faces of the result";
 }
 
-// The host tail starts from the device's flags and classes and skips the tests of edges whose
-// end points the last device iteration left untouched (TailSeed, collapse/sequential_run.hpp):
+// The host tail starts from the device's edges, flags and classes and skips the tests of edges
+// whose end points the last device iteration left untouched (TailSeed, collapse/sequential_run.hpp):
 // the same result as starting from the mesh alone (TETCOLLAPSE_HOST_TAIL_SEED=0), with fewer
 // tests in the first host iteration after a greedy selection, and as many after the two passes
 // (no touched flags: their pass 2 may drop the winner that blocked an admissible edge).
@@ -252,12 +252,41 @@ TEST(CollapseHostTail, SeedFromTheDeviceChangesNothing) {
       ASSERT_EQ(rs.iterations.size(), ra.iterations.size());
       const size_t first_host = rs.iterations.size() - size_t(count_on_host(rs));
       for (size_t i = 0; i < rs.iterations.size(); ++i) EXPECT_EQ(rs.iterations[i].collapsed, ra.iterations[i].collapsed);
+      EXPECT_EQ(rs.iterations[first_host].edges, ra.iterations[first_host].edges);  // the device's list, gathered
+      EXPECT_EQ(rs.iterations[first_host].marked, ra.iterations[first_host].marked);
       EXPECT_EQ(rs.iterations[first_host].passed_q, ra.iterations[first_host].passed_q);
       if (conflicts != CollapseOptions::TwoPass)
         EXPECT_LT(rs.iterations[first_host].tested, ra.iterations[first_host].tested);
       else
         EXPECT_EQ(rs.iterations[first_host].tested, ra.iterations[first_host].tested);
     }
+}
+
+// A seed's edge list that is no list of edges of the mesh (odd length, a >= b, a vertex out of
+// range) is refused before it is used.
+TEST(CollapseHostTail, SeedEdgesAreChecked) {
+  const Mesh in = test::cube_tets(2);
+  CollapseOptions o;
+  o.method = CollapseOptions::Sequential;
+  o.target_length = 1;
+  const size_t nv = size_t(in.num_vertices());
+  for (const std::vector<int32_t>& bad : std::vector<std::vector<int32_t>>{
+           {0, 1, 2}, {1, 0}, {0, int32_t(nv)}, {-1, 1}, {3, 3}}) {
+    sequential_detail::TailSeed seed;
+    seed.vflags.assign(nv, 0);
+    seed.vclass.assign(nv, 0);
+    seed.touched.assign(nv, 1);
+    seed.edges = bad;
+    Mesh m = in;
+    EXPECT_THROW(sequential_detail::SequentialRun(m, o, &seed), std::invalid_argument) << bad.size() << " entries";
+  }
+  sequential_detail::TailSeed seed;  // a good one is taken
+  seed.vflags.assign(nv, 0);
+  seed.vclass.assign(nv, 0);
+  seed.touched.assign(nv, 1);
+  seed.edges = {0, 1};
+  Mesh m = in;
+  EXPECT_NO_THROW(sequential_detail::SequentialRun(m, o, &seed));
 }
 
 // tail_touched (cl/collapse_verdicts.cl): a vertex counts as touched when its ring changed
