@@ -541,8 +541,11 @@ inline int tcc_loop_next(uint* n, int* cur, uint* round, uint max_n, __global ui
  * ahead their entries of vt_off, three ahead the rings' lists (two lines each), two ahead the
  * rings' tets, one ahead their points (loading the lists and the offsets without their own steps
  * was ~25% of this function's samples, then the selection's first iteration ~10% faster with
- * them). The matching selection's live tests (tdead non-null) also read tdead of each tet and,
- * at an end point on S (vflags), its row of tet_nbr. */
+ * them). In match_decide (tdead non-null) also, two items ahead, tdead of each tet and, at an end
+ * point on S (vflags), its row of tet_nbr, which a live test reads (whether it is live is known
+ * only after the blocker scan, so for every item). Prefetches change no result: they write
+ * nothing, and every load here reads what the items' own work may read, in a launch that does
+ * not write it. */
 inline void tcc_prefetch_test(uint i, uint n, __global const uint* tlist, __global const int* edges,
                               __global const uint* vt_off, __global const int* vt, __global const int* tets,
                               __global const double* pts, __global const uchar* tdead, __global const int* tet_nbr,
