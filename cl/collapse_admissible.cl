@@ -233,7 +233,7 @@ __kernel void lazy_p1_decide(uint n, __global const uint* tlist, __global const 
   uint i = get_global_id(0);
   if (i >= n) return;
 #ifdef TCC_PREFETCH_OK
-  tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets, pts, TCC_NO_DEAD, tet_nbr, vflags);
+  tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets, pts, TCC_NO_DEAD, tet_nbr, vflags, q_min, tet_quality);
 #endif
   tcc_p1_decide((int)tlist[i], edges, state, vaff, slot, dlist, cnt + 2, TCC_TEST_ARGS);
 }
@@ -421,7 +421,7 @@ __kernel void greedy_decide(uint n, uint cur, __global const uint* tlist, __glob
   uint i = get_global_id(0);
   if (i >= n) return;
 #ifdef TCC_PREFETCH_OK
-  tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets, pts, TCC_NO_DEAD, tet_nbr, vflags);
+  tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets, pts, TCC_NO_DEAD, tet_nbr, vflags, q_min, tet_quality);
 #endif
   tcc_greedy_decide((int)tlist[i], edges, prio, slot, blocker, tnext, cnt + (1 - cur), queued, round, inlist, cnt + 4,
                     vstamp, dlist, cnt + 2, state, vaff, waiting ? whead : 0, wnext, TCC_TEST_ARGS);

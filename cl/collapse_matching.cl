@@ -275,7 +275,7 @@ __kernel void match_decide(uint n, uint cur, __global const uint* tlist, __globa
   uint i = get_global_id(0);
   if (i >= n) return;
 #ifdef TCC_PREFETCH_OK
-  tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets, pts, tdead, tet_nbr, vflags);
+  tcc_prefetch_test(i, n, tlist, edges, vt_off, vt, tets, pts, tdead, tet_nbr, vflags, q_min, tet_quality);
   tcc_prefetch_decide(i, n, tlist, edges, nb_off, nb, slotp, slot, vaff, state, blocker, spec, prio, verdict, eflags);
 #endif
   tcc_match_decide((int)tlist[i], edges, prio, slot, slotp, blocker, spec, dround, tnext, cnt + (1 - cur), queued, round, inlist,
