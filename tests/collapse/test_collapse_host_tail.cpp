@@ -270,23 +270,23 @@ TEST(CollapseHostTail, SeedEdgesAreChecked) {
   o.method = CollapseOptions::Sequential;
   o.target_length = 1;
   const size_t nv = size_t(in.num_vertices());
-  for (const std::vector<int32_t>& bad : std::vector<std::vector<int32_t>>{
-           {0, 1, 2}, {1, 0}, {0, int32_t(nv)}, {-1, 1}, {3, 3}}) {
+  auto seed_with = [nv](std::vector<int32_t> edges) {
     sequential_detail::TailSeed seed;
     seed.vflags.assign(nv, 0);
     seed.vclass.assign(nv, 0);
     seed.touched.assign(nv, 1);
-    seed.edges = bad;
+    seed.edges = std::move(edges);
+    return seed;
+  };
+  for (const std::vector<int32_t>& bad : std::vector<std::vector<int32_t>>{
+           {0, 1, 2}, {1, 0}, {0, int32_t(nv)}, {-1, 1}, {3, 3}}) {
+    const sequential_detail::TailSeed seed = seed_with(bad);
     Mesh m = in;
     EXPECT_THROW(sequential_detail::SequentialRun(m, o, &seed), std::invalid_argument) << bad.size() << " entries";
   }
-  sequential_detail::TailSeed seed;  // a good one is taken
-  seed.vflags.assign(nv, 0);
-  seed.vclass.assign(nv, 0);
-  seed.touched.assign(nv, 1);
-  seed.edges = {0, 1};
+  const sequential_detail::TailSeed good = seed_with({0, 1});  // a good one is taken
   Mesh m = in;
-  EXPECT_NO_THROW(sequential_detail::SequentialRun(m, o, &seed));
+  EXPECT_NO_THROW(sequential_detail::SequentialRun(m, o, &good));
 }
 
 // tail_touched (cl/collapse_verdicts.cl): a vertex counts as touched when its ring changed
