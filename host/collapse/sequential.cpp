@@ -136,7 +136,22 @@ bool SequentialRun::step() {
 
   // 1. edges and costs
   edges_.clear();
-  if (!seed_edges_.empty()) {  // the device's, of this mesh (TailSeed::edges)
+  if (greedy_ && it_ > 0) {
+    // Greedy, after an iteration whose surface guard refused some edges (else the run is done):
+    // every other marked edge was tested after the last change of its star and refused, and
+    // the guard refuses nothing else, so those edges are the candidates (their end points
+    // renumbered by the compaction; an edge gone since is dropped by is_edge).
+    for (size_t i = 0; i + 1 < refused_.size(); i += 2) {
+      const int32_t a = std::min(refused_[i], refused_[i + 1]), b = std::max(refused_[i], refused_[i + 1]);
+      if (sm_.is_edge(a, b)) edges_.push_back({sm_.length(a, b), a, b, 0});
+    }
+    std::sort(edges_.begin(), edges_.end(), [](const QueueEntry& x, const QueueEntry& y) {
+      return x.a != y.a ? x.a < y.a : x.b < y.b;
+    });
+    edges_.erase(std::unique(edges_.begin(), edges_.end(),
+                             [](const QueueEntry& x, const QueueEntry& y) { return x.a == y.a && x.b == y.b; }),
+                 edges_.end());
+  } else if (!seed_edges_.empty()) {  // the device's, of this mesh (TailSeed::edges)
     for (size_t i = 0; i + 1 < seed_edges_.size(); i += 2) {
       const int32_t a = seed_edges_[i], b = seed_edges_[i + 1];
       edges_.push_back({sm_.length(a, b), a, b, 0});
@@ -193,6 +208,7 @@ bool SequentialRun::step() {
   // 2. pop, check again where an earlier collapse changed the star, collapse
   const uint32_t cur = uint32_t(it_) + 1;
   int64_t guard_refusals = 0;
+  refused_.clear();
   while (!heap_.empty()) {
     std::pop_heap(heap_.begin(), heap_.end(), later);
     const QueueEntry e = heap_.back();
@@ -222,6 +238,7 @@ bool SequentialRun::step() {
       // touched, so the edge is tested again next iteration (S nearby may have moved away)
       touched_[e.a] = touched_[e.b] = cur;
       ++guard_refusals;
+      if (greedy_) refused_.insert(refused_.end(), {e.a, e.b});
       continue;
     }
     sm_.collapse(e.a, e.b, dir);
@@ -253,6 +270,15 @@ bool SequentialRun::step() {
 
   // 3. compaction
   if (s.collapsed > 0) {
+    // a refused edge with an end point removed since is gone: the edges at the survivor were
+    // tested after that collapse
+    size_t kept_refused = 0;
+    for (size_t i = 0; i + 1 < refused_.size(); i += 2)
+      if (sm_.alive(refused_[i]) && sm_.alive(refused_[i + 1])) {
+        refused_[kept_refused++] = refused_[i];
+        refused_[kept_refused++] = refused_[i + 1];
+      }
+    refused_.resize(kept_refused);
     sm_.compact(vmap_, kept_);
     // per-vertex data of the survivors; origin composed with the vertex map
     for (size_t i = 0; i < kept_.size(); ++i) touched_[i] = touched_[kept_[i]];
@@ -262,6 +288,7 @@ bool SequentialRun::step() {
       mask_.resize(kept_.size());
     }
     for (int32_t& x : origin_) x = vmap_[x];
+    for (int32_t& x : refused_) x = vmap_[x];  // their end points are alive (above)
   }
   const double t4 = seconds_since(t0);
   s.seconds_connectivity = t1;

@@ -20,6 +20,9 @@
 // next iteration, as in the paper. Greedy mode (set_greedy; the parallel method's host tail):
 // after each collapse the marked edges of every touched vertex go into the queue at once (each
 // edge once), and the run stops after an iteration in which the surface guard refused nothing.
+// Then every marked edge was tested after the last change of its star and refused, except those
+// the guard refused, so a later greedy iteration lists only those edges (its edges, marked,
+// passed_q and tested count them alone).
 // The options of the parallel method's conflict detection (conflicts, selection_rounds) do not
 // apply; a user cost (cost_cl_source) is refused.
 //
@@ -84,6 +87,9 @@ class SequentialRun {
   // guard refused an edge (it looks beyond the star), which another iteration tests again.
   void set_greedy(bool on) { greedy_ = on; }
   const CollapseReport& report() const { return report_; }
+  // Greedy: the edges (2 per edge, current numbering) the surface guard refused in the last
+  // iteration, which the next one lists (alone).
+  const std::vector<int32_t>& guard_refused() const { return refused_; }
   double target() const { return target_; }
 
  private:
@@ -110,6 +116,9 @@ class SequentialRun {
   std::vector<int32_t> nb_, vmap_, kept_;
   bool greedy_ = false;
   std::unordered_set<uint64_t> queued_;  // greedy: the edges (a << 32 | b) in the queue
+  // greedy: the edges the surface guard refused in the last iteration (2 per edge; the
+  // candidates of the next one)
+  std::vector<int32_t> refused_;
   std::vector<uint32_t> greedy_mark_;
   uint32_t greedy_stamp_ = 0;
 };

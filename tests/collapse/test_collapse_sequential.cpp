@@ -686,6 +686,64 @@ TEST(SequentialGuard, FlatteningDoesNotPushTheSurfaceIntoAnotherBody) {
   for (auto [c, dir] : admitted) EXPECT_FALSE(sm.guard_ok(c, 4, dir)) << "corner " << c;
 }
 
+// Greedy (the host tail's mode): after an iteration in which the surface guard refused edges,
+// the next iteration lists only those. Sound when no other edge is admissible and passes the
+// guard then: checked over every edge of the mesh after each such iteration.
+TEST(SequentialGuard, GreedyLaterIterationsNeedOnlyTheRefusedEdges) {
+  // the dimple with the tip in its void (refused) beside a cube that collapses in the same
+  // iteration, so that another iteration follows
+  Mesh both = dimple_and_tip(true);
+  const Mesh cube = test::cube_tets(3);
+  const int32_t base = int32_t(both.num_vertices());
+  for (size_t i = 0; i < cube.points.size(); ++i) both.points.push_back(cube.points[i] + (i % 3 == 0 ? 5.0 : 0.0));
+  for (int32_t v : cube.tets) both.tets.push_back(base + v);
+  std::vector<std::pair<std::string, Mesh>> inputs{{"dimple and tip beside a cube", both}};
+  const std::string fusee = test::shared_mesh("gen_gmsh_917_fusee_88k.msh");
+  if (!fusee.empty()) inputs.emplace_back("fusee 88k", read_mesh(fusee));
+  else std::printf("fusee 88k absent: the dimple and the cube alone\n");
+  int64_t refusing_iterations = 0, checked_iterations = 0;
+  for (const auto& [name, in] : inputs) {
+    SCOPED_TRACE(name);
+    Mesh m = in;
+    CollapseOptions o;
+    o.min_quality = 0;
+    if (name == "dimple and tip beside a cube") o.target_length = 10;
+    else o.target_factor = 2;
+    SequentialRun run(m, o);
+    run.set_greedy(true);
+    for (bool more = run.step();; ) {
+      const std::vector<int32_t>& refused = run.guard_refused();
+      refusing_iterations += !refused.empty();
+      if (!more) break;  // more: the guard refused edges and the iteration collapsed some
+      std::set<std::pair<int32_t, int32_t>> listed;
+      for (size_t i = 0; i + 1 < refused.size(); i += 2)
+        listed.insert({std::min(refused[i], refused[i + 1]), std::max(refused[i], refused[i + 1])});
+      SeqMesh& sm = run.seq();
+      std::vector<int32_t> nb;
+      int64_t admissible = 0;
+      for (int32_t a = 0; a < sm.num_vertices(); ++a) {
+        sm.neighbours(a, nb, true);
+        for (int32_t b : nb) {
+          if (!(sm.length(a, b) < run.target())) continue;
+          const Verdict v = sm.check(a, b);
+          if (v.reason != kOk || !sm.guard_ok(a, b, v.dir)) continue;
+          ++admissible;
+          EXPECT_TRUE(listed.count({a, b})) << "edge " << a << "-" << b << " is admissible and not listed";
+        }
+      }
+      ++checked_iterations;
+      more = run.step();
+      const IterationStats& s = run.report().iterations.back();
+      EXPECT_LE(s.edges, int64_t(listed.size()));  // the listed edges that are still edges
+      EXPECT_EQ(s.collapsed >= 1, admissible >= 1) << admissible << " admissible edges";
+    }
+    std::printf("%s: %lld iterations with refusals, %lld checked (all inputs so far)\n", name.c_str(),
+                (long long)refusing_iterations, (long long)checked_iterations);
+  }
+  EXPECT_GE(refusing_iterations, 1) << "the guard refused nothing";
+  EXPECT_GE(checked_iterations, 1) << "no iteration with refusals and collapses: the test saw no later iteration";
+}
+
 // --- refusals ---
 
 TEST(SequentialCollapse, CornersAreNeverRemoved) {
