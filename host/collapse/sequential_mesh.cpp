@@ -718,15 +718,24 @@ void SeqMesh::guard_insert(int32_t t, int f) {
                       point(q[geo::TC_TET_FACES[f][2]])};
   int lo[3], hi[3];
   guard_cells(p, lo, hi);
+  const double nodes = double(hi[0] - lo[0] + 1) * double(hi[1] - lo[1] + 1) * double(hi[2] - lo[2] + 1);
+  if (double(gface_.size()) + nodes >= double(std::numeric_limits<int32_t>::max()))
+    throw InputError("<mesh>", "the sequential method's surface guard needs more than 2^31 grid entries");
   for (int k = lo[2]; k <= hi[2]; ++k)
     for (int j = lo[1]; j <= hi[1]; ++j)
-      for (int i = lo[0]; i <= hi[0]; ++i) cells_[guard_key(i, j, k)].push_back(4 * t + f);
+      for (int i = lo[0]; i <= hi[0]; ++i) {
+        int32_t& head = ghead_[guard_cell(i, j, k)];
+        gface_.push_back(4 * t + f);
+        gnext_.push_back(head);
+        head = int32_t(gface_.size() - 1);
+      }
 }
 
 void SeqMesh::build_guard(double h) {
   guard_on_ = true;
   guard_h_req_ = h;
-  cells_.clear();
+  gface_.clear();
+  gnext_.clear();
   gseen_.assign(4 * size_t(nt_), 0);
   gstamp_ = 0;
   // the S faces (all three vertices on S, owned), their mean extent and the bounding box
@@ -757,11 +766,20 @@ void SeqMesh::build_guard(double h) {
   guard_h_ = faces.empty() ? h : extent / double(faces.size());  // a few S faces per cell
   const double span = std::fmax(hi.x - lo.x, std::fmax(hi.y - lo.y, hi.z - lo.z));
   if (!(guard_h_ > 0) || !std::isfinite(guard_h_)) guard_h_ = std::isfinite(span) && span > 0 ? span : 1.0;
-  guard_h_ = std::fmax(guard_h_, span / double(1 << 20));  // cell coordinates fit 21 bits
+  guard_h_ = std::fmax(guard_h_, span / double(1 << 20));  // at most 2^20 cells per axis
   guard_org_ = std::isfinite(lo.x) ? lo : tc_d3{0, 0, 0};
   const double d[3] = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
-  for (int c = 0; c < 3; ++c)
-    guard_dim_[c] = std::isfinite(d[c]) ? std::max(1, std::min(1 << 20, int(std::floor(d[c] / guard_h_)) + 1)) : 1;
+  const double max_cells = std::fmax(65536.0, 8.0 * double(faces.size()));
+  for (;;) {
+    for (int c = 0; c < 3; ++c)
+      guard_dim_[c] = std::isfinite(d[c]) ? std::max(1, std::min(1 << 20, int(std::floor(d[c] / guard_h_)) + 1)) : 1;
+    const double cells = double(guard_dim_[0]) * double(guard_dim_[1]) * double(guard_dim_[2]);
+    if (cells <= max_cells) break;
+    guard_h_ *= std::fmax(1.01, std::cbrt(cells / max_cells));  // larger cells, fewer of them
+  }
+  ghead_.assign(size_t(guard_dim_[0]) * size_t(guard_dim_[1]) * size_t(guard_dim_[2]), -1);
+  gface_.reserve(4 * faces.size());
+  gnext_.reserve(4 * faces.size());
   for (int32_t e : faces) guard_insert(e >> 2, e & 3);
 }
 
@@ -829,9 +847,8 @@ bool SeqMesh::guard_ok(int32_t a, int32_t b, uint8_t dir) {
     for (int k = lo[2]; k <= hi[2]; ++k)
       for (int j = lo[1]; j <= hi[1]; ++j)
         for (int i = lo[0]; i <= hi[0]; ++i) {
-          auto it = cells_.find(guard_key(i, j, k));
-          if (it == cells_.end()) continue;
-          for (int32_t e : it->second) {
+          for (int32_t node = ghead_[guard_cell(i, j, k)]; node >= 0; node = gnext_[size_t(node)]) {
+            const int32_t e = gface_[size_t(node)];
             if (gseen_[e] == gstamp_) continue;
             gseen_[e] = gstamp_;
             const int32_t t = e >> 2;

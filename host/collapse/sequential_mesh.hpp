@@ -27,7 +27,6 @@
 #pragma once
 
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 #include "geometry.h"
@@ -106,7 +105,7 @@ class SeqMesh {
   int64_t verify_nbr() const;
 
   // Surface guard (the device's: cl/collapse_guard.cl). build_guard() indexes the current
-  // S faces in a hash grid of cells of the mean extent of an S face (h when there is none);
+  // S faces in a grid of cells of the mean extent of an S face (h when there is none);
   // collapses keep it current and compact() rebuilds it. guard_ok() tells whether the collapse
   // of (a, b) in direction dir keeps S free of self-intersections: its new S triangles (those
   // of tcc_sg_new_tri) against every current S face it does not replace, and among themselves,
@@ -163,7 +162,9 @@ class SeqMesh {
   uint8_t owned_sface(int32_t t, int f, uint8_t* on_s = nullptr) const;
   void guard_insert(int32_t t, int f);
   void guard_cells(const geo::tc_d3* p, int (&lo)[3], int (&hi)[3]) const;
-  uint64_t guard_key(int i, int j, int k) const { return (uint64_t(k) << 42) | (uint64_t(j) << 21) | uint64_t(i); }
+  size_t guard_cell(int i, int j, int k) const {
+    return size_t(i) + size_t(guard_dim_[0]) * (size_t(j) + size_t(guard_dim_[1]) * size_t(k));
+  }
   bool link_ok(int32_t a, int32_t b, uint8_t fe);
   uint8_t volume_and_quality(int32_t a, int32_t b, int dir) const;
   geo::tc_d3 placement(int32_t a, int32_t b, unsigned dir) const;
@@ -200,7 +201,12 @@ class SeqMesh {
   double guard_h_req_ = 0, guard_h_ = 1;
   geo::tc_d3 guard_org_{0, 0, 0};
   int guard_dim_[3] = {1, 1, 1};
-  std::unordered_map<uint64_t, std::vector<int32_t>> cells_;
+  // a dense grid of list heads (at most max(2^16, 8 x the S faces) cells: build_guard makes the
+  // cells larger when the mean extent would need more) and the lists' nodes, appended to by
+  // every insertion: no allocation per cell, and a rebuild costs one pass over the faces
+  // (a hash map of per-cell vectors took ~20 ms per build on W1's host tail)
+  std::vector<int32_t> ghead_;            // per cell: the first node, -1 none
+  std::vector<int32_t> gface_, gnext_;    // per node: the face 4 t + f and the next node (-1)
   std::vector<uint32_t> gseen_;
   uint32_t gstamp_ = 0;
   std::vector<NewTri> newtris_;

@@ -686,6 +686,33 @@ TEST(SequentialGuard, FlatteningDoesNotPushTheSurfaceIntoAnotherBody) {
   for (auto [c, dir] : admitted) EXPECT_FALSE(sm.guard_ok(c, 4, dir)) << "corner " << c;
 }
 
+// The guard's grid has at most max(2^16, 8 x the S faces) cells: with a small tet far away
+// (cells of the faces' mean extent would number ~10^9), its cells grow, and it still refuses.
+TEST(SequentialGuard, RefusesWithTheGridCoarsened) {
+  CollapseOptions o;
+  o.target_length = 10;
+  o.min_quality = 0;
+  for (bool far : {false, true}) {
+    Mesh in = dimple_and_tip(true);
+    if (far) {
+      const int32_t base = int32_t(in.num_vertices());
+      in.points.insert(in.points.end(), {1000, 1000, 1000, 1001, 1000, 1000, 1000, 1001, 1000, 1000, 1000, 1001});
+      add_tet(in, base, base + 1, base + 2, base + 3);
+    }
+    SeqMesh sm(in, seq_params_from(o));
+    sm.build_guard(0.1);
+    int refused = 0;
+    for (int32_t c = 0; c < 4; ++c) {
+      const Verdict v = sm.check(c, 4);
+      if (v.reason == kOk) refused += !sm.guard_ok(c, 4, v.dir);
+    }
+    EXPECT_GE(refused, 1) << (far ? "with" : "without") << " the far tet";
+    Mesh out = in;
+    collapse_sequential(out, o);
+    EXPECT_TRUE(check(out, in).valid) << (far ? "with" : "without") << " the far tet";
+  }
+}
+
 // Greedy (the host tail's mode): after an iteration in which the surface guard refused edges,
 // the next iteration lists only those. Sound when no other edge is admissible and passes the
 // guard then: checked over every edge of the mesh after each such iteration.
