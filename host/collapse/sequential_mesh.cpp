@@ -610,6 +610,17 @@ void SeqMesh::compact(std::vector<int32_t>& vmap, std::vector<int32_t>& kept) {
   }
   tets.resize(4 * size_t(m));
   nbr_.resize(4 * size_t(m));
+  // the guard's grid kept, its faces renumbered (those of removed tets dropped), unless the
+  // collapses since it was built added more than half as many entries again (stale ones,
+  // checked on use): then built again below
+  const bool rebuild_guard = guard_on_ && 2 * gface_.size() > gbuilt_.size() + 1024;
+  if (guard_on_ && !rebuild_guard) {
+    for (std::vector<int32_t>* list : {&gbuilt_, &gface_})
+      for (int32_t& e : *list)
+        if (e >= 0) e = tmap[size_t(e >> 2)] < 0 ? -1 : 4 * tmap[size_t(e >> 2)] + (e & 3);
+    gseen_.assign(4 * size_t(m), 0);
+    gstamp_ = 0;
+  }
   for (Labels& l : mesh_.tet_labels) l.values.resize(m);
   for (Field& f : mesh_.tet_fields) f.values.resize(size_t(m) * f.components);
 
@@ -623,7 +634,7 @@ void SeqMesh::compact(std::vector<int32_t>& vmap, std::vector<int32_t>& kept) {
   mark_.resize(n);  // stale stamps are all older than the next one
   lmark_.resize(n);
   rebuild_rings();
-  if (guard_on_) build_guard(guard_h_req_);
+  if (rebuild_guard) build_guard(guard_h_req_);
 }
 
 // --- surface guard ---
@@ -777,10 +788,36 @@ void SeqMesh::build_guard(double h) {
     if (cells <= max_cells) break;
     guard_h_ *= std::fmax(1.01, std::cbrt(cells / max_cells));  // larger cells, fewer of them
   }
-  ghead_.assign(size_t(guard_dim_[0]) * size_t(guard_dim_[1]) * size_t(guard_dim_[2]), -1);
-  gface_.reserve(4 * faces.size());
-  gnext_.reserve(4 * faces.size());
-  for (int32_t e : faces) guard_insert(e >> 2, e & 3);
+  // the faces by cell (counted, then placed), each in every cell its box meets
+  const size_t ncells = size_t(guard_dim_[0]) * size_t(guard_dim_[1]) * size_t(guard_dim_[2]);
+  ghead_.assign(ncells, -1);
+  gcell_off_.assign(ncells + 1, 0);
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int32_t e : faces) {
+      const int32_t* q = tet(e >> 2);
+      const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[e & 3][0]]), point(q[geo::TC_TET_FACES[e & 3][1]]),
+                          point(q[geo::TC_TET_FACES[e & 3][2]])};
+      int clo[3], chi[3];
+      guard_cells(p, clo, chi);
+      for (int k = clo[2]; k <= chi[2]; ++k)
+        for (int j = clo[1]; j <= chi[1]; ++j)
+          for (int i = clo[0]; i <= chi[0]; ++i) {
+            const size_t c = guard_cell(i, j, k);
+            if (pass == 0) ++gcell_off_[c + 1];
+            else gbuilt_[gcell_off_[c]++] = e;  // the offsets moved one cell on (restored below)
+          }
+    }
+    if (pass == 0) {
+      for (size_t c = 0; c < ncells; ++c) {
+        if (double(gcell_off_[c]) + double(gcell_off_[c + 1]) >= double(std::numeric_limits<int32_t>::max()))
+          throw InputError("<mesh>", "the sequential method's surface guard needs more than 2^31 grid entries");
+        gcell_off_[c + 1] += gcell_off_[c];
+      }
+      gbuilt_.assign(gcell_off_[ncells], -1);
+    }
+  }
+  for (size_t c = ncells; c > 0; --c) gcell_off_[c] = gcell_off_[c - 1];
+  gcell_off_[0] = 0;
 }
 
 bool SeqMesh::guard_ok(int32_t a, int32_t b, uint8_t dir) {
@@ -847,8 +884,19 @@ bool SeqMesh::guard_ok(int32_t a, int32_t b, uint8_t dir) {
     for (int k = lo[2]; k <= hi[2]; ++k)
       for (int j = lo[1]; j <= hi[1]; ++j)
         for (int i = lo[0]; i <= hi[0]; ++i) {
-          for (int32_t node = ghead_[guard_cell(i, j, k)]; node >= 0; node = gnext_[size_t(node)]) {
-            const int32_t e = gface_[size_t(node)];
+          const size_t cell = guard_cell(i, j, k);
+          // the faces placed by build_guard, then those inserted since
+          for (int32_t r = int32_t(gcell_off_[cell]), node = ghead_[cell];;) {
+            int32_t e;
+            if (r >= 0 && uint32_t(r) < gcell_off_[cell + 1]) {
+              e = gbuilt_[size_t(r++)];
+            } else {
+              r = -1;
+              if (node < 0) break;
+              e = gface_[size_t(node)];
+              node = gnext_[size_t(node)];
+            }
+            if (e < 0) continue;  // of a tet removed before a compaction
             if (gseen_[e] == gstamp_) continue;
             gseen_[e] = gstamp_;
             const int32_t t = e >> 2;

@@ -106,7 +106,8 @@ class SeqMesh {
 
   // Surface guard (the device's: cl/collapse_guard.cl). build_guard() indexes the current
   // S faces in a grid of cells of the mean extent of an S face (h when there is none);
-  // collapses keep it current and compact() rebuilds it. guard_ok() tells whether the collapse
+  // collapses keep it current and compact() renumbers it (rebuilds it once the collapses
+  // have added half as many entries again). guard_ok() tells whether the collapse
   // of (a, b) in direction dir keeps S free of self-intersections: its new S triangles (those
   // of tcc_sg_new_tri) against every current S face it does not replace, and among themselves,
   // with the device's triangle test (cl/collapse_guard_geometry.h).
@@ -201,12 +202,16 @@ class SeqMesh {
   double guard_h_req_ = 0, guard_h_ = 1;
   geo::tc_d3 guard_org_{0, 0, 0};
   int guard_dim_[3] = {1, 1, 1};
-  // a dense grid of list heads (at most max(2^16, 8 x the S faces) cells: build_guard makes the
-  // cells larger when the mean extent would need more) and the lists' nodes, appended to by
-  // every insertion: no allocation per cell, and a rebuild costs one pass over the faces
-  // (a hash map of per-cell vectors took ~20 ms per build on W1's host tail)
-  std::vector<int32_t> ghead_;            // per cell: the first node, -1 none
-  std::vector<int32_t> gface_, gnext_;    // per node: the face 4 t + f and the next node (-1)
+  // A dense grid of at most max(2^16, 8 x the S faces) cells (build_guard makes the cells larger
+  // when the mean extent would need more): the faces build_guard placed, by cell (gbuilt_ from
+  // gcell_off_[c] to gcell_off_[c + 1]), and per cell a list of the faces inserted since
+  // (ghead_, then gface_ / gnext_ per node, -1 ends). No allocation per cell, and a build is
+  // two passes over the faces (a hash map of per-cell vectors took ~20 ms per build on W1's
+  // host tail). A face id is 4 t + f, -1 when dropped by compact().
+  std::vector<uint32_t> gcell_off_;
+  std::vector<int32_t> gbuilt_;
+  std::vector<int32_t> ghead_;
+  std::vector<int32_t> gface_, gnext_;
   std::vector<uint32_t> gseen_;
   uint32_t gstamp_ = 0;
   std::vector<NewTri> newtris_;
