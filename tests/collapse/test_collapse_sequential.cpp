@@ -713,6 +713,45 @@ TEST(SequentialGuard, RefusesWithTheGridCoarsened) {
   }
 }
 
+// compact() renumbers the guard's grid instead of building it again (when few collapses came
+// since it was built): after one collapse elsewhere, the dimple's collapses are still refused.
+TEST(SequentialGuard, RefusesAfterACompaction) {
+  CollapseOptions o;
+  o.target_length = 10;
+  o.min_quality = 0;
+  Mesh in = dimple_and_tip(true);  // vertices 0-9, then a cube whose collapse comes first
+  const Mesh cube = test::cube_tets(4);
+  const int32_t base = int32_t(in.num_vertices());
+  for (size_t i = 0; i < cube.points.size(); ++i) in.points.push_back(cube.points[i] + (i % 3 == 0 ? 5.0 : 0.0));
+  for (int32_t v : cube.tets) in.tets.push_back(base + v);
+  Mesh m = in;
+  SeqMesh sm(m, seq_params_from(o));
+  sm.build_guard(0.1);
+  std::vector<int32_t> nb, vmap, kept;
+  bool collapsed = false;
+  for (int32_t a = base; a < sm.num_vertices() && !collapsed; ++a) {
+    sm.neighbours(a, nb, true);
+    for (int32_t b : nb) {
+      const Verdict v = sm.check(a, b);
+      if (v.reason != kOk || !sm.guard_ok(a, b, v.dir)) continue;
+      sm.collapse(a, b, v.dir);
+      collapsed = true;
+      break;
+    }
+  }
+  ASSERT_TRUE(collapsed) << "no collapse in the cube";
+  sm.compact(vmap, kept);
+  for (int32_t v = 0; v < base; ++v) ASSERT_EQ(vmap[v], v);  // the dimple's vertices keep their numbers
+  int admitted = 0;
+  for (int32_t c = 0; c < 4; ++c) {
+    const Verdict v = sm.check(c, 4);
+    if (v.reason != kOk) continue;
+    ++admitted;
+    EXPECT_FALSE(sm.guard_ok(c, 4, v.dir)) << "corner " << c;
+  }
+  EXPECT_GE(admitted, 1);
+}
+
 // Greedy (the host tail's mode): after an iteration in which the surface guard refused edges,
 // the next iteration lists only those. Sound when no other edge is admissible and passes the
 // guard then: checked over every edge of the mesh after each such iteration.
@@ -764,6 +803,9 @@ TEST(SequentialGuard, GreedyLaterIterationsNeedOnlyTheRefusedEdges) {
       EXPECT_LE(s.edges, int64_t(listed.size()));  // the listed edges that are still edges
       EXPECT_EQ(s.collapsed >= 1, admissible >= 1) << admissible << " admissible edges";
     }
+    run.finish();
+    // the grid renumbered by the compactions still refuses what the first refused
+    EXPECT_TRUE(check(m, in).valid) << check_report_text(check(m, in));
     std::printf("%s: %lld iterations with refusals, %lld checked (all inputs so far)\n", name.c_str(),
                 (long long)refusing_iterations, (long long)checked_iterations);
   }
