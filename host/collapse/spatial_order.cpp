@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <utility>
 
 namespace tc::collapse_detail {
 
@@ -34,7 +35,9 @@ SpatialOrder spatial_order(const Mesh& mesh) {
   for (int c = 0; c < 3; ++c) extent = std::max(extent, hi[c] > lo[c] ? hi[c] - lo[c] : 0.0);
   // 0 when every point is the same, or when the extent overflows (coordinates near +-1e308)
   const double scale = extent > 0 && std::isfinite(extent) ? double((1u << 21) - 1) / extent : 0;
-  std::vector<uint64_t> code(nv);
+  // (code, input index) sorted as pairs, not indices through a comparator that looks the codes
+  // up: the same order, without a cache miss per comparison (W1: ~17 ms -> a few)
+  std::vector<std::pair<uint64_t, int32_t>> code(nv);
   for (size_t v = 0; v < nv; ++v) {
     uint64_t k = 0;
     for (int c = 0; c < 3; ++c) {
@@ -42,15 +45,16 @@ SpatialOrder spatial_order(const Mesh& mesh) {
       const double q = std::isfinite(x) && scale > 0 ? (x - lo[c]) * scale : 0.0;  // non-finite: refused later
       k |= spread3(q > 0 ? uint64_t(std::min(q, double((1u << 21) - 1))) : 0) << c;
     }
-    code[v] = k;
+    code[v] = {k, int32_t(v)};
   }
+  std::sort(code.begin(), code.end());
   o.vertex_old.resize(nv);
-  std::iota(o.vertex_old.begin(), o.vertex_old.end(), 0);
-  std::sort(o.vertex_old.begin(), o.vertex_old.end(),
-            [&](int32_t a, int32_t b) { return code[a] != code[b] ? code[a] < code[b] : a < b; });
   o.vertex_new.resize(nv);
-  for (size_t i = 0; i < nv; ++i) o.vertex_new[size_t(o.vertex_old[i])] = int32_t(i);
-  // tets: a stable counting sort by their smallest new vertex index
+  for (size_t i = 0; i < nv; ++i) {
+    o.vertex_old[i] = code[i].second;
+    o.vertex_new[size_t(code[i].second)] = int32_t(i);
+  }
+  // tets: a stable counting sort by their smallest new vertex index, each placed renumbered
   std::vector<uint32_t> start(nv + 1, 0), key(nt);
   for (size_t t = 0; t < nt; ++t) {
     int32_t m = o.vertex_new[size_t(mesh.tets[4 * t])];
@@ -60,7 +64,12 @@ SpatialOrder spatial_order(const Mesh& mesh) {
   }
   for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
   o.tet_old.resize(nt);
-  for (size_t t = 0; t < nt; ++t) o.tet_old[start[key[t]]++] = int32_t(t);
+  o.tets.resize(4 * nt);
+  for (size_t t = 0; t < nt; ++t) {
+    const uint32_t at = start[key[t]]++;
+    o.tet_old[at] = int32_t(t);
+    for (int k = 0; k < 4; ++k) o.tets[4 * size_t(at) + k] = o.vertex_new[size_t(mesh.tets[4 * t + k])];
+  }
   return o;
 }
 

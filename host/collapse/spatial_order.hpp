@@ -18,6 +18,7 @@ struct SpatialOrder {
   std::vector<int32_t> vertex_old;  // new vertex -> input vertex
   std::vector<int32_t> vertex_new;  // input vertex -> new vertex
   std::vector<int32_t> tet_old;     // new tet -> input tet
+  std::vector<int32_t> tets;        // 4 per tet: the tets in the new order, with new vertex indices
 };
 
 // Assumes check_collapse_input(mesh) passed (tet indices in range).

@@ -167,9 +167,7 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
     dm.tets = DeviceBuffer<int32_t>(ctx, mesh.tets);
   } else {
     dm.points = DeviceBuffer<double>(ctx, gather(mesh.points, nv, 3, vold));
-    std::vector<int32_t> tets = gather(mesh.tets, nt, 4, told);
-    for (int32_t& v : tets) v = order->vertex_new[size_t(v)];
-    dm.tets = DeviceBuffer<int32_t>(ctx, tets);
+    dm.tets = DeviceBuffer<int32_t>(ctx, spatial.tets);
   }
   dm.labels.clear();
   for (const Labels& l : mesh.tet_labels) {  // lengths checked by check_collapse_input

@@ -88,11 +88,15 @@ TEST(SpatialOrder, IsAPermutationThatKeepsEdgeEndsClose) {
   std::vector<int32_t> t = o.tet_old;
   std::sort(t.begin(), t.end());
   for (size_t i = 0; i < nt; ++i) ASSERT_EQ(t[i], int32_t(i));
-  // tets by their smallest new vertex
+  // tets by their smallest new vertex; tets holds them in that order, renumbered
+  ASSERT_EQ(o.tets.size(), 4 * nt);
   int32_t prev = -1;
   for (size_t j = 0; j < nt; ++j) {
     int32_t lo = INT32_MAX;
-    for (int k = 0; k < 4; ++k) lo = std::min(lo, o.vertex_new[size_t(m.tets[4 * size_t(o.tet_old[j]) + k])]);
+    for (int k = 0; k < 4; ++k) {
+      lo = std::min(lo, o.vertex_new[size_t(m.tets[4 * size_t(o.tet_old[j]) + k])]);
+      ASSERT_EQ(o.tets[4 * j + k], o.vertex_new[size_t(m.tets[4 * size_t(o.tet_old[j]) + k])]) << "tet " << j;
+    }
     EXPECT_GE(lo, prev) << "tet " << j;
     prev = lo;
   }
