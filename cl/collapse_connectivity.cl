@@ -328,14 +328,20 @@ __kernel void conn_tet_neighbours_carry(uint nt, __global const int* tets, __glo
 }
 
 /* Over vertices 0..n-1, or over list[0..n-1] when use_list. */
+/* The two local indices of a tet other than i and j (i != j), for the faces through a vertex:
+ * face j of a tet holding v at local lv has v and the vertices at TCC_OTHER2[lv][j]. */
+__constant uchar TCC_OTHER2[4][4][2] = {{{0, 0}, {2, 3}, {1, 3}, {1, 2}},
+                                        {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
+                                        {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
+                                        {{1, 2}, {0, 2}, {0, 1}, {0, 0}}};
+
 __kernel void conn_tet_neighbours(uint n, __global const int* tets, __global const uint* vt_off,
                                   __global const int* vt, __global int* tet_nbr, int use_list,
                                   __global const uint* list) {
   uint gid = get_global_id(0);
   if (gid >= n) return;
   uint v = use_list ? list[gid] : gid;
-  int ft[TCC_MAX_MIN_FACES];
-  uchar ff[TCC_MAX_MIN_FACES];
+  int tf[TCC_MAX_MIN_FACES]; /* 4 t + f (t < 2^29: check_collapse_input) */
   ulong key[TCC_MAX_MIN_FACES];
   int k = 0, overflow = 0;
   for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) {
@@ -344,23 +350,16 @@ __kernel void conn_tet_neighbours(uint n, __global const int* tets, __global con
     int lv = tcc_local(tets, t, (int)v);
     for (int f = 0; f < 4; ++f) {
       if (f == lv) continue;
-      int u = -1, w = -1, ok = 1;
-      for (int j = 0; j < 4; ++j) {
-        if (j == f || j == lv) continue;
-        if (q[j] < (int)v) ok = 0;
-        if (u < 0) u = q[j];
-        else w = q[j];
-      }
-      if (!ok) continue; /* v is not the smallest vertex of this face */
+      int u = q[TCC_OTHER2[lv][f][0]], w = q[TCC_OTHER2[lv][f][1]];
+      if (u < (int)v || w < (int)v) continue; /* v is not the smallest vertex of this face */
       if (k == TCC_MAX_MIN_FACES) {
         overflow = 1;
         int other;
-        int n = tcc_face_others(tets, vt_off, vt, t, f, &other);
-        tet_nbr[4 * t + f] = n == 0 ? -1 : n == 1 ? other : -2;
+        int m = tcc_face_others(tets, vt_off, vt, t, f, &other);
+        tet_nbr[4 * t + f] = m == 0 ? -1 : m == 1 ? other : -2;
         continue;
       }
-      ft[k] = t;
-      ff[k] = (uchar)f;
+      tf[k] = 4 * t + f;
       key[k] = u < w ? ((ulong)(uint)u << 32 | (uint)w) : ((ulong)(uint)w << 32 | (uint)u);
       ++k;
     }
@@ -368,8 +367,8 @@ __kernel void conn_tet_neighbours(uint n, __global const int* tets, __global con
   if (overflow) { /* faces beyond the capacity may match these too: the ring scan for each */
     for (int i = 0; i < k; ++i) {
       int other;
-      int n = tcc_face_others(tets, vt_off, vt, ft[i], ff[i], &other);
-      tet_nbr[4 * ft[i] + ff[i]] = n == 0 ? -1 : n == 1 ? other : -2;
+      int m = tcc_face_others(tets, vt_off, vt, tf[i] >> 2, tf[i] & 3, &other);
+      tet_nbr[tf[i]] = m == 0 ? -1 : m == 1 ? other : -2;
     }
     return;
   }
@@ -377,23 +376,20 @@ __kernel void conn_tet_neighbours(uint n, __global const int* tets, __global con
    * is a boundary face, two are the two tets of an inner face, more an invalid input. */
   for (int i = 1; i < k; ++i) {
     ulong kk = key[i];
-    int tt = ft[i];
-    uchar fv = ff[i];
+    int x = tf[i];
     int j = i;
     for (; j > 0 && key[j - 1] > kk; --j) {
       key[j] = key[j - 1];
-      ft[j] = ft[j - 1];
-      ff[j] = ff[j - 1];
+      tf[j] = tf[j - 1];
     }
     key[j] = kk;
-    ft[j] = tt;
-    ff[j] = fv;
+    tf[j] = x;
   }
   for (int i = 0; i < k;) {
     int j = i + 1;
     while (j < k && key[j] == key[i]) ++j;
     for (int m = i; m < j; ++m)
-      tet_nbr[4 * ft[m] + ff[m]] = j - i == 1 ? -1 : j - i == 2 ? ft[m == i ? i + 1 : i] : -2;
+      tet_nbr[tf[m]] = j - i == 1 ? -1 : j - i == 2 ? (tf[m == i ? i + 1 : i] >> 2) : -2;
     i = j;
   }
 }
