@@ -25,6 +25,11 @@ struct DeviceMesh {
   DeviceBuffer<double> vfields, tfields;
   bool has_mask = false;
   DeviceBuffer<uint8_t> vmask;
+  // ring(v) of every vertex (ascending), filled on the host by upload_mesh for a CPU device;
+  // the first build_connectivity takes them (has_rings then false)
+  bool has_rings = false;
+  DeviceBuffer<uint32_t> vt_off;  // nv + 1
+  DeviceBuffer<int32_t> vt;       // 4 nt
 };
 
 // Stage 1 output.

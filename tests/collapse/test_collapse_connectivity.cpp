@@ -63,11 +63,15 @@ std::vector<int32_t> device_tet_nbr(Context& ctx, const Mesh& mesh) {
 // classes_capped: the program is built with TCC_MAX_VERTEX_SFACES small, so that vertices with
 // more S-faces are corners (and their edges' flags come from ring scans); then every vertex of S
 // must have its reference class or be a corner, and some must be corners that are not.
-void compare_with_reference(Context& ctx, const Mesh& mesh, bool classes_capped = false) {
+// device_rings: the rings by the device's count, scatter and sort (a GPU's way) even when the
+// upload filled them on the host (a CPU device's).
+void compare_with_reference(Context& ctx, const Mesh& mesh, bool classes_capped = false, bool device_rings = false) {
   CollapseOptions o;
   StageParams p = params_from(o);
   DeviceMesh dm;
   upload_mesh(ctx, mesh, o, dm);
+  EXPECT_EQ(dm.has_rings, ctx.info().type == "CPU");
+  if (device_rings) dm.has_rings = false;
   Connectivity c;
   build_connectivity(ctx, dm, c, p);
   Topology ref = build_topology(mesh);
@@ -123,13 +127,17 @@ void compare_with_reference(Context& ctx, const Mesh& mesh, bool classes_capped 
 
 TEST(CollapseConnectivity, CubeMatchesBuildTopology) {
   Context ctx;
-  compare_with_reference(ctx, test::cube_tets(4));
+  for (bool device_rings : {false, true}) {
+    SCOPED_TRACE(device_rings ? "device rings" : "upload's rings");
+    compare_with_reference(ctx, test::cube_tets(4), false, device_rings);
+  }
 }
 
 TEST(CollapseConnectivity, MaterialInterfaceMatchesBuildTopology) {
   Context ctx;
   Mesh m = two_materials(4);
   compare_with_reference(ctx, m);
+  compare_with_reference(ctx, m, false, true);
   Topology ref = build_topology(m);
   int interface_vertices = 0;
   for (uint8_t b : ref.vertex_boundary) interface_vertices += (b & kOnInterface) ? 1 : 0;
