@@ -327,14 +327,15 @@ __kernel void conn_tet_neighbours_carry(uint nt, __global const int* tets, __glo
   }
 }
 
-/* Over vertices 0..n-1, or over list[0..n-1] when use_list. */
-/* The two local indices of a tet other than i and j (i != j), for the faces through a vertex:
- * face j of a tet holding v at local lv has v and the vertices at TCC_OTHER2[lv][j]. */
+/* The two local indices of a tet other than lv and f (lv != f), ascending: face f (opposite
+ * local vertex f) of a tet holding v at local index lv has v and the vertices at
+ * TCC_OTHER2[lv][f]. */
 __constant uchar TCC_OTHER2[4][4][2] = {{{0, 0}, {2, 3}, {1, 3}, {1, 2}},
                                         {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
                                         {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
                                         {{1, 2}, {0, 2}, {0, 1}, {0, 0}}};
 
+/* Over vertices 0..n-1, or over list[0..n-1] when use_list. */
 __kernel void conn_tet_neighbours(uint n, __global const int* tets, __global const uint* vt_off,
                                   __global const int* vt, __global int* tet_nbr, int use_list,
                                   __global const uint* list) {

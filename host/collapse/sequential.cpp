@@ -217,7 +217,9 @@ bool SequentialRun::step() {
     if (!sm_.alive(e.a) || !sm_.alive(e.b)) continue;
     uint8_t dir = e.dir;
     const bool invalidated = touched_[e.a] == cur || touched_[e.b] == cur;
-    if (invalidated && o_.sequential_skip_invalidated) continue;  // the paper's reading: next iteration
+    // the paper's reading: next iteration (not in greedy mode, whose stop rule and listing of
+    // the guard's refusals rely on every invalidated edge being tested again)
+    if (invalidated && o_.sequential_skip_invalidated && !greedy_) continue;
     if (!reuse || invalidated) {
       if (!sm_.is_edge(e.a, e.b)) continue;
       const double cost = sm_.length(e.a, e.b);

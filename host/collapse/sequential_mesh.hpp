@@ -103,11 +103,14 @@ class SeqMesh {
   // The same for the tet neighbours: the faces of live tets whose kept neighbour differs from a
   // ring scan's.
   int64_t verify_nbr() const;
+  // The same for the surface guard's grid (after build_guard): the (S face, cell) pairs missing
+  // from it, over every S face of the live tets and every cell its box meets.
+  int64_t verify_guard() const;
 
   // Surface guard (the device's: cl/collapse_guard.cl). build_guard() indexes the current
   // S faces in a grid of cells of the mean extent of an S face (h when there is none);
   // collapses keep it current and compact() renumbers it (rebuilds it once the collapses
-  // have added half as many entries again). guard_ok() tells whether the collapse
+  // have added more than half as many entries again, plus 1024). guard_ok() tells whether the collapse
   // of (a, b) in direction dir keeps S free of self-intersections: its new S triangles (those
   // of tcc_sg_new_tri) against every current S face it does not replace, and among themselves,
   // with the device's triangle test (cl/collapse_guard_geometry.h).

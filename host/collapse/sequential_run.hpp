@@ -26,7 +26,8 @@
 // The options of the parallel method's conflict detection (conflicts, selection_rounds) do not
 // apply; a user cost (cost_cl_source) is refused.
 //
-// IterationStats of an iteration: marked (all marked edges), passed_q (of those, passing Q at
+// IterationStats of an iteration: marked (all marked edges; in a greedy iteration after the
+// first, of the listed edges only, as edges), passed_q (of those, passing Q at
 // the start), tested (link and volume tests at the start), admissible (pushed into the queue),
 // after_pass1 = after_pass2 = collapsed (no conflict passes); seconds_connectivity: the edge
 // list, seconds_admissible: marking, checks and queue, seconds_collapse: popping, checking

@@ -48,7 +48,10 @@ namespace tc {
 
 struct IterationStats {
   int iteration = 0;              // 0-based
-  int64_t vertices = 0, tets = 0, edges = 0;  // of the mesh this iteration started from
+  // of the mesh this iteration started from; edges, marked, passed_q and tested of a host-tail
+  // iteration after its first (on_host) count only the edges it lists: those the surface guard
+  // refused in the iteration before (every other edge was refused after its star last changed)
+  int64_t vertices = 0, tets = 0, edges = 0;
   int64_t marked = 0;             // cost < target (and in the mask)
   // The admissible filter is lazy (it runs inside conflict pass 1, or inside the greedy
   // selection): Q is evaluated on every marked edge, but the link condition and the volume test

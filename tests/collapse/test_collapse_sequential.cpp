@@ -382,6 +382,7 @@ TEST(SequentialVerdicts, IncrementalStateAgreesWithTheDeviceInLaterIterations) {
       const std::string what = name + " after iteration " + std::to_string(it + 1);
       EXPECT_EQ(run.seq().verify_classes(), 0) << what;
       EXPECT_EQ(run.seq().verify_nbr(), 0) << what;
+      EXPECT_EQ(run.seq().verify_guard(), 0) << what;
       expect_same_verdicts(ctx, run.seq(), m, o, run.target(), what);
     }
   }
@@ -411,6 +412,7 @@ TEST(SequentialVerdicts, ClassesStayThoseOfAFreshClassification) {
       EXPECT_EQ(bad, 0) << name << " after iteration " << steps;
       EXPECT_EQ(run.seq().verify_classes(), 0) << name << " after iteration " << steps;
       EXPECT_EQ(run.seq().verify_nbr(), 0) << name << " after iteration " << steps;
+      EXPECT_EQ(run.seq().verify_guard(), 0) << name << " after iteration " << steps;
     }
     EXPECT_GT(steps, 1) << name;
   }
@@ -652,6 +654,18 @@ Mesh dimple_and_tip(bool with_b, double lift = 0) {
   return m;
 }
 
+// cube_tets(n) moved to x in [5, 6], then dimple_and_tip(true) with its vertices from *first on:
+// collapses in the cube renumber the dimple's vertices and tets.
+Mesh cube_then_dimple(int n, int32_t* first) {
+  Mesh m = test::cube_tets(n);
+  for (size_t i = 0; i < m.points.size(); i += 3) m.points[i] += 5.0;
+  const Mesh d = dimple_and_tip(true);
+  *first = int32_t(m.num_vertices());
+  m.points.insert(m.points.end(), d.points.begin(), d.points.end());
+  for (int32_t v : d.tets) m.tets.push_back(*first + v);
+  return m;
+}
+
 }  // namespace
 
 TEST(SequentialGuard, FlatteningDoesNotPushTheSurfaceIntoAnotherBody) {
@@ -719,17 +733,14 @@ TEST(SequentialGuard, RefusesAfterACompaction) {
   CollapseOptions o;
   o.target_length = 10;
   o.min_quality = 0;
-  Mesh in = dimple_and_tip(true);  // vertices 0-9, then a cube whose collapse comes first
-  const Mesh cube = test::cube_tets(4);
-  const int32_t base = int32_t(in.num_vertices());
-  for (size_t i = 0; i < cube.points.size(); ++i) in.points.push_back(cube.points[i] + (i % 3 == 0 ? 5.0 : 0.0));
-  for (int32_t v : cube.tets) in.tets.push_back(base + v);
-  Mesh m = in;
+  int32_t first = 0;
+  Mesh m = cube_then_dimple(4, &first);
+  const int64_t nt = m.num_tets();
   SeqMesh sm(m, seq_params_from(o));
   sm.build_guard(0.1);
   std::vector<int32_t> nb, vmap, kept;
   bool collapsed = false;
-  for (int32_t a = base; a < sm.num_vertices() && !collapsed; ++a) {
+  for (int32_t a = 0; a < first && !collapsed; ++a) {  // one collapse in the cube
     sm.neighbours(a, nb, true);
     for (int32_t b : nb) {
       const Verdict v = sm.check(a, b);
@@ -740,14 +751,20 @@ TEST(SequentialGuard, RefusesAfterACompaction) {
     }
   }
   ASSERT_TRUE(collapsed) << "no collapse in the cube";
+  EXPECT_EQ(sm.verify_guard(), 0) << "after the collapse";
   sm.compact(vmap, kept);
-  for (int32_t v = 0; v < base; ++v) ASSERT_EQ(vmap[v], v);  // the dimple's vertices keep their numbers
+  EXPECT_EQ(sm.verify_guard(), 0) << "after the compaction";
+  // the dimple's vertices and tets (the last five) moved down
+  ASSERT_EQ(vmap[size_t(first)], first - 1);
+  ASSERT_LT(m.num_tets(), nt);
+  const int32_t centre = vmap[size_t(first) + 4];
   int admitted = 0;
   for (int32_t c = 0; c < 4; ++c) {
-    const Verdict v = sm.check(c, 4);
+    const int32_t corner = vmap[size_t(first + c)];
+    const Verdict v = sm.check(corner, centre);
     if (v.reason != kOk) continue;
     ++admitted;
-    EXPECT_FALSE(sm.guard_ok(c, 4, v.dir)) << "corner " << c;
+    EXPECT_FALSE(sm.guard_ok(corner, centre, v.dir)) << "corner " << c;
   }
   EXPECT_GE(admitted, 1);
 }
@@ -756,14 +773,11 @@ TEST(SequentialGuard, RefusesAfterACompaction) {
 // the next iteration lists only those. Sound when no other edge is admissible and passes the
 // guard then: checked over every edge of the mesh after each such iteration.
 TEST(SequentialGuard, GreedyLaterIterationsNeedOnlyTheRefusedEdges) {
-  // the dimple with the tip in its void (refused) beside a cube that collapses in the same
-  // iteration, so that another iteration follows
-  Mesh both = dimple_and_tip(true);
-  const Mesh cube = test::cube_tets(3);
-  const int32_t base = int32_t(both.num_vertices());
-  for (size_t i = 0; i < cube.points.size(); ++i) both.points.push_back(cube.points[i] + (i % 3 == 0 ? 5.0 : 0.0));
-  for (int32_t v : cube.tets) both.tets.push_back(base + v);
-  std::vector<std::pair<std::string, Mesh>> inputs{{"dimple and tip beside a cube", both}};
+  // the dimple with the tip in its void (refused) after a cube that collapses in the same
+  // iteration, so that another iteration follows with the refused edges renumbered
+  int32_t first = 0;  // the dimple's first vertex
+  std::vector<std::pair<std::string, Mesh>> inputs{{"dimple and tip beside a cube", cube_then_dimple(3, &first)}};
+  ASSERT_EQ(int32_t(inputs[0].second.num_vertices()), first + 10);
   const std::string fusee = test::shared_mesh("gen_gmsh_917_fusee_88k.msh");
   if (!fusee.empty()) inputs.emplace_back("fusee 88k", read_mesh(fusee));
   else std::printf("fusee 88k absent: the dimple and the cube alone\n");
@@ -785,6 +799,13 @@ TEST(SequentialGuard, GreedyLaterIterationsNeedOnlyTheRefusedEdges) {
       for (size_t i = 0; i + 1 < refused.size(); i += 2)
         listed.insert({std::min(refused[i], refused[i + 1]), std::max(refused[i], refused[i + 1])});
       SeqMesh& sm = run.seq();
+      EXPECT_EQ(sm.verify_guard(), 0);  // renumbered by the compaction, not built again
+      if (name == "dimple and tip beside a cube") {
+        // renumbered: edges to the dimple's centre, vertex 4 of the last 10 (the cube lost some)
+        EXPECT_LT(sm.num_vertices(), int32_t(in.num_vertices()));
+        const int32_t centre = sm.num_vertices() - 10 + 4;
+        for (const auto& [a, b] : listed) EXPECT_TRUE(sm.is_edge(a, b) && b == centre) << a << "-" << b;
+      }
       std::vector<int32_t> nb;
       int64_t admissible = 0;
       for (int32_t a = 0; a < sm.num_vertices(); ++a) {
@@ -804,7 +825,8 @@ TEST(SequentialGuard, GreedyLaterIterationsNeedOnlyTheRefusedEdges) {
       EXPECT_EQ(s.collapsed >= 1, admissible >= 1) << admissible << " admissible edges";
     }
     run.finish();
-    // the grid renumbered by the compactions still refuses what the first refused
+    // valid: the later iterations (their grid renumbered by the compactions) refused again
+    // what the first refused
     EXPECT_TRUE(check(m, in).valid) << check_report_text(check(m, in));
     std::printf("%s: %lld iterations with refusals, %lld checked (all inputs so far)\n", name.c_str(),
                 (long long)refusing_iterations, (long long)checked_iterations);
