@@ -703,21 +703,9 @@ int64_t SeqMesh::verify_guard() const {
     if (!talive_[t]) continue;
     for (int f = 0; f < 4; ++f) {
       if (!owned_sface(t, f)) continue;
-      const int32_t* q = tet(t);
-      const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]),
-                          point(q[geo::TC_TET_FACES[f][2]])};
-      int lo[3], hi[3];
-      guard_cells(p, lo, hi);
-      for (int k = lo[2]; k <= hi[2]; ++k)
-        for (int j = lo[1]; j <= hi[1]; ++j)
-          for (int i = lo[0]; i <= hi[0]; ++i) {
-            const size_t cell = guard_cell(i, j, k);
-            bool found = std::find(gbuilt_.begin() + gcell_off_[cell], gbuilt_.begin() + gcell_off_[cell + 1],
-                                   4 * t + f) != gbuilt_.begin() + gcell_off_[cell + 1];
-            for (int32_t node = ghead_[cell]; node >= 0 && !found; node = gnext_[size_t(node)])
-              found = gface_[size_t(node)] == 4 * t + f;
-            missing += found ? 0 : 1;
-          }
+      each_guard_cell(t, f, [&](size_t cell) {
+        missing += any_guard_face(cell, [&](int32_t e) { return e == 4 * t + f; }) ? 0 : 1;
+      });
     }
   }
   return missing;
@@ -751,24 +739,15 @@ void SeqMesh::guard_cells(const tc_d3* p, int (&lo)[3], int (&hi)[3]) const {
 }
 
 void SeqMesh::guard_insert(int32_t t, int f) {
-  const int32_t* q = tet(t);
-  const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]),
-                      point(q[geo::TC_TET_FACES[f][2]])};
-  int lo[3], hi[3];
-  guard_cells(p, lo, hi);
-  const double nodes = double(hi[0] - lo[0] + 1) * double(hi[1] - lo[1] + 1) * double(hi[2] - lo[2] + 1);
-  // (unreachable at any size the method can hold in memory; were it thrown within collapse(),
-  // the SeqMesh would be left half changed, and the run is abandoned)
-  if (double(gface_.size()) + nodes >= double(std::numeric_limits<int32_t>::max()))
-    throw InputError("<mesh>", "the sequential method's surface guard needs more than 2^31 grid entries");
-  for (int k = lo[2]; k <= hi[2]; ++k)
-    for (int j = lo[1]; j <= hi[1]; ++j)
-      for (int i = lo[0]; i <= hi[0]; ++i) {
-        int32_t& head = ghead_[guard_cell(i, j, k)];
-        gface_.push_back(4 * t + f);
-        gnext_.push_back(head);
-        head = int32_t(gface_.size() - 1);
-      }
+  each_guard_cell(t, f, [&](size_t cell) {
+    // (unreachable at any size the method can hold in memory; were it thrown within collapse(),
+    // the SeqMesh would be left half changed, and the run is abandoned)
+    if (gface_.size() + 1 >= size_t(std::numeric_limits<int32_t>::max()))
+      throw InputError("<mesh>", "the sequential method's surface guard needs more than 2^31 grid entries");
+    gface_.push_back(4 * t + f);
+    gnext_.push_back(ghead_[cell]);
+    ghead_[cell] = int32_t(gface_.size() - 1);
+  });
 }
 
 void SeqMesh::build_guard(double h) {
@@ -822,20 +801,11 @@ void SeqMesh::build_guard(double h) {
   ghead_.assign(ncells, -1);
   gcell_off_.assign(ncells + 1, 0);
   for (int pass = 0; pass < 2; ++pass) {
-    for (int32_t e : faces) {
-      const int32_t* q = tet(e >> 2);
-      const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[e & 3][0]]), point(q[geo::TC_TET_FACES[e & 3][1]]),
-                          point(q[geo::TC_TET_FACES[e & 3][2]])};
-      int clo[3], chi[3];
-      guard_cells(p, clo, chi);
-      for (int k = clo[2]; k <= chi[2]; ++k)
-        for (int j = clo[1]; j <= chi[1]; ++j)
-          for (int i = clo[0]; i <= chi[0]; ++i) {
-            const size_t c = guard_cell(i, j, k);
-            if (pass == 0) ++gcell_off_[c + 1];
-            else gbuilt_[gcell_off_[c]++] = e;  // the offsets moved one cell on (restored below)
-          }
-    }
+    for (int32_t e : faces)
+      each_guard_cell(e >> 2, e & 3, [&](size_t c) {
+        if (pass == 0) ++gcell_off_[c + 1];
+        else gbuilt_[gcell_off_[c]++] = e;  // the offsets moved one cell on (restored below)
+      });
     if (pass == 0) {
       for (size_t c = 0; c < ncells; ++c) {
         if (double(gcell_off_[c]) + double(gcell_off_[c + 1]) >= double(std::numeric_limits<int32_t>::max()))
@@ -908,44 +878,30 @@ bool SeqMesh::guard_ok(int32_t a, int32_t b, uint8_t dir) {
     }
     tc_d3 nlo, nhi;
     box_of(nt.pos, nlo, nhi);
-    int lo[3], hi[3];
-    guard_cells(nt.pos, lo, hi);
-    for (int k = lo[2]; k <= hi[2]; ++k)
-      for (int j = lo[1]; j <= hi[1]; ++j)
-        for (int i = lo[0]; i <= hi[0]; ++i) {
-          const size_t cell = guard_cell(i, j, k);
-          // the faces placed by build_guard, then those inserted since
-          for (int32_t r = int32_t(gcell_off_[cell]), node = ghead_[cell];;) {
-            int32_t e;
-            if (r >= 0 && uint32_t(r) < gcell_off_[cell + 1]) {
-              e = gbuilt_[size_t(r++)];
-            } else {
-              r = -1;
-              if (node < 0) break;
-              e = gface_[size_t(node)];
-              node = gnext_[size_t(node)];
-            }
-            if (e < 0) continue;  // of a tet removed before a compaction
-            if (gseen_[e] == gstamp_) continue;
-            gseen_[e] = gstamp_;
-            const int32_t t = e >> 2;
-            const int f = e & 3;
-            if (!talive_[t]) continue;
-            const int32_t* q = tet(t);
-            int32_t fid[3];
-            bool replaced = false;
-            for (int c = 0; c < 3; ++c) {
-              fid[c] = q[geo::TC_TET_FACES[f][c]];
-              replaced = replaced || fid[c] == x || (moves_y && fid[c] == y);
-            }
-            if (replaced) continue;  // a face the collapse moves or removes
-            const tc_d3 fpos[3] = {point(fid[0]), point(fid[1]), point(fid[2])};
-            tc_d3 flo, fhi;
-            box_of(fpos, flo, fhi);
-            if (boxes_apart(nlo, nhi, flo, fhi) || !owned_sface(t, f)) continue;
-            if (geo::tc_sg_tri_tri(nt.id, nt.pos, fid, fpos)) return false;
-          }
-        }
+    bool crossed = false;
+    each_guard_cell(nt.pos, [&](size_t cell) {
+      crossed = crossed || any_guard_face(cell, [&](int32_t e) {
+                  if (gseen_[e] == gstamp_) return false;
+                  gseen_[e] = gstamp_;
+                  const int32_t t = e >> 2;
+                  const int f = e & 3;
+                  if (!talive_[t]) return false;
+                  const int32_t* q = tet(t);
+                  int32_t fid[3];
+                  bool replaced = false;
+                  for (int c = 0; c < 3; ++c) {
+                    fid[c] = q[geo::TC_TET_FACES[f][c]];
+                    replaced = replaced || fid[c] == x || (moves_y && fid[c] == y);
+                  }
+                  if (replaced) return false;  // a face the collapse moves or removes
+                  const tc_d3 fpos[3] = {point(fid[0]), point(fid[1]), point(fid[2])};
+                  tc_d3 flo, fhi;
+                  box_of(fpos, flo, fhi);
+                  if (boxes_apart(nlo, nhi, flo, fhi) || !owned_sface(t, f)) return false;
+                  return geo::tc_sg_tri_tri(nt.id, nt.pos, fid, fpos) != 0;
+                });
+    });
+    if (crossed) return false;
   }
   return true;
 }

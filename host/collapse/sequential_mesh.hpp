@@ -166,6 +166,33 @@ class SeqMesh {
   uint8_t owned_sface(int32_t t, int f, uint8_t* on_s = nullptr) const;
   void guard_insert(int32_t t, int f);
   void guard_cells(const geo::tc_d3* p, int (&lo)[3], int (&hi)[3]) const;
+  // fn(cell) for every cell of the guard's grid that the box of triangle p meets
+  template <class Fn>
+  void each_guard_cell(const geo::tc_d3* p, Fn&& fn) const {
+    int lo[3], hi[3];
+    guard_cells(p, lo, hi);
+    for (int k = lo[2]; k <= hi[2]; ++k)
+      for (int j = lo[1]; j <= hi[1]; ++j)
+        for (int i = lo[0]; i <= hi[0]; ++i) fn(guard_cell(i, j, k));
+  }
+  // The same for face f of tet t.
+  template <class Fn>
+  void each_guard_cell(int32_t t, int f, Fn&& fn) const {
+    const int32_t* q = tet(t);
+    const geo::tc_d3 p[3] = {point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]),
+                             point(q[geo::TC_TET_FACES[f][2]])};
+    each_guard_cell(p, fn);
+  }
+  // Whether fn(e) holds for a face id e (4 t + f) registered in the cell: those build_guard
+  // placed, then those inserted since (ids dropped by compact() skipped); stops at the first.
+  template <class Fn>
+  bool any_guard_face(size_t cell, Fn&& fn) const {
+    for (uint32_t r = gcell_off_[cell]; r < gcell_off_[cell + 1]; ++r)
+      if (gbuilt_[r] >= 0 && fn(gbuilt_[r])) return true;
+    for (int32_t node = ghead_[cell]; node >= 0; node = gnext_[size_t(node)])
+      if (gface_[size_t(node)] >= 0 && fn(gface_[size_t(node)])) return true;
+    return false;
+  }
   size_t guard_cell(int i, int j, int k) const {
     return size_t(i) + size_t(guard_dim_[0]) * (size_t(j) + size_t(guard_dim_[1]) * size_t(k));
   }
