@@ -211,7 +211,7 @@ __kernel void sguard_applied_queries(uint ne, __global const int* edges, __globa
                                      __global const uint* vt_off, __global const int* vt, __global const uchar* tdead,
                                      __global const uchar* smask, __global const uchar* vflags, __global int* qedge,
                                      __global double* qbox, __global uint* qntri, __global uint* qcount,
-                                     int only_flagged, __global const uchar* requery) {
+                                     int only_flagged, __global const uchar* requery, __global int* qof) {
   uint e = get_global_id(0);
   if (e >= ne || !fin[e] || (only_flagged && !requery[e])) return;
   int x, y;
@@ -232,6 +232,7 @@ __kernel void sguard_applied_queries(uint ne, __global const int* edges, __globa
   uint slot = atomic_inc(qcount);
   qedge[slot] = (int)e;
   qntri[slot] = n;
+  qof[x] = (int)slot; /* a vertex survives one collapse at most */
   __global double* b = qbox + 6 * slot;
   b[0] = lo.x, b[1] = lo.y, b[2] = lo.z, b[3] = hi.x, b[4] = hi.y, b[5] = hi.z;
 }
@@ -288,6 +289,28 @@ __kernel void sguard_tris(uint nq, __global const int* qedge, __global const uin
   })
 }
 
+/* Each pair of S faces of the result is tested once (sguard_surface and sguard_pairs with
+ * `dedup`, the matching selection's runs). Without it, a pair (A, B) is tested for every query
+ * q whose survivor x_q is a vertex of A or B: by the sweep of A against q when x_q is in B
+ * alone (and of B when in A alone), by sguard_pairs of q when in both; each refuses q on a
+ * hit. With it, only for the query whose survivor has the lowest id of those (qof: the query of
+ * each survivor of the run, -1 for other vertices; tmin: per triangle, the lowest survivor among
+ * its vertices), and a hit refuses all of them (tcc_sg_refuse_all): the same refusals, about
+ * half the pairs (W1's first iteration: most S faces have a survivor). */
+inline int tcc_sg_first_survivor(const int* id, __global const int* qof) {
+  int m = INT_MAX;
+  for (int k = 0; k < 3; ++k)
+    if (qof[id[k]] >= 0) m = min(m, id[k]);
+  return m;
+}
+inline void tcc_sg_refuse_all(const int* ia, const int* ib, __global const int* qof, uint code,
+                              volatile __global uint* qbad) {
+  for (int k = 0; k < 6; ++k) {
+    const int q = qof[k < 3 ? ia[k] : ib[k - 3]];
+    if (q >= 0) atomic_max(qbad + q, code); /* the largest code whatever the order */
+  }
+}
+
 /* The S faces through the survivor of each query of sguard_applied_queries, at qoff[q] ..
  * qoff[q + 1]; qrep: the survivor (the faces through it are the query's own). */
 __kernel void sguard_applied_tris(uint nq, __global const int* qedge, __global const uint* qoff,
@@ -295,7 +318,7 @@ __kernel void sguard_applied_tris(uint nq, __global const int* qedge, __global c
                                   __global const int* tets, __global const uint* vt_off, __global const int* vt,
                                   __global const uchar* tdead, __global const uchar* smask, __global int* tid,
                                   __global double* tpos, __global double* tbox, __global double* tplane,
-                                  __global int* qrep) {
+                                  __global int* qrep, __global const int* qof, __global int* tmin) {
   uint qi = get_global_id(0);
   if (qi >= nq) return;
   int x, y;
@@ -307,6 +330,7 @@ __kernel void sguard_applied_tris(uint nq, __global const int* qedge, __global c
   double3 pos[3];
   TCC_SG_FOR_APPLIED_TRIS(x, y, id, pos, {
     tcc_sg_store_tri(n, id, pos, tid, tpos, tbox, tplane);
+    tmin[n] = tcc_sg_first_survivor(id, qof);
     ++n;
   })
 }
@@ -411,7 +435,8 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
                              __global const uint* qoff, __global const int* tid, __global const double* tpos,
                              __global const double* tbox, __global const double* tplane, double ox, double oy, double oz,
                              double ih, int gx, int gy, int gz, __global const uint* cell_off,
-                             __global const uint* cell_items, __global const int* qcell, __global uint* qbad) {
+                             __global const uint* cell_items, __global const int* qcell, __global uint* qbad,
+                             int dedup, __global const int* qof, __global const int* tmin) {
   const uint g = get_global_id(0);
   if (g >= n) return;
   const uint t = stets[g];
@@ -427,13 +452,17 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
     double3 lo = fmin(fmin(fpos[0], fpos[1]), fpos[2]), hi = fmax(fmax(fpos[0], fpos[1]), fpos[2]);
     int has_plane = 0; /* the face's plane, computed at its first triangle test */
     tc_sg_plane fplane;
+    const int fmin_ = dedup ? tcc_sg_first_survivor(fid, qof) : INT_MAX;
     TCC_SG_FOR_CELL_QUERIES(lo, hi, qi, {
-      if (qbad[qi] || !tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, qbox + 6 * qi, qcell + 6 * qi, ci, cj, ck)) continue;
       /* the face is one the collapse moves or removes: it has x, or y when y moves (-1 else) */
-      const int rx = qrep[2 * qi], ry = qrep[2 * qi + 1];
+      const int rx = qrep[2 * qi];
+      /* dedup: the face has x or a lower survivor (its pairs with q are that one's) */
+      if (dedup ? fmin_ <= rx : qbad[qi] != 0u) continue;
+      if (!tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, qbox + 6 * qi, qcell + 6 * qi, ci, cj, ck)) continue;
+      const int ry = qrep[2 * qi + 1];
       if (fid[0] == rx || fid[1] == rx || fid[2] == rx || fid[0] == ry || fid[1] == ry || fid[2] == ry) continue;
       for (uint r = qoff[qi]; r < qoff[qi + 1]; ++r) {
-        if (tcc_sg_tri_box_apart(lo, hi, tbox, r)) continue;
+        if ((dedup && tmin[r] < rx) || tcc_sg_tri_box_apart(lo, hi, tbox, r)) continue;
         int id[3];
         double3 pos[3];
         tcc_sg_load_tri(tid, tpos, r, id, pos);
@@ -443,7 +472,12 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
         }
         if (!tc_sg_tri_tri_planes(id, pos, tcc_sg_load_plane(tplane, r), fid, fpos, fplane)) continue;
         uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
-        qbad[qi] = code < 0x7ffffffeu ? code + 2u : 1u;
+        code = code < 0x7ffffffeu ? code + 2u : 1u;
+        if (dedup) { /* every query of the pair; and on: the face's pairs with q's other triangles */
+          tcc_sg_refuse_all(id, fid, qof, code, qbad);
+          continue;
+        }
+        qbad[qi] = code;
         break;
       }
     })
@@ -457,13 +491,17 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
                            __global const double* tpos, __global const double* tbox, __global const double* tplane,
                            double ox, double oy, double oz, double ih, int gx, int gy, int gz,
                            __global const uint* cell_off, __global const uint* cell_items, __global const int* qcell,
-                           __global uint* qbad, int cross) {
+                           __global uint* qbad, int cross, int dedup, __global const int* qrep, __global const int* qof,
+                           __global const int* tmin) {
   uint qa = get_global_id(0);
   if (qa >= nq) return;
   __global const double* ba = qbox + 6 * qa;
   double3 lo = (double3)(ba[0], ba[1], ba[2]), hi = (double3)(ba[3], ba[4], ba[5]);
-  /* the new triangles of the collapse among themselves (S folded over itself around y) */
+  /* the new triangles of the collapse among themselves (S folded over itself around y); dedup:
+   * a pair with a lower survivor is that one's */
+  const int x = dedup ? qrep[2 * qa] : 0;
   for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
+    if (dedup && tmin[na] < x) continue;
     int ida[3];
     double3 posa[3];
     tcc_sg_load_tri(tid, tpos, na, ida, posa);
@@ -471,11 +509,15 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
     double3 alo, ahi;
     tcc_sg_load_box(tbox, na, &alo, &ahi);
     for (uint nb = na + 1; nb < qoff[qa + 1]; ++nb) {
-      if (tcc_sg_tri_box_apart(alo, ahi, tbox, nb)) continue;
+      if ((dedup && tmin[nb] < x) || tcc_sg_tri_box_apart(alo, ahi, tbox, nb)) continue;
       int idb[3];
       double3 posb[3];
       tcc_sg_load_tri(tid, tpos, nb, idb, posb);
       if (!tc_sg_tri_tri_planes(ida, posa, pla, idb, posb, tcc_sg_load_plane(tplane, nb))) continue;
+      if (dedup) {
+        tcc_sg_refuse_all(ida, idb, qof, 0x80000000u | qa, qbad);
+        continue;
+      }
       qbad[qa] = 0x80000000u | qa;
       return;
     }

@@ -106,10 +106,12 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   const bool only = only_requery;
   only_requery = false;
   if (only) ensure_nonempty(requery, ctx, c.ne);  // (filled by restrict_to_undone)
+  ensure_nonempty(qof, ctx, dm.nv);
+  qof.fill(-1);
   launch(ctx, p, "sguard_applied_queries", c.ne, cl_uint(c.ne), c.edges.buffer(), s.fin.buffer(), s.dir.buffer(),
          dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), s.tdead.buffer(),
          applied_smask.buffer(), c.vflags.buffer(), qedge.buffer(), qbox.buffer(), qntri.buffer(), qcount.buffer(),
-         cl_int(only ? 1 : 0), only ? requery.buffer() : applied_smask.buffer());
+         cl_int(only ? 1 : 0), only ? requery.buffer() : applied_smask.buffer(), qof.buffer());
   uint32_t nq = 0;
   qcount.download(&nq, 1);
   last_queries = nq;
@@ -118,7 +120,8 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   reserve_triangles(ctx, nq, ntri);
   launch(ctx, p, "sguard_applied_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(),
          s.dir.buffer(), dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), s.tdead.buffer(),
-         applied_smask.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(), tplane.buffer(), qrep.buffer());
+         applied_smask.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(), tplane.buffer(), qrep.buffer(), qof.buffer(),
+         tmin.buffer());
   ensure_nonempty(applied_stets, ctx, dm.nt);
   const uint32_t n_applied = dev::compact_indices(ctx, applied_owns_s, applied_stets, dm.nt);
   return test_queries(ctx, dm, c, s, p, chosen, nq, applied_smask, applied_stets, n_applied);
@@ -164,6 +167,8 @@ void SurfaceGuard::reserve_triangles(Context& ctx, uint32_t nq, uint32_t ntri) {
   ensure_nonempty(tbox, ctx, size_t(ntri) * 6);
   ensure_nonempty(tplane, ctx, size_t(ntri) * 5);
   ensure_nonempty(qrep, ctx, size_t(nq) * 2);
+  ensure_nonempty(tmin, ctx, ntri);
+  ensure_nonempty(qof, ctx, 1);  // run (no dedup) does not read it, but passes it
 }
 
 uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
@@ -222,16 +227,20 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
 
   ensure_nonempty(qbad, ctx, nq);
   qbad.fill(0u);
+  // the matching selection's runs test the result, whose S faces they all are: each pair once
+  const cl_int dedup = s.in_place && each_pair_once ? 1 : 0;
   ensure_nonempty(vcell, ctx, dm.nv);
   launch(ctx, p, "sguard_vertex_cells", dm.nv, cl_uint(dm.nv), dm.points.buffer(), cl_double(lo[0]), cl_double(lo[1]),
          cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), vcell.buffer());
   launch(ctx, p, "sguard_surface", n_sweep, cl_uint(n_sweep), sweep_tets.buffer(), smask.buffer(), vcell.buffer(),
          dm.points.buffer(), dm.tets.buffer(), qrep.buffer(), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
          tbox.buffer(), tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
-         cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer());
+         cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer(),
+         dedup, qof.buffer(), tmin.buffer());
   launch(ctx, p, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),
          tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
-         cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer(), cl_int(s.in_place ? 0 : 1));
+         cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer(), cl_int(s.in_place ? 0 : 1),
+         dedup, qrep.buffer(), qof.buffer(), tmin.buffer());
   qcount.fill(0u);
   const bool has_verdict = !s.in_place && s.verdict.size() >= c.ne && s.verdict.buffer()();
   launch(ctx, p, "sguard_drop", nq, cl_uint(nq), qedge.buffer(), qbad.buffer(), s.marked.buffer(),

@@ -14,6 +14,9 @@ namespace tc::collapse_detail {
 struct SurfaceGuard {
   DeviceBuffer<int32_t> qedge, tid;          // per query: its edge; per new triangle: ids
   DeviceBuffer<int32_t> qrep;                // per query: x, and y when it moves (else -1)
+  // run_applied: per vertex, the query whose survivor it is (-1: none); per triangle, the lowest
+  // survivor among its vertices (each pair of S faces tested once: cl/collapse_guard.cl)
+  DeviceBuffer<int32_t> qof, tmin;
   DeviceBuffer<double> qbox, tpos, tbox, tplane;  // per query: box; per new triangle: positions, box, plane
   DeviceBuffer<uint32_t> qntri, qoff, qcount, qbad, cell_off, cell_items;
   DeviceBuffer<int32_t> qcell;               // per query: the cells of its box's low and high corners (6 ints)
@@ -29,6 +32,10 @@ struct SurfaceGuard {
   DeviceBuffer<uint32_t> undone_list;
   DeviceBuffer<double> undone_boxes;
   bool only_requery = false;
+  // run_applied tests each pair of S faces once, for the query of its lowest survivor, and a hit
+  // refuses every query of the pair (cl/collapse_guard.cl); false: once per query of the pair,
+  // as run does (the same refusals; for the tests).
+  bool each_pair_once = true;
 
   // Tests the `chosen` collapses of s.fin / s.dir; returns how many were refused (their edges
   // are unmarked in s.marked).

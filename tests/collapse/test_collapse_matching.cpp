@@ -514,3 +514,60 @@ TEST(CollapseMatching, GuardAfterUndoTestsWhatTheUndoChanged) {
   EXPECT_GT(undos, 0);
   EXPECT_LT(restricted_queries, full_queries);
 }
+
+// The surface guard of the matching selection tests each pair of S faces of the result once, for
+// the query of its lowest survivor, and a hit refuses every query of the pair
+// (SurfaceGuard::each_pair_once): on every guard run of runs where the guard refuses (as above),
+// it refuses the same collapses as testing each pair once per query of the pair.
+TEST(CollapseMatching, GuardTestsEachPairOnceWithTheSameRefusals) {
+  std::vector<std::pair<std::string, double>> runs;
+  for (auto [name, factor] : {std::pair<const char*, double>{"gen_gmsh_wrenchnut_27k.msh", 3.0},
+                              {"gen_gmsh_917_fusee_88k.msh", 1.0}}) {
+    const std::string path = test::shared_mesh(name);
+    if (!path.empty()) runs.push_back({path, factor});
+  }
+  if (runs.empty()) GTEST_SKIP() << "gen_gmsh_wrenchnut_27k.msh and gen_gmsh_917_fusee_88k.msh absent from the shared meshes";
+  Context ctx;
+  int guard_runs = 0;
+  uint32_t refusals = 0;
+  for (const auto& [path, factor] : runs) {
+    SCOPED_TRACE(path);
+    const Mesh in = read_mesh(path);
+    CollapseOptions o;
+    StageParams p = params_from(o);
+    p.target = factor * median_edge_length(in);
+    DeviceMesh dm, next;
+    std::vector<int32_t> vertex_new;
+    upload_mesh(ctx, in, o, dm, &vertex_new);
+    Connectivity c;
+    EdgeState s;
+    DeviceBuffer<int32_t> origin(ctx, 1);
+    for (int it = 0; it < 40; ++it) {
+      build_connectivity(ctx, dm, c, p, &s);
+      carry_verdicts(ctx, dm, c, s);
+      cost_and_mark(ctx, dm, c, s, p);
+      matching_backup(ctx, dm, s);
+      uint32_t passed_q = 0, tested = 0;
+      uint32_t chosen = matching_selection(ctx, dm, c, s, p, passed_q, tested);
+      for (;;) {
+        SurfaceGuard every, once;
+        every.each_pair_once = false;
+        const uint32_t refused_every = every.run_applied(ctx, dm, c, s, p, chosen);
+        const std::vector<uint32_t> marked = s.marked.download_range(0, c.ne);
+        const uint32_t refused = once.run_applied(ctx, dm, c, s, p, chosen);
+        ++guard_runs;
+        EXPECT_EQ(refused, refused_every) << "iteration " << it;
+        EXPECT_EQ(s.marked.download_range(0, c.ne), marked) << "iteration " << it;  // the same ones unmarked
+        refusals += refused;
+        if (refused == 0) break;
+        chosen -= matching_undo(ctx, dm, c, s, once);
+      }
+      if (chosen == 0) break;
+      remember_for_carry(ctx, dm, c, s);
+      collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
+      note_compaction(ctx, dm, c, s);
+    }
+  }
+  EXPECT_GT(guard_runs, 4);
+  EXPECT_GT(refusals, 0u);
+}
