@@ -427,16 +427,51 @@ inline int tcc_sg_cells_used(uint a, uint b, uint c, int gx, int gy, __global co
   return 0;
 }
 
+/* The S face fid (fpos, box lo..hi; its plane fplane once *has_plane; code names it) against the
+ * triangles of query qi (survivor rx; ry, when it moves, else -1): unless the face has one of
+ * them (the collapse moves or removes it), each triangle whose box meets the face's is tested;
+ * a hit refuses qi (returns at once), or with dedup every query of the pair (tcc_sg_refuse_all)
+ * and only the pairs whose lowest survivor is rx are tested. */
+inline void tcc_sg_face_query(uint qi, int rx, const int* fid, const double3* fpos, double3 lo, double3 hi,
+                              int* has_plane, tc_sg_plane* fplane, uint code, int dedup, __global const int* qrep,
+                              __global const uint* qoff, __global const int* tid, __global const double* tpos,
+                              __global const double* tbox, __global const double* tplane,
+                              __global const int* qof, __global const int* tmin, __global uint* qbad) {
+  const int ry = qrep[2 * qi + 1];
+  if (fid[0] == rx || fid[1] == rx || fid[2] == rx || fid[0] == ry || fid[1] == ry || fid[2] == ry) return;
+  for (uint r = qoff[qi]; r < qoff[qi + 1]; ++r) {
+    if ((dedup && tmin[r] < rx) || tcc_sg_tri_box_apart(lo, hi, tbox, r)) continue;
+    int id[3];
+    double3 pos[3];
+    tcc_sg_load_tri(tid, tpos, r, id, pos);
+    if (!*has_plane) {
+      *fplane = tc_sg_plane_of(fpos);
+      *has_plane = 1;
+    }
+    if (!tc_sg_tri_tri_planes(id, pos, tcc_sg_load_plane(tplane, r), fid, fpos, *fplane)) continue;
+    if (!dedup) {
+      qbad[qi] = code;
+      return;
+    }
+    tcc_sg_refuse_all(id, fid, qof, code, qbad); /* and on: the face's pairs with other triangles */
+  }
+}
+
 /* Every current S face (smask: the faces a tet owns on S) against the queries whose box it
- * overlaps; a face in cells without queries (vcell) is passed over before its points are read. */
+ * overlaps; a face in cells without queries (vcell) is passed over before its points are read.
+ * The grid's entries for the sweep (cell_q, 4 ints each, in cell_items' order): the query, its
+ * survivor x, its box's low corner's cell packed as vcell's (tcc_sg_owner_cell's test without
+ * reading the query's arrays), 0. A cell lists its queries by increasing x, so with dedup its
+ * scan stops at the first x at or above the face's lowest survivor (the face has x, or the
+ * pairs are another query's). */
 __kernel void sguard_surface(uint n, __global const uint* stets, __global const uchar* smask,
                              __global const uint* vcell, __global const double* pts,
                              __global const int* tets, __global const int* qrep, __global const double* qbox,
                              __global const uint* qoff, __global const int* tid, __global const double* tpos,
                              __global const double* tbox, __global const double* tplane, double ox, double oy, double oz,
                              double ih, int gx, int gy, int gz, __global const uint* cell_off,
-                             __global const uint* cell_items, __global const int* qcell, __global uint* qbad,
-                             int dedup, __global const int* qof, __global const int* tmin) {
+                             __global const int* cell_q, __global uint* qbad, int dedup, __global const int* qof,
+                             __global const int* tmin) {
   const uint g = get_global_id(0);
   if (g >= n) return;
   const uint t = stets[g];
@@ -453,34 +488,30 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
     int has_plane = 0; /* the face's plane, computed at its first triangle test */
     tc_sg_plane fplane;
     const int fmin_ = dedup ? tcc_sg_first_survivor(fid, qof) : INT_MAX;
-    TCC_SG_FOR_CELL_QUERIES(lo, hi, qi, {
-      /* the face is one the collapse moves or removes: it has x, or y when y moves (-1 else) */
-      const int rx = qrep[2 * qi];
-      /* dedup: the face has x or a lower survivor (its pairs with q are that one's) */
-      if (dedup ? fmin_ <= rx : qbad[qi] != 0u) continue;
-      if (!tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, qbox + 6 * qi, qcell + 6 * qi, ci, cj, ck)) continue;
-      const int ry = qrep[2 * qi + 1];
-      if (fid[0] == rx || fid[1] == rx || fid[2] == rx || fid[0] == ry || fid[1] == ry || fid[2] == ry) continue;
-      for (uint r = qoff[qi]; r < qoff[qi + 1]; ++r) {
-        if ((dedup && tmin[r] < rx) || tcc_sg_tri_box_apart(lo, hi, tbox, r)) continue;
-        int id[3];
-        double3 pos[3];
-        tcc_sg_load_tri(tid, tpos, r, id, pos);
-        if (!has_plane) {
-          fplane = tc_sg_plane_of(fpos);
-          has_plane = 1;
+    uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
+    code = code < 0x7ffffffeu ? code + 2u : 1u;
+    const int i0 = tcc_sg_cell(lo.x, ox, ih, gx), i1 = tcc_sg_cell(hi.x, ox, ih, gx);
+    const int j0 = tcc_sg_cell(lo.y, oy, ih, gy), j1 = tcc_sg_cell(hi.y, oy, ih, gy);
+    const int k0 = tcc_sg_cell(lo.z, oz, ih, gz), k1 = tcc_sg_cell(hi.z, oz, ih, gz);
+    for (int ck = k0; ck <= k1; ++ck)
+      for (int cj = j0; cj <= j1; ++cj)
+        for (int ci = i0; ci <= i1; ++ci) {
+          const uint c = ((uint)ck * (uint)gy + (uint)cj) * (uint)gx + (uint)ci;
+          for (uint m = cell_off[c]; m < cell_off[c + 1]; ++m) {
+            const int4 item = vload4(m, cell_q);
+            const uint qi = (uint)item.x, qc = (uint)item.z;
+            if (dedup ? fmin_ <= item.y : qbad[qi] != 0u) {
+              if (dedup) break;
+              continue;
+            }
+            /* the pair is met in the cell of its boxes' overlap's low corner (tcc_sg_owner_cell) */
+            if (max(i0, (int)(qc & 0x3ffu)) != ci || max(j0, (int)((qc >> 10) & 0x3ffu)) != cj ||
+                max(k0, (int)(qc >> 20)) != ck || tcc_sg_box_apart(lo, hi, qbox + 6 * qi))
+              continue;
+            tcc_sg_face_query(qi, item.y, fid, fpos, lo, hi, &has_plane, &fplane, code, dedup, qrep, qoff, tid, tpos,
+                              tbox, tplane, qof, tmin, qbad);
+          }
         }
-        if (!tc_sg_tri_tri_planes(id, pos, tcc_sg_load_plane(tplane, r), fid, fpos, fplane)) continue;
-        uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
-        code = code < 0x7ffffffeu ? code + 2u : 1u;
-        if (dedup) { /* every query of the pair; and on: the face's pairs with q's other triangles */
-          tcc_sg_refuse_all(id, fid, qof, code, qbad);
-          continue;
-        }
-        qbad[qi] = code;
-        break;
-      }
-    })
   }
 }
 

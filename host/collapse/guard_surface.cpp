@@ -213,8 +213,24 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
   };
   for (uint32_t q = 0; q < nq; ++q) for_cells(q, [&](size_t cell) { ++off[cell + 1]; });
   for (size_t i = 0; i < ncells; ++i) off[i + 1] += off[i];
+  // placed by increasing survivor (x, qrep), which the sweep's scan of a cell relies on with
+  // dedup: a counting sort of the queries by x
+  const std::vector<int32_t> rep = qrep.download_range(0, size_t(nq) * 2);
+  std::vector<uint32_t> by_x(size_t(dm.nv) + 1, 0), order(nq);
+  for (uint32_t q = 0; q < nq; ++q) ++by_x[size_t(rep[2 * q]) + 1];
+  for (size_t i = 0; i < size_t(dm.nv); ++i) by_x[i + 1] += by_x[i];
+  for (uint32_t q = 0; q < nq; ++q) order[by_x[size_t(rep[2 * q])]++] = q;
   std::vector<uint32_t> items(std::max<uint32_t>(off[ncells], 1)), cursor(off.begin(), off.end() - 1);
-  for (uint32_t q = 0; q < nq; ++q) for_cells(q, [&](size_t cell) { items[cursor[cell]++] = q; });
+  std::vector<int32_t> sweep_items(size_t(std::max<uint32_t>(off[ncells], 1)) * 4, 0);
+  for (uint32_t q : order)
+    for_cells(q, [&](size_t cell) {
+      const uint32_t m = cursor[cell]++;
+      items[m] = q;
+      const int32_t* r = &range[6 * size_t(q)];
+      sweep_items[4 * size_t(m)] = int32_t(q);
+      sweep_items[4 * size_t(m) + 1] = rep[2 * q];
+      sweep_items[4 * size_t(m) + 2] = r[0] | r[1] << 10 | r[2] << 20;  // as sguard_vertex_cells packs
+    });
   if (kProfile)
     std::fprintf(stderr, "  surface guard grid: h %g, %d x %d x %d cells, %u entries for %u queries\n", h, g[0], g[1],
                  g[2], off[ncells], nq);
@@ -222,6 +238,8 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
   cell_off.upload(off);
   ensure_nonempty(cell_items, ctx, items.size());
   cell_items.upload(items);
+  ensure_nonempty(cell_q, ctx, sweep_items.size());
+  cell_q.upload(sweep_items);
   ensure_nonempty(qcell, ctx, range.size());
   qcell.upload(range);
 
@@ -235,8 +253,8 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
   launch(ctx, p, "sguard_surface", n_sweep, cl_uint(n_sweep), sweep_tets.buffer(), smask.buffer(), vcell.buffer(),
          dm.points.buffer(), dm.tets.buffer(), qrep.buffer(), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
          tbox.buffer(), tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
-         cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer(),
-         dedup, qof.buffer(), tmin.buffer());
+         cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_q.buffer(), qbad.buffer(), dedup, qof.buffer(),
+         tmin.buffer());
   launch(ctx, p, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),
          tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
          cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer(), cl_int(s.in_place ? 0 : 1),
