@@ -261,7 +261,7 @@ bool SequentialRun::step() {
           const int32_t a = std::min(u, w), b = std::max(u, w);
           const double cost = sm_.length(a, b);
           if (!marked(a, b, cost)) continue;
-          if (!queued_.insert(key(a, b)).second) continue;  // already queued (popped: tested again)
+          if (!queued_.insert(key(a, b))) continue;  // already queued (popped: tested again)
           heap_.push_back({cost, a, b, 0});
           std::push_heap(heap_.begin(), heap_.end(), later);
         }

@@ -43,9 +43,9 @@
 
 #include <chrono>
 #include <cstdint>
-#include <unordered_set>
 #include <vector>
 
+#include "collapse/edge_key_set.hpp"
 #include "collapse/sequential_mesh.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/mesh.hpp"
@@ -116,7 +116,7 @@ class SequentialRun {
   std::vector<int32_t> seed_edges_;  // TailSeed::edges, for the first iteration (then cleared)
   std::vector<int32_t> nb_, vmap_, kept_;
   bool greedy_ = false;
-  std::unordered_set<uint64_t> queued_;  // greedy: the edges (a << 32 | b) in the queue
+  EdgeKeySet queued_;  // greedy: the edges (a << 32 | b) in the queue
   // greedy: the edges the surface guard refused in the last iteration (2 per edge; the
   // candidates of the next one)
   std::vector<int32_t> refused_;
