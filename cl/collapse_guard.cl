@@ -204,37 +204,35 @@ inline void tcc_sg_applied(int e, __global const int* edges, __global const ucha
   *y = (d & TCC_DIR_REMOVE_V1) ? edges[2 * e + 1] : edges[2 * e];
 }
 
-/* Queries of the matching selection: the taken collapses whose survivor is on S, with the box and
- * the number of the S faces through it now. */
+/* Queries of the matching selection: the taken collapses whose survivor is on S, with the number
+ * of the S faces through it now (sguard_applied_tris writes them and the box). */
 __kernel void sguard_applied_queries(uint ne, __global const int* edges, __global const uint* fin,
-                                     __global const uchar* dir, __global const double* pts, __global const int* tets,
+                                     __global const uchar* dir, __global const int* tets,
                                      __global const uint* vt_off, __global const int* vt, __global const uchar* tdead,
                                      __global const uchar* smask, __global const uchar* vflags, __global int* qedge,
-                                     __global double* qbox, __global uint* qntri, __global uint* qcount,
-                                     int only_flagged, __global const uchar* requery, __global int* qof) {
+                                     __global uint* qntri, __global uint* qcount, int only_flagged,
+                                     __global const uchar* requery, __global int* qof) {
   uint e = get_global_id(0);
   if (e >= ne || !fin[e] || (only_flagged && !requery[e])) return;
   int x, y;
   tcc_sg_applied((int)e, edges, dir, &x, &y);
   if (!vflags[x] && !vflags[y]) return; /* S is not touched */
-  double3 lo = (double3)(INFINITY, INFINITY, INFINITY), hi = -lo;
-  int id[3];
-  double3 pos[3];
-  uint n = 0;
-  TCC_SG_FOR_APPLIED_TRIS(x, y, id, pos, {
-    ++n;
-    for (int k = 0; k < 3; ++k) {
-      lo = fmin(lo, pos[k]);
-      hi = fmax(hi, pos[k]);
+  uint n = 0; /* the faces of TCC_SG_FOR_APPLIED_TRIS, counted without their points */
+  for (int side = 0; side < 2; ++side) {
+    const int z = side == 0 ? x : y;
+    for (uint i = vt_off[z]; i < vt_off[z + 1]; ++i) {
+      const int t = vt[i];
+      const uint m = smask[t];
+      if (tdead[t] || !m) continue;
+      const int l = tcc_local(tets, t, x);
+      for (int f = 0; f < 4; ++f) n += f != l && (m & (1u << f)) ? 1u : 0u;
     }
-  })
+  }
   if (n == 0) return;
   uint slot = atomic_inc(qcount);
   qedge[slot] = (int)e;
   qntri[slot] = n;
   qof[x] = (int)slot; /* a vertex survives one collapse at most */
-  __global double* b = qbox + 6 * slot;
-  b[0] = lo.x, b[1] = lo.y, b[2] = lo.z, b[3] = hi.x, b[4] = hi.y, b[5] = hi.z;
 }
 
 /* The plane data (tc_sg_plane) of new triangle n in tplane (5 doubles each). */
@@ -312,13 +310,15 @@ inline void tcc_sg_refuse_all(const int* ia, const int* ib, __global const int* 
 }
 
 /* The S faces through the survivor of each query of sguard_applied_queries, at qoff[q] ..
- * qoff[q + 1]; qrep: the survivor (the faces through it are the query's own). */
+ * qoff[q + 1], and the query's box; qrep: the survivor (the faces through it are the query's
+ * own). */
 __kernel void sguard_applied_tris(uint nq, __global const int* qedge, __global const uint* qoff,
                                   __global const int* edges, __global const uchar* dir, __global const double* pts,
                                   __global const int* tets, __global const uint* vt_off, __global const int* vt,
                                   __global const uchar* tdead, __global const uchar* smask, __global int* tid,
                                   __global double* tpos, __global double* tbox, __global double* tplane,
-                                  __global int* qrep, __global const int* qof, __global int* tmin) {
+                                  __global int* qrep, __global const int* qof, __global int* tmin,
+                                  __global double* qbox) {
   uint qi = get_global_id(0);
   if (qi >= nq) return;
   int x, y;
@@ -328,11 +328,18 @@ __kernel void sguard_applied_tris(uint nq, __global const int* qedge, __global c
   uint n = qoff[qi];
   int id[3];
   double3 pos[3];
+  double3 lo = (double3)(INFINITY, INFINITY, INFINITY), hi = -lo;
   TCC_SG_FOR_APPLIED_TRIS(x, y, id, pos, {
     tcc_sg_store_tri(n, id, pos, tid, tpos, tbox, tplane);
     tmin[n] = tcc_sg_first_survivor(id, qof);
     ++n;
+    for (int k = 0; k < 3; ++k) {
+      lo = fmin(lo, pos[k]);
+      hi = fmax(hi, pos[k]);
+    }
   })
+  __global double* b = qbox + 6 * qi;
+  b[0] = lo.x, b[1] = lo.y, b[2] = lo.z, b[3] = hi.x, b[4] = hi.y, b[5] = hi.z;
 }
 
 inline void tcc_sg_load_tri(__global const int* tid, __global const double* tpos, uint n, int* id, double3* pos) {

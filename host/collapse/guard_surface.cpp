@@ -109,9 +109,9 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   ensure_nonempty(qof, ctx, dm.nv);
   qof.fill(-1);
   launch(ctx, p, "sguard_applied_queries", c.ne, cl_uint(c.ne), c.edges.buffer(), s.fin.buffer(), s.dir.buffer(),
-         dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), s.tdead.buffer(),
-         applied_smask.buffer(), c.vflags.buffer(), qedge.buffer(), qbox.buffer(), qntri.buffer(), qcount.buffer(),
-         cl_int(only ? 1 : 0), only ? requery.buffer() : applied_smask.buffer(), qof.buffer());
+         dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), s.tdead.buffer(),
+         applied_smask.buffer(), c.vflags.buffer(), qedge.buffer(), qntri.buffer(), qcount.buffer(), cl_int(only ? 1 : 0),
+         only ? requery.buffer() : applied_smask.buffer(), qof.buffer());
   uint32_t nq = 0;
   qcount.download(&nq, 1);
   last_queries = nq;
@@ -121,7 +121,7 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   launch(ctx, p, "sguard_applied_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(),
          s.dir.buffer(), dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), s.tdead.buffer(),
          applied_smask.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(), tplane.buffer(), qrep.buffer(), qof.buffer(),
-         tmin.buffer());
+         tmin.buffer(), qbox.buffer());
   ensure_nonempty(applied_stets, ctx, dm.nt);
   const uint32_t n_applied = dev::compact_indices(ctx, applied_owns_s, applied_stets, dm.nt);
   return test_queries(ctx, dm, c, s, p, chosen, nq, applied_smask, applied_stets, n_applied);
