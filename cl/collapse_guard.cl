@@ -177,8 +177,9 @@ __kernel void sguard_applied_smask(uint nt, __global const int* tet_nbr, __globa
 
 /* Loop over the S faces of the result through the survivor x of the collapse of y onto x: the
  * faces through x of the tets of ring(x) U ring(y) that are left (the two rings share only the
- * removed tets). BODY sees id[3] and pos[3]. */
-#define TCC_SG_FOR_APPLIED_TRIS(x, y, id, pos, BODY)                                                    \
+ * removed tets). The body (the variadic rest) sees the tet t_ and the face f_
+ * (sguard_applied_queries counts them, sguard_applied_tris writes them: one selection for both). */
+#define TCC_SG_FOR_APPLIED_FACES(x, y, ...)                                                             \
   for (int side_ = 0; side_ < 2; ++side_) {                                                              \
     int z_ = side_ == 0 ? (x) : (y);                                                                     \
     for (uint i_ = vt_off[z_]; i_ < vt_off[z_ + 1]; ++i_) {                                              \
@@ -188,14 +189,19 @@ __kernel void sguard_applied_smask(uint nt, __global const int* tet_nbr, __globa
       int l_ = tcc_local(tets, t_, (x));                                                                 \
       for (int f_ = 0; f_ < 4; ++f_) {                                                                   \
         if (f_ == l_ || !(m_ & (1u << f_))) continue;                                                    \
-        for (int k_ = 0; k_ < 3; ++k_) {                                                                 \
-          id[k_] = tets[4 * t_ + TC_TET_FACES[f_][k_]];                                                  \
-          pos[k_] = tc_point(pts, id[k_]);                                                               \
-        }                                                                                                \
-        BODY                                                                                             \
+        __VA_ARGS__                                                                                      \
       }                                                                                                  \
     }                                                                                                    \
   }
+/* The same with each face's vertices: the body sees id[3] and pos[3]. */
+#define TCC_SG_FOR_APPLIED_TRIS(x, y, id, pos, ...)                                                     \
+  TCC_SG_FOR_APPLIED_FACES(x, y, {                                                                       \
+    for (int k_ = 0; k_ < 3; ++k_) {                                                                     \
+      id[k_] = tets[4 * t_ + TC_TET_FACES[f_][k_]];                                                      \
+      pos[k_] = tc_point(pts, id[k_]);                                                                   \
+    }                                                                                                    \
+    __VA_ARGS__                                                                                          \
+  })
 
 /* The applied collapse of edge e: x survives, y was removed. */
 inline void tcc_sg_applied(int e, __global const int* edges, __global const uchar* dir, int* x, int* y) {
@@ -217,17 +223,8 @@ __kernel void sguard_applied_queries(uint ne, __global const int* edges, __globa
   int x, y;
   tcc_sg_applied((int)e, edges, dir, &x, &y);
   if (!vflags[x] && !vflags[y]) return; /* S is not touched */
-  uint n = 0; /* the faces of TCC_SG_FOR_APPLIED_TRIS, counted without their points */
-  for (int side = 0; side < 2; ++side) {
-    const int z = side == 0 ? x : y;
-    for (uint i = vt_off[z]; i < vt_off[z + 1]; ++i) {
-      const int t = vt[i];
-      const uint m = smask[t];
-      if (tdead[t] || !m) continue;
-      const int l = tcc_local(tets, t, x);
-      for (int f = 0; f < 4; ++f) n += f != l && (m & (1u << f)) ? 1u : 0u;
-    }
-  }
+  uint n = 0; /* without their points */
+  TCC_SG_FOR_APPLIED_FACES(x, y, { ++n; })
   if (n == 0) return;
   uint slot = atomic_inc(qcount);
   qedge[slot] = (int)e;
@@ -435,10 +432,11 @@ inline int tcc_sg_cells_used(uint a, uint b, uint c, int gx, int gy, __global co
 }
 
 /* The S face fid (fpos, box lo..hi; its plane fplane once *has_plane; code names it) against the
- * triangles of query qi (survivor rx; ry, when it moves, else -1): unless the face has one of
- * them (the collapse moves or removes it), each triangle whose box meets the face's is tested;
- * a hit refuses qi (returns at once), or with dedup every query of the pair (tcc_sg_refuse_all)
- * and only the pairs whose lowest survivor is rx are tested. */
+ * triangles of query qi (rx = qrep[2 qi], the survivor in run_applied, the removed vertex in run;
+ * ry = qrep[2 qi + 1]: -1, or the survivor when it moves): unless the face has one of them (the
+ * collapse moves or removes it), each triangle whose box meets the face's is tested; a hit
+ * refuses qi (returns at once), or with dedup every query of the pair (tcc_sg_refuse_all), and
+ * only the pairs whose lowest survivor is rx are tested. */
 inline void tcc_sg_face_query(uint qi, int rx, const int* fid, const double3* fpos, double3 lo, double3 hi,
                               int* has_plane, tc_sg_plane* fplane, uint code, int dedup, __global const int* qrep,
                               __global const uint* qoff, __global const int* tid, __global const double* tpos,
@@ -467,10 +465,10 @@ inline void tcc_sg_face_query(uint qi, int rx, const int* fid, const double3* fp
 /* Every current S face (smask: the faces a tet owns on S) against the queries whose box it
  * overlaps; a face in cells without queries (vcell) is passed over before its points are read.
  * The grid's entries for the sweep (cell_q, 4 ints each, in cell_items' order): the query, its
- * survivor x, its box's low corner's cell packed as vcell's (tcc_sg_owner_cell's test without
- * reading the query's arrays), 0. A cell lists its queries by increasing x, so with dedup its
- * scan stops at the first x at or above the face's lowest survivor (the face has x, or the
- * pairs are another query's). */
+ * x = qrep[2 q] (the survivor in run_applied), its box's low corner's cell packed as vcell's
+ * (tcc_sg_owner_cell's test without reading the query's arrays), 0. With dedup a cell lists its
+ * queries by increasing x, and its scan stops at the first x at or above the face's lowest
+ * survivor (the face has x, or the pairs are another query's). */
 __kernel void sguard_surface(uint n, __global const uint* stets, __global const uchar* smask,
                              __global const uint* vcell, __global const double* pts,
                              __global const int* tets, __global const int* qrep, __global const double* qbox,
@@ -494,7 +492,7 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
     double3 lo = fmin(fmin(fpos[0], fpos[1]), fpos[2]), hi = fmax(fmax(fpos[0], fpos[1]), fpos[2]);
     int has_plane = 0; /* the face's plane, computed at its first triangle test */
     tc_sg_plane fplane;
-    const int fmin_ = dedup ? tcc_sg_first_survivor(fid, qof) : INT_MAX;
+    const int flow = dedup ? tcc_sg_first_survivor(fid, qof) : INT_MAX; /* its lowest survivor */
     uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
     code = code < 0x7ffffffeu ? code + 2u : 1u;
     const int i0 = tcc_sg_cell(lo.x, ox, ih, gx), i1 = tcc_sg_cell(hi.x, ox, ih, gx);
@@ -507,8 +505,9 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
           for (uint m = cell_off[c]; m < cell_off[c + 1]; ++m) {
             const int4 item = vload4(m, cell_q);
             const uint qi = (uint)item.x, qc = (uint)item.z;
-            if (dedup ? fmin_ <= item.y : qbad[qi] != 0u) {
-              if (dedup) break;
+            if (dedup) {
+              if (flow <= item.y) break;
+            } else if (qbad[qi] != 0u) {
               continue;
             }
             /* the pair is met in the cell of its boxes' overlap's low corner (tcc_sg_owner_cell) */

@@ -56,6 +56,7 @@ static_assert(kMaxCellsPerAxis + 1 < 1024, "sguard_vertex_cells packs a cell in 
 uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                            uint32_t chosen) {
   last_queries = 0;
+  last_run_each_pair_once = false;
   if (chosen == 0) return 0;
   ensure_nonempty(qedge, ctx, chosen);
   ensure_nonempty(qbox, ctx, size_t(chosen) * 6);
@@ -85,12 +86,15 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
     n_stets = dev::compact_indices(ctx, c.owns_s, stets, dm.nt);
     stets_generation = c.generation;
   }
-  return test_queries(ctx, dm, c, s, p, chosen, nq, c.smask, stets, n_stets);
+  ensure_nonempty(qof, ctx, 1);  // passed, not read (each pair once is for run_applied)
+  ensure_nonempty(tmin, ctx, 1);
+  return test_queries(ctx, dm, c, s, p, chosen, nq, c.smask, stets, n_stets, false);
 }
 
 uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                                    uint32_t chosen) {
   last_queries = 0;
+  last_run_each_pair_once = false;
   if (chosen == 0) return 0;
   // the S faces of the result
   ensure_nonempty(applied_owns_s, ctx, dm.nt);
@@ -118,13 +122,14 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   if (nq == 0) return 0;
   const uint32_t ntri = query_offsets(ctx, nq);
   reserve_triangles(ctx, nq, ntri);
+  ensure_nonempty(tmin, ctx, ntri);
   launch(ctx, p, "sguard_applied_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(),
          s.dir.buffer(), dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), s.tdead.buffer(),
          applied_smask.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(), tplane.buffer(), qrep.buffer(), qof.buffer(),
          tmin.buffer(), qbox.buffer());
   ensure_nonempty(applied_stets, ctx, dm.nt);
   const uint32_t n_applied = dev::compact_indices(ctx, applied_owns_s, applied_stets, dm.nt);
-  return test_queries(ctx, dm, c, s, p, chosen, nq, applied_smask, applied_stets, n_applied);
+  return test_queries(ctx, dm, c, s, p, chosen, nq, applied_smask, applied_stets, n_applied, each_pair_once);
 }
 
 void SurfaceGuard::restrict_to_undone(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
@@ -167,13 +172,11 @@ void SurfaceGuard::reserve_triangles(Context& ctx, uint32_t nq, uint32_t ntri) {
   ensure_nonempty(tbox, ctx, size_t(ntri) * 6);
   ensure_nonempty(tplane, ctx, size_t(ntri) * 5);
   ensure_nonempty(qrep, ctx, size_t(nq) * 2);
-  ensure_nonempty(tmin, ctx, ntri);
-  ensure_nonempty(qof, ctx, 1);  // run (no dedup) does not read it, but passes it
 }
 
 uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                                     uint32_t chosen, uint32_t nq, DeviceBuffer<uint8_t>& smask,
-                                    DeviceBuffer<uint32_t>& sweep_tets, uint32_t n_sweep) {
+                                    DeviceBuffer<uint32_t>& sweep_tets, uint32_t n_sweep, bool each_once) {
   // The grid: cells twice the median query box (most boxes span <= 2 cells per axis, the large
   // ones are entered in every cell they span), at most kMaxCellsPerAxis per axis.
   const std::vector<double> box = qbox.download_range(0, size_t(nq) * 6);
@@ -213,13 +216,18 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
   };
   for (uint32_t q = 0; q < nq; ++q) for_cells(q, [&](size_t cell) { ++off[cell + 1]; });
   for (size_t i = 0; i < ncells; ++i) off[i + 1] += off[i];
-  // placed by increasing survivor (x, qrep), which the sweep's scan of a cell relies on with
-  // dedup: a counting sort of the queries by x
+  // each pair once: placed by increasing x = qrep[2 q] (the survivor), which the sweep's scan of
+  // a cell relies on (a counting sort of the queries by x); else in query order
   const std::vector<int32_t> rep = qrep.download_range(0, size_t(nq) * 2);
-  std::vector<uint32_t> by_x(size_t(dm.nv) + 1, 0), order(nq);
-  for (uint32_t q = 0; q < nq; ++q) ++by_x[size_t(rep[2 * q]) + 1];
-  for (size_t i = 0; i < size_t(dm.nv); ++i) by_x[i + 1] += by_x[i];
-  for (uint32_t q = 0; q < nq; ++q) order[by_x[size_t(rep[2 * q])]++] = q;
+  std::vector<uint32_t> order(nq);
+  if (each_once) {
+    std::vector<uint32_t> by_x(size_t(dm.nv) + 1, 0);
+    for (uint32_t q = 0; q < nq; ++q) ++by_x[size_t(rep[2 * q]) + 1];
+    for (size_t i = 0; i < size_t(dm.nv); ++i) by_x[i + 1] += by_x[i];
+    for (uint32_t q = 0; q < nq; ++q) order[by_x[size_t(rep[2 * q])]++] = q;
+  } else {
+    for (uint32_t q = 0; q < nq; ++q) order[q] = q;
+  }
   std::vector<uint32_t> items(std::max<uint32_t>(off[ncells], 1)), cursor(off.begin(), off.end() - 1);
   std::vector<int32_t> sweep_items(size_t(std::max<uint32_t>(off[ncells], 1)) * 4, 0);
   for (uint32_t q : order)
@@ -236,17 +244,22 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
                  g[2], off[ncells], nq);
   ensure_nonempty(cell_off, ctx, off.size());
   cell_off.upload(off);
-  ensure_nonempty(cell_items, ctx, items.size());
-  cell_items.upload(items);
   ensure_nonempty(cell_q, ctx, sweep_items.size());
   cell_q.upload(sweep_items);
+  // the queries' own cells and lists, for sguard_pairs across queries (not with the matching
+  // selection's, in place: the sweep meets those pairs)
+  const bool cross = !s.in_place;
+  ensure_nonempty(cell_items, ctx, items.size());
   ensure_nonempty(qcell, ctx, range.size());
-  qcell.upload(range);
+  if (cross) {
+    cell_items.upload(items);
+    qcell.upload(range);
+  }
 
   ensure_nonempty(qbad, ctx, nq);
   qbad.fill(0u);
-  // the matching selection's runs test the result, whose S faces they all are: each pair once
-  const cl_int dedup = s.in_place && each_pair_once ? 1 : 0;
+  const cl_int dedup = each_once ? 1 : 0;
+  last_run_each_pair_once = each_once;
   ensure_nonempty(vcell, ctx, dm.nv);
   launch(ctx, p, "sguard_vertex_cells", dm.nv, cl_uint(dm.nv), dm.points.buffer(), cl_double(lo[0]), cl_double(lo[1]),
          cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), vcell.buffer());
@@ -257,7 +270,7 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
          tmin.buffer());
   launch(ctx, p, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),
          tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
-         cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer(), cl_int(s.in_place ? 0 : 1),
+         cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer(), cl_int(cross ? 1 : 0),
          dedup, qrep.buffer(), qof.buffer(), tmin.buffer());
   qcount.fill(0u);
   const bool has_verdict = !s.in_place && s.verdict.size() >= c.ne && s.verdict.buffer()();

@@ -20,7 +20,7 @@ struct SurfaceGuard {
   DeviceBuffer<double> qbox, tpos, tbox, tplane;  // per query: box; per new triangle: positions, box, plane
   DeviceBuffer<uint32_t> qntri, qoff, qcount, qbad, cell_off, cell_items;
   DeviceBuffer<int32_t> qcell;               // per query: the cells of its box's low and high corners (6 ints)
-  DeviceBuffer<int32_t> cell_q;  // per grid entry (cell_items' order): query, its x, its low cell packed, 0
+  DeviceBuffer<int32_t> cell_q;  // per grid entry (cell_items' order): query, qrep's x, its low cell packed, 0
   DeviceBuffer<uint32_t> vcell;              // per vertex: its cell, packed (sguard_vertex_cells)
   uint32_t last_queries = 0;  // collapses tested by the last run (that change S)
   DeviceBuffer<uint32_t> stets;  // the tets owning an S face (n_stets), listed for the connectivity
@@ -35,8 +35,10 @@ struct SurfaceGuard {
   bool only_requery = false;
   // run_applied tests each pair of S faces once, for the query of its lowest survivor, and a hit
   // refuses every query of the pair (cl/collapse_guard.cl); false: once per query of the pair,
-  // as run does (the same refusals; for the tests).
+  // as run does (the same refusals; for the tests). last_run_each_pair_once: whether the last run
+  // tested pairs, each once (false when it had no query, and for run).
   bool each_pair_once = true;
+  bool last_run_each_pair_once = false;
 
   // Tests the `chosen` collapses of s.fin / s.dir; returns how many were refused (their edges
   // are unmarked in s.marked).
@@ -60,10 +62,11 @@ struct SurfaceGuard {
   uint32_t query_offsets(Context& ctx, uint32_t nq);
   void reserve_triangles(Context& ctx, uint32_t nq, uint32_t ntri);
   // The queries' triangles (tid, ...) against the S faces the n_sweep tets of sweep_tets own
-  // (smask) and against each other, through a grid; the queries with a hit are refused.
+  // (smask) and against each other, through a grid; the queries with a hit are refused. each_once:
+  // each pair once (run_applied, with qof and tmin filled).
   uint32_t test_queries(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                         uint32_t chosen, uint32_t nq, DeviceBuffer<uint8_t>& smask, DeviceBuffer<uint32_t>& sweep_tets,
-                        uint32_t n_sweep);
+                        uint32_t n_sweep, bool each_once);
 };
 
 }  // namespace tc::collapse_detail

@@ -488,6 +488,7 @@ TEST(CollapseMatching, GuardAfterUndoTestsWhatTheUndoChanged) {
         ++undos;
         // a guard testing every query of the result, beside the restricted one the loop runs next
         SurfaceGuard full;
+        full.each_pair_once = false;  // and each pair once per query of the pair, as before session 18
         const uint32_t full_refused = full.run_applied(ctx, dm, c, s, p, chosen);
         full_queries += int(full.last_queries);
         const std::vector<uint32_t> marked = s.marked.download_range(0, c.ne);
@@ -552,12 +553,23 @@ TEST(CollapseMatching, GuardTestsEachPairOnceWithTheSameRefusals) {
       for (;;) {
         SurfaceGuard every, once;
         every.each_pair_once = false;
+        // the refused edges of each, flagged (SurfaceGuard::refused_edges)
+        auto refused_flags = [&](SurfaceGuard& g) {
+          DeviceBuffer<uint8_t> flag(ctx, std::max<size_t>(c.ne, 1));
+          DeviceBuffer<uint32_t> list(ctx, std::max<size_t>(c.ne, 1)), count(ctx, 1);
+          flag.fill(0);
+          count.fill(0u);
+          g.refused_edges(ctx, flag, list, count);
+          return flag.download_range(0, c.ne);
+        };
         const uint32_t refused_every = every.run_applied(ctx, dm, c, s, p, chosen);
-        const std::vector<uint32_t> marked = s.marked.download_range(0, c.ne);
+        EXPECT_FALSE(every.last_run_each_pair_once);
+        const std::vector<uint8_t> flags_every = refused_flags(every);
         const uint32_t refused = once.run_applied(ctx, dm, c, s, p, chosen);
-        ++guard_runs;
+        EXPECT_EQ(once.last_run_each_pair_once, once.last_queries > 0);
+        guard_runs += once.last_run_each_pair_once ? 1 : 0;
         EXPECT_EQ(refused, refused_every) << "iteration " << it;
-        EXPECT_EQ(s.marked.download_range(0, c.ne), marked) << "iteration " << it;  // the same ones unmarked
+        EXPECT_EQ(refused_flags(once), flags_every) << "iteration " << it;  // the same edges refused
         refusals += refused;
         if (refused == 0) break;
         chosen -= matching_undo(ctx, dm, c, s, once);

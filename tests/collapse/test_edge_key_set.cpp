@@ -1,10 +1,10 @@
 // EdgeKeySet (host/collapse/edge_key_set.hpp), the host tail's set of queued edges: the same
-// answers as std::unordered_set over random inserts and erases, with keys crowded into few
-// home slots (long probe runs, erases from their middle) and through growths.
+// answers as std::unordered_set over random inserts and erases; erases from long and wrapping
+// probe runs (keys made for chosen home slots); growth.
 #include <gtest/gtest.h>
 
-#include <cstdint>
 #include <algorithm>
+#include <cstdint>
 #include <random>
 #include <unordered_set>
 #include <vector>
@@ -45,26 +45,69 @@ TEST(EdgeKeySet, AnswersAsUnorderedSet) {
   }
 }
 
-// Keys that differ only in their high bits (the hash keeps the high bits of a product): runs of
-// neighbours, erased in every order from the middle of their run.
-TEST(EdgeKeySet, ErasesFromLongRuns) {
+// Keys made to land on chosen home slots (the inverse of the hash's multiplier): long runs of
+// keys sharing a home, runs that wrap around the end of the table, runs mixing keys that may
+// move back at an erase with keys that may not; erased in random orders, every other key checked
+// after each erase. The table keeps its first size (1024 slots) for at most 511 keys.
+TEST(EdgeKeySet, ErasesFromCrowdedAndWrappingRuns) {
+  const uint64_t mul = 0x9E3779B97F4A7C15ull;  // EdgeKeySet's hash: the top 10 bits of key * mul
+  uint64_t inv = mul;
+  for (int i = 0; i < 6; ++i) inv *= 2 - mul * inv;  // Newton: mul * inv == 1 mod 2^64
+  ASSERT_EQ(mul * inv, 1ull);
+  std::mt19937_64 rng(5);
+  auto with_home = [&](uint64_t h) {  // a key whose home slot in 1024 is h
+    for (;;) {
+      const uint64_t k = ((h << 54) | (rng() >> 10)) * inv;
+      if (k != ~0ull) return k;
+    }
+  };
   std::vector<uint64_t> keys;
-  for (int32_t a = 0; a < 600; ++a) keys.push_back(key(a, 0));
-  for (uint64_t k = 1; k < 600; ++k) keys.push_back(k);  // a = 0: homes crowd together
-  std::mt19937 rng(11);
-  for (int round = 0; round < 20; ++round) {
+  const std::pair<uint64_t, int> homes[] = {{1019, 3}, {1021, 6}, {1023, 5}, {0, 4}, {2, 2},  // wrapping
+                                            {500, 7},  {501, 1},  {503, 4},  {505, 1}, {506, 3},
+                                            {700, 1},  {701, 1},  {702, 1}};
+  for (auto [h, count] : homes)
+    for (int i = 0; i < count; ++i) keys.push_back(with_home(h));
+  for (int i = 0; i < 300; ++i) keys.push_back(with_home(rng() % 1024));  // and the rest of the table
+  for (int round = 0; round < 30; ++round) {
     EdgeKeySet set;
-    for (uint64_t k : keys) ASSERT_TRUE(set.insert(k));
     std::vector<uint64_t> order = keys;
+    std::shuffle(order.begin(), order.end(), rng);
+    for (uint64_t k : order) ASSERT_TRUE(set.insert(k));
+    for (uint64_t k : order) ASSERT_FALSE(set.insert(k));
     std::shuffle(order.begin(), order.end(), rng);
     for (size_t i = 0; i < order.size(); ++i) {
       ASSERT_TRUE(set.erase(order[i]));
+      ASSERT_FALSE(set.erase(order[i]));
       ASSERT_FALSE(set.contains(order[i]));
-      if (i % 97 != 0) continue;
       for (size_t j = i + 1; j < order.size(); ++j) {
-        ASSERT_TRUE(set.contains(order[j])) << i << " " << j;
+        ASSERT_TRUE(set.contains(order[j])) << "round " << round << ", after erase " << i;
       }
     }
     EXPECT_EQ(set.size(), 0u);
   }
+}
+
+// Growth: the keys of a crowded 1024-slot table, then enough others to grow it twice; all found,
+// and erased, after.
+TEST(EdgeKeySet, KeepsItsKeysThroughGrowth) {
+  const uint64_t mul = 0x9E3779B97F4A7C15ull;
+  uint64_t inv = mul;
+  for (int i = 0; i < 6; ++i) inv *= 2 - mul * inv;
+  std::mt19937_64 rng(9);
+  std::vector<uint64_t> keys;
+  for (int i = 0; i < 400; ++i) keys.push_back(((uint64_t(1020 + i % 8) << 54) | (rng() >> 10)) * inv);
+  for (int i = 0; i < 3000; ++i) keys.push_back(rng() >> 1);
+  EdgeKeySet set;
+  for (uint64_t k : keys) ASSERT_TRUE(set.insert(k));
+  EXPECT_EQ(set.size(), keys.size());
+  for (uint64_t k : keys) ASSERT_TRUE(set.contains(k));
+  std::shuffle(keys.begin(), keys.end(), rng);
+  for (size_t i = 0; i < keys.size(); ++i) {
+    ASSERT_TRUE(set.erase(keys[i]));
+    if (i % 500 != 0) continue;
+    for (size_t j = i + 1; j < keys.size(); ++j) {
+      ASSERT_TRUE(set.contains(keys[j]));
+    }
+  }
+  EXPECT_EQ(set.size(), 0u);
 }
