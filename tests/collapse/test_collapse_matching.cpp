@@ -448,47 +448,74 @@ TEST(CollapseMatching, WholeRunsValidDeterministicAndInFewerIterations) {
   }
 }
 
-// After the undo of refused collapses, the surface guard tests only the queries near the
-// undone ones (SurfaceGuard::restrict_to_undone): on every iteration of runs where the guard
-// refuses (the shared gen_gmsh_wrenchnut_27k at 3x and gen_gmsh_917_fusee_88k at 1x the median
-// edge length), it refuses what a guard testing every query of the result refuses, and the
-// results are valid.
-TEST(CollapseMatching, GuardAfterUndoTestsWhatTheUndoChanged) {
+namespace {
+// The shared meshes on which the matching selection's surface guard refuses collapses (the
+// wrenchnut 27k at 3x and the fusee 88k at 1x the median edge length), those present.
+std::vector<std::pair<std::string, double>> guard_refusal_runs() {
   std::vector<std::pair<std::string, double>> runs;
   for (auto [name, factor] : {std::pair<const char*, double>{"gen_gmsh_wrenchnut_27k.msh", 3.0},
                               {"gen_gmsh_917_fusee_88k.msh", 1.0}}) {
     const std::string path = test::shared_mesh(name);
     if (!path.empty()) runs.push_back({path, factor});
   }
+  return runs;
+}
+
+// The matching selection's iterations on `in` (target factor x its median edge length, in the
+// spatial order, as collapse() without the host tail); after each selection
+// guard(iteration, dm, c, s, p, chosen) runs the surface guard and its undos and returns the
+// collapses left. Returns the result.
+template <class Guard>
+Mesh run_guarded_matching(Context& ctx, const Mesh& in, double factor, const Guard& guard) {
+  CollapseOptions o;
+  StageParams p = params_from(o);
+  p.target = factor * median_edge_length(in);
+  DeviceMesh dm, next;
+  std::vector<int32_t> vertex_new;  // the spatial order, as collapse() (the refusals depend on the order)
+  upload_mesh(ctx, in, o, dm, &vertex_new);
+  Connectivity c;
+  EdgeState s;
+  DeviceBuffer<int32_t> origin(ctx, 1);
+  for (int it = 0; it < 40; ++it) {
+    build_connectivity(ctx, dm, c, p, &s);
+    carry_verdicts(ctx, dm, c, s);
+    cost_and_mark(ctx, dm, c, s, p);
+    matching_backup(ctx, dm, s);
+    uint32_t passed_q = 0, tested = 0;
+    const uint32_t chosen = guard(it, dm, c, s, p, matching_selection(ctx, dm, c, s, p, passed_q, tested));
+    if (chosen == 0) break;
+    remember_for_carry(ctx, dm, c, s);
+    collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
+    note_compaction(ctx, dm, c, s);
+  }
+  Mesh out = in;
+  download_mesh(dm, out);
+  return out;
+}
+}  // namespace
+
+// After the undo of refused collapses, the surface guard tests only the queries near the
+// undone ones (SurfaceGuard::restrict_to_undone): on every iteration of runs where the guard
+// refuses (guard_refusal_runs), it refuses what a guard testing every query of the result
+// refuses (each pair once per query of the pair, the rule before session 18), and the results
+// are valid.
+TEST(CollapseMatching, GuardAfterUndoTestsWhatTheUndoChanged) {
+  const auto runs = guard_refusal_runs();
   if (runs.empty()) GTEST_SKIP() << "gen_gmsh_wrenchnut_27k.msh and gen_gmsh_917_fusee_88k.msh absent from the shared meshes";
   Context ctx;
   int undos = 0, restricted_queries = 0, full_queries = 0;
   for (const auto& [path, factor] : runs) {
     SCOPED_TRACE(path);
     const Mesh in = read_mesh(path);
-    CollapseOptions o;
-    StageParams p = params_from(o);
-    p.target = factor * median_edge_length(in);
-    DeviceMesh dm, next;
-    std::vector<int32_t> vertex_new;  // the spatial order, as collapse() (the refusals depend on the order)
-    upload_mesh(ctx, in, o, dm, &vertex_new);
-    Connectivity c;
-    EdgeState s;
     SurfaceGuard guard;
-    DeviceBuffer<int32_t> origin(ctx, 1);
-    for (int it = 0; it < 40; ++it) {
-      build_connectivity(ctx, dm, c, p, &s);
-      carry_verdicts(ctx, dm, c, s);
-      cost_and_mark(ctx, dm, c, s, p);
-      matching_backup(ctx, dm, s);
-      uint32_t passed_q = 0, tested = 0;
-      uint32_t chosen = matching_selection(ctx, dm, c, s, p, passed_q, tested);
+    const Mesh out = run_guarded_matching(ctx, in, factor, [&](int it, DeviceMesh& dm, Connectivity& c, EdgeState& s,
+                                                               const StageParams& p, uint32_t chosen) {
       while (guard.run_applied(ctx, dm, c, s, p, chosen) > 0) {
         chosen -= matching_undo(ctx, dm, c, s, guard);
         ++undos;
         // a guard testing every query of the result, beside the restricted one the loop runs next
         SurfaceGuard full;
-        full.each_pair_once = false;  // and each pair once per query of the pair, as before session 18
+        full.each_pair_once = false;
         const uint32_t full_refused = full.run_applied(ctx, dm, c, s, p, chosen);
         full_queries += int(full.last_queries);
         const std::vector<uint32_t> marked = s.marked.download_range(0, c.ne);
@@ -499,13 +526,8 @@ TEST(CollapseMatching, GuardAfterUndoTestsWhatTheUndoChanged) {
         if (refused == 0) break;
         chosen -= matching_undo(ctx, dm, c, s, guard);
       }
-      if (chosen == 0) break;
-      remember_for_carry(ctx, dm, c, s);
-      collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
-      note_compaction(ctx, dm, c, s);
-    }
-    Mesh out = in;
-    download_mesh(dm, out);
+      return chosen;
+    });
     CheckOptions co;
     co.quality = false;
     co.hausdorff = false;
@@ -518,50 +540,30 @@ TEST(CollapseMatching, GuardAfterUndoTestsWhatTheUndoChanged) {
 
 // The surface guard of the matching selection tests each pair of S faces of the result once, for
 // the query of its lowest survivor, and a hit refuses every query of the pair
-// (SurfaceGuard::each_pair_once): on every guard run of runs where the guard refuses (as above),
-// it refuses the same collapses as testing each pair once per query of the pair.
+// (SurfaceGuard::each_pair_once): on every guard run of guard_refusal_runs, it refuses the same
+// edges as testing each pair once per query of the pair.
 TEST(CollapseMatching, GuardTestsEachPairOnceWithTheSameRefusals) {
-  std::vector<std::pair<std::string, double>> runs;
-  for (auto [name, factor] : {std::pair<const char*, double>{"gen_gmsh_wrenchnut_27k.msh", 3.0},
-                              {"gen_gmsh_917_fusee_88k.msh", 1.0}}) {
-    const std::string path = test::shared_mesh(name);
-    if (!path.empty()) runs.push_back({path, factor});
-  }
+  const auto runs = guard_refusal_runs();
   if (runs.empty()) GTEST_SKIP() << "gen_gmsh_wrenchnut_27k.msh and gen_gmsh_917_fusee_88k.msh absent from the shared meshes";
   Context ctx;
   int guard_runs = 0;
   uint32_t refusals = 0;
   for (const auto& [path, factor] : runs) {
     SCOPED_TRACE(path);
-    const Mesh in = read_mesh(path);
-    CollapseOptions o;
-    StageParams p = params_from(o);
-    p.target = factor * median_edge_length(in);
-    DeviceMesh dm, next;
-    std::vector<int32_t> vertex_new;
-    upload_mesh(ctx, in, o, dm, &vertex_new);
-    Connectivity c;
-    EdgeState s;
-    DeviceBuffer<int32_t> origin(ctx, 1);
-    for (int it = 0; it < 40; ++it) {
-      build_connectivity(ctx, dm, c, p, &s);
-      carry_verdicts(ctx, dm, c, s);
-      cost_and_mark(ctx, dm, c, s, p);
-      matching_backup(ctx, dm, s);
-      uint32_t passed_q = 0, tested = 0;
-      uint32_t chosen = matching_selection(ctx, dm, c, s, p, passed_q, tested);
+    run_guarded_matching(ctx, read_mesh(path), factor, [&](int it, DeviceMesh& dm, Connectivity& c, EdgeState& s,
+                                                          const StageParams& p, uint32_t chosen) {
+      // the refused edges of a guard's last run, flagged (SurfaceGuard::refused_edges)
+      auto refused_flags = [&](SurfaceGuard& g) {
+        DeviceBuffer<uint8_t> flag(ctx, std::max<size_t>(c.ne, 1));
+        DeviceBuffer<uint32_t> list(ctx, std::max<size_t>(c.ne, 1)), count(ctx, 1);
+        flag.fill(0);
+        count.fill(0u);
+        g.refused_edges(ctx, flag, list, count);
+        return flag.download_range(0, c.ne);
+      };
       for (;;) {
         SurfaceGuard every, once;
         every.each_pair_once = false;
-        // the refused edges of each, flagged (SurfaceGuard::refused_edges)
-        auto refused_flags = [&](SurfaceGuard& g) {
-          DeviceBuffer<uint8_t> flag(ctx, std::max<size_t>(c.ne, 1));
-          DeviceBuffer<uint32_t> list(ctx, std::max<size_t>(c.ne, 1)), count(ctx, 1);
-          flag.fill(0);
-          count.fill(0u);
-          g.refused_edges(ctx, flag, list, count);
-          return flag.download_range(0, c.ne);
-        };
         const uint32_t refused_every = every.run_applied(ctx, dm, c, s, p, chosen);
         EXPECT_FALSE(every.last_run_each_pair_once);
         const std::vector<uint8_t> flags_every = refused_flags(every);
@@ -571,14 +573,10 @@ TEST(CollapseMatching, GuardTestsEachPairOnceWithTheSameRefusals) {
         EXPECT_EQ(refused, refused_every) << "iteration " << it;
         EXPECT_EQ(refused_flags(once), flags_every) << "iteration " << it;  // the same edges refused
         refusals += refused;
-        if (refused == 0) break;
+        if (refused == 0) return chosen;
         chosen -= matching_undo(ctx, dm, c, s, once);
       }
-      if (chosen == 0) break;
-      remember_for_carry(ctx, dm, c, s);
-      collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
-      note_compaction(ctx, dm, c, s);
-    }
+    });
   }
   EXPECT_GT(guard_runs, 4);
   EXPECT_GT(refusals, 0u);
