@@ -364,7 +364,10 @@ inline int tcc_sg_tri_box_apart(double3 lo, double3 hi, __global const double* t
 }
 
 /* The uniform grid of the query boxes (built by the host): cell (i, j, k) of size 1 / ih from
- * org, dims gd; the queries of cell c are cell_items[cell_off[c] .. cell_off[c + 1]). A product
+ * org, dims gd; the entries of cell c are cell_q[cell_off[c] .. cell_off[c + 1]), 4 ints each:
+ * the query, its x = qrep[2 q] (the survivor in run_applied), the cell of its box's low corner
+ * packed as vcell's (i | j << 10 | k << 20), 0; each cell's by increasing x when the run tests
+ * each pair once (sguard_surface's scan stops early), else by query. A product
  * by the inverse instead of a division (the host's cell_of does the same arithmetic, which
  * keeps every pair's owner cell among the cells both were entered in). */
 inline int tcc_sg_cell(double v, double org, double ih, int n) {
@@ -375,20 +378,20 @@ inline int tcc_sg_cell(double v, double org, double ih, int n) {
 /* Is (i, j, k) the cell holding the low corner of the overlap of boxes A and B (so each pair
  * is tested once)? Also tests the overlap. The cell of the overlap's low corner is, per axis,
  * the larger of the two boxes' low cells (the cell of a coordinate does not decrease with it):
- * A's are (i0, j0, k0), B's the first three of qcell (the host's cells of B's low and high
- * corners, the same arithmetic), so most pairs met in
- * another of their common cells are passed over before B's box is read. */
-inline int tcc_sg_owner_cell(double3 alo, double3 ahi, int i0, int j0, int k0, __global const double* b,
-                             __global const int* qcell, int i, int j, int k) {
-  if (max(i0, qcell[0]) != i || max(j0, qcell[1]) != j || max(k0, qcell[2]) != k) return 0;
+ * A's are (i0, j0, k0), B's packed in bc (a grid entry's, the host's same arithmetic), so most
+ * pairs met in another of their common cells are passed over before B's box is read. */
+inline int tcc_sg_owner_cell(double3 alo, double3 ahi, int i0, int j0, int k0, uint bc, __global const double* b,
+                             int i, int j, int k) {
+  if (max(i0, (int)(bc & 0x3ffu)) != i || max(j0, (int)((bc >> 10) & 0x3ffu)) != j || max(k0, (int)(bc >> 20)) != k)
+    return 0;
   return !tcc_sg_box_apart(alo, ahi, b);
 }
 
-/* Loop over the queries entered in the grid cells that the box [LO, HI] overlaps: the body
- * (the variadic rest, so that it may hold commas) sees the cell (ci, cj, ck) and the query QI
- * (`continue` goes to the next query). Needs ox, oy, oz, ih, gx, gy, gz, cell_off and
- * cell_items in scope. */
-#define TCC_SG_FOR_CELL_QUERIES(LO, HI, QI, ...)                                                              \
+/* Loop over the grid entries (cell_q) of the cells that the box [LO, HI] overlaps: the body (the
+ * variadic rest, so that it may hold commas) sees the box's low cell (i0_, j0_, k0_), the cell
+ * (ci, cj, ck) and the entry ITEM (`continue` goes to the next entry, `break` to the next
+ * cell). Needs ox, oy, oz, ih, gx, gy, gz, cell_off and cell_q in scope. */
+#define TCC_SG_FOR_CELL_ENTRIES(LO, HI, ITEM, ...)                                                            \
   {                                                                                                          \
     const int i0_ = tcc_sg_cell((LO).x, ox, ih, gx), i1_ = tcc_sg_cell((HI).x, ox, ih, gx);                  \
     const int j0_ = tcc_sg_cell((LO).y, oy, ih, gy), j1_ = tcc_sg_cell((HI).y, oy, ih, gy);                  \
@@ -398,7 +401,7 @@ inline int tcc_sg_owner_cell(double3 alo, double3 ahi, int i0, int j0, int k0, _
         for (int ci = i0_; ci <= i1_; ++ci) {                                                                \
           const uint c_ = ((uint)ck * (uint)gy + (uint)cj) * (uint)gx + (uint)ci;                            \
           for (uint m_ = cell_off[c_]; m_ < cell_off[c_ + 1]; ++m_) {                                        \
-            const uint QI = cell_items[m_];                                                                  \
+            const int4 ITEM = vload4(m_, cell_q);                                                            \
             __VA_ARGS__                                                                                      \
           }                                                                                                  \
         }                                                                                                    \
@@ -464,11 +467,8 @@ inline void tcc_sg_face_query(uint qi, int rx, const int* fid, const double3* fp
 
 /* Every current S face (smask: the faces a tet owns on S) against the queries whose box it
  * overlaps; a face in cells without queries (vcell) is passed over before its points are read.
- * The grid's entries for the sweep (cell_q, 4 ints each, in cell_items' order): the query, its
- * x = qrep[2 q] (the survivor in run_applied), its box's low corner's cell packed as vcell's
- * (tcc_sg_owner_cell's test without reading the query's arrays), 0. With dedup a cell lists its
- * queries by increasing x, and its scan stops at the first x at or above the face's lowest
- * survivor (the face has x, or the pairs are another query's). */
+ * With dedup a cell's scan stops at the first x at or above the face's lowest survivor (the face
+ * has x, or the pairs are another query's). */
 __kernel void sguard_surface(uint n, __global const uint* stets, __global const uchar* smask,
                              __global const uint* vcell, __global const double* pts,
                              __global const int* tets, __global const int* qrep, __global const double* qbox,
@@ -495,29 +495,17 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
     const int flow = dedup ? tcc_sg_first_survivor(fid, qof) : INT_MAX; /* its lowest survivor */
     uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
     code = code < 0x7ffffffeu ? code + 2u : 1u;
-    const int i0 = tcc_sg_cell(lo.x, ox, ih, gx), i1 = tcc_sg_cell(hi.x, ox, ih, gx);
-    const int j0 = tcc_sg_cell(lo.y, oy, ih, gy), j1 = tcc_sg_cell(hi.y, oy, ih, gy);
-    const int k0 = tcc_sg_cell(lo.z, oz, ih, gz), k1 = tcc_sg_cell(hi.z, oz, ih, gz);
-    for (int ck = k0; ck <= k1; ++ck)
-      for (int cj = j0; cj <= j1; ++cj)
-        for (int ci = i0; ci <= i1; ++ci) {
-          const uint c = ((uint)ck * (uint)gy + (uint)cj) * (uint)gx + (uint)ci;
-          for (uint m = cell_off[c]; m < cell_off[c + 1]; ++m) {
-            const int4 item = vload4(m, cell_q);
-            const uint qi = (uint)item.x, qc = (uint)item.z;
-            if (dedup) {
-              if (flow <= item.y) break;
-            } else if (qbad[qi] != 0u) {
-              continue;
-            }
-            /* the pair is met in the cell of its boxes' overlap's low corner (tcc_sg_owner_cell) */
-            if (max(i0, (int)(qc & 0x3ffu)) != ci || max(j0, (int)((qc >> 10) & 0x3ffu)) != cj ||
-                max(k0, (int)(qc >> 20)) != ck || tcc_sg_box_apart(lo, hi, qbox + 6 * qi))
-              continue;
-            tcc_sg_face_query(qi, item.y, fid, fpos, lo, hi, &has_plane, &fplane, code, dedup, qrep, qoff, tid, tpos,
-                              tbox, tplane, qof, tmin, qbad);
-          }
-        }
+    TCC_SG_FOR_CELL_ENTRIES(lo, hi, item, {
+      const uint qi = (uint)item.x;
+      if (dedup) {
+        if (flow <= item.y) break;
+      } else if (qbad[qi] != 0u) {
+        continue;
+      }
+      if (!tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, (uint)item.z, qbox + 6 * qi, ci, cj, ck)) continue;
+      tcc_sg_face_query(qi, item.y, fid, fpos, lo, hi, &has_plane, &fplane, code, dedup, qrep, qoff, tid, tpos, tbox,
+                        tplane, qof, tmin, qbad);
+    })
   }
 }
 
@@ -527,8 +515,7 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
 __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const uint* qoff, __global const int* tid,
                            __global const double* tpos, __global const double* tbox, __global const double* tplane,
                            double ox, double oy, double oz, double ih, int gx, int gy, int gz,
-                           __global const uint* cell_off, __global const uint* cell_items, __global const int* qcell,
-                           __global uint* qbad, int cross, int dedup, __global const int* qrep, __global const int* qof,
+                           __global const uint* cell_off, __global const int* cell_q, __global uint* qbad, int cross, int dedup, __global const int* qrep, __global const int* qof,
                            __global const int* tmin) {
   uint qa = get_global_id(0);
   if (qa >= nq) return;
@@ -560,8 +547,9 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
     }
   }
   if (!cross) return;
-  TCC_SG_FOR_CELL_QUERIES(lo, hi, qb, {
-    if (qb == qa || !tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, qbox + 6 * qb, qcell + 6 * qb, ci, cj, ck)) continue;
+  TCC_SG_FOR_CELL_ENTRIES(lo, hi, item, {
+    const uint qb = (uint)item.x;
+    if (qb == qa || !tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, (uint)item.z, qbox + 6 * qb, ci, cj, ck)) continue;
     for (uint na = qoff[qa]; na < qoff[qa + 1]; ++na) {
       double3 alo, ahi;
       tcc_sg_load_box(tbox, na, &alo, &ahi);

@@ -228,33 +228,24 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
   } else {
     for (uint32_t q = 0; q < nq; ++q) order[q] = q;
   }
-  std::vector<uint32_t> items(std::max<uint32_t>(off[ncells], 1)), cursor(off.begin(), off.end() - 1);
-  std::vector<int32_t> sweep_items(size_t(std::max<uint32_t>(off[ncells], 1)) * 4, 0);
+  // the entries (cl/collapse_guard.cl, tcc_sg_cell): query, x, low cell packed, 0
+  std::vector<uint32_t> cursor(off.begin(), off.end() - 1);
+  std::vector<int32_t> entries(size_t(std::max<uint32_t>(off[ncells], 1)) * 4, 0);
   for (uint32_t q : order)
     for_cells(q, [&](size_t cell) {
-      const uint32_t m = cursor[cell]++;
-      items[m] = q;
+      const size_t m = cursor[cell]++;
       const int32_t* r = &range[6 * size_t(q)];
-      sweep_items[4 * size_t(m)] = int32_t(q);
-      sweep_items[4 * size_t(m) + 1] = rep[2 * q];
-      sweep_items[4 * size_t(m) + 2] = r[0] | r[1] << 10 | r[2] << 20;  // as sguard_vertex_cells packs
+      entries[4 * m] = int32_t(q);
+      entries[4 * m + 1] = rep[2 * q];
+      entries[4 * m + 2] = r[0] | r[1] << 10 | r[2] << 20;  // as sguard_vertex_cells packs
     });
   if (kProfile)
     std::fprintf(stderr, "  surface guard grid: h %g, %d x %d x %d cells, %u entries for %u queries\n", h, g[0], g[1],
                  g[2], off[ncells], nq);
   ensure_nonempty(cell_off, ctx, off.size());
   cell_off.upload(off);
-  ensure_nonempty(cell_q, ctx, sweep_items.size());
-  cell_q.upload(sweep_items);
-  // the queries' own cells and lists, for sguard_pairs across queries (not with the matching
-  // selection's, in place: the sweep meets those pairs)
-  const bool cross = !s.in_place;
-  ensure_nonempty(cell_items, ctx, items.size());
-  ensure_nonempty(qcell, ctx, range.size());
-  if (cross) {
-    cell_items.upload(items);
-    qcell.upload(range);
-  }
+  ensure_nonempty(cell_q, ctx, entries.size());
+  cell_q.upload(entries);
 
   ensure_nonempty(qbad, ctx, nq);
   qbad.fill(0u);
@@ -270,7 +261,7 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
          tmin.buffer());
   launch(ctx, p, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),
          tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
-         cl_int(g[2]), cell_off.buffer(), cell_items.buffer(), qcell.buffer(), qbad.buffer(), cl_int(cross ? 1 : 0),
+         cl_int(g[2]), cell_off.buffer(), cell_q.buffer(), qbad.buffer(), cl_int(s.in_place ? 0 : 1),
          dedup, qrep.buffer(), qof.buffer(), tmin.buffer());
   qcount.fill(0u);
   const bool has_verdict = !s.in_place && s.verdict.size() >= c.ne && s.verdict.buffer()();

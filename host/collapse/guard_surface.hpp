@@ -18,9 +18,8 @@ struct SurfaceGuard {
   // survivor among its vertices (each pair of S faces tested once: cl/collapse_guard.cl)
   DeviceBuffer<int32_t> qof, tmin;
   DeviceBuffer<double> qbox, tpos, tbox, tplane;  // per query: box; per new triangle: positions, box, plane
-  DeviceBuffer<uint32_t> qntri, qoff, qcount, qbad, cell_off, cell_items;
-  DeviceBuffer<int32_t> qcell;               // per query: the cells of its box's low and high corners (6 ints)
-  DeviceBuffer<int32_t> cell_q;  // per grid entry (cell_items' order): query, qrep's x, its low cell packed, 0
+  DeviceBuffer<uint32_t> qntri, qoff, qcount, qbad, cell_off;
+  DeviceBuffer<int32_t> cell_q;  // per grid entry, by cell (cell_off): query, qrep's x, its low cell packed, 0
   DeviceBuffer<uint32_t> vcell;              // per vertex: its cell, packed (sguard_vertex_cells)
   uint32_t last_queries = 0;  // collapses tested by the last run (that change S)
   DeviceBuffer<uint32_t> stets;  // the tets owning an S face (n_stets), listed for the connectivity
