@@ -618,6 +618,11 @@ void SeqMesh::compact(std::vector<int32_t>& vmap, std::vector<int32_t>& kept) {
     for (std::vector<int32_t>* list : {&gbuilt_, &gface_})
       for (int32_t& e : *list)
         if (e >= 0) e = tmap[size_t(e >> 2)] < 0 ? -1 : 4 * tmap[size_t(e >> 2)] + (e & 3);
+    // the registrations follow their faces (a kept tet's new index is at most its old one)
+    for (size_t t = 0; t < tmap.size(); ++t)
+      if (tmap[t] >= 0)
+        for (size_t f = 0; f < 4; ++f) gver_[4 * size_t(tmap[t]) + f] = gver_[4 * t + f];
+    gver_.resize(4 * size_t(m));
     gseen_.assign(4 * size_t(m), 0);
     gstamp_ = 0;
   }
@@ -696,17 +701,40 @@ int64_t SeqMesh::verify_nbr() const {
   return bad;
 }
 
-int64_t SeqMesh::verify_guard() const {
+int64_t SeqMesh::verify_guard() {
   if (!guard_on_) return 0;
   int64_t missing = 0;
   for (int32_t t = 0; t < nt_; ++t) {
     if (!talive_[t]) continue;
     for (int f = 0; f < 4; ++f) {
       if (!owned_sface(t, f)) continue;
-      each_guard_cell(t, f, [&](size_t cell) {
-        missing += any_guard_face(cell, [&](int32_t e) { return e == 4 * t + f; }) ? 0 : 1;
+      const int32_t* q = tet(t);
+      const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]),
+                          point(q[geo::TC_TET_FACES[f][2]])};
+      tc_d3 lo, hi;
+      box_of(p, lo, hi);
+      each_guard_cell(p, [&](size_t cell) {
+        // an entry of the face whose box holds the face's box now
+        missing += any_live_guard_face(cell, lo, hi, [&](int32_t e, const GuardBox& b) {
+                     return e == 4 * t + f && b.lo[0] <= lo.x && b.lo[1] <= lo.y && b.lo[2] <= lo.z &&
+                            hi.x <= b.hi[0] && hi.y <= b.hi[1] && hi.z <= b.hi[2];
+                   })
+                       ? 0
+                       : 1;
       });
     }
+  }
+  // no face twice in a cell among the live entries (a registration makes the earlier ones stale)
+  const tc_d3 all_lo{-INFINITY, -INFINITY, -INFINITY}, all_hi{INFINITY, INFINITY, INFINITY};
+  std::vector<int32_t> ids;
+  for (size_t cell = 0; cell + 1 < gcell_off_.size(); ++cell) {
+    ids.clear();
+    any_live_guard_face(cell, all_lo, all_hi, [&](int32_t e, const GuardBox&) {
+      ids.push_back(e);
+      return false;
+    });
+    std::sort(ids.begin(), ids.end());
+    missing += int64_t(ids.size()) - (std::unique(ids.begin(), ids.end()) - ids.begin());
   }
   return missing;
 }
@@ -738,13 +766,35 @@ void SeqMesh::guard_cells(const tc_d3* p, int (&lo)[3], int (&hi)[3]) const {
   }
 }
 
+SeqMesh::GuardBox SeqMesh::guard_box(const tc_d3* p) {
+  tc_d3 lo, hi;
+  box_of(p, lo, hi);
+  const double l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z};
+  GuardBox b;
+  for (int c = 0; c < 3; ++c) {
+    // rounded outward (a NaN stays NaN: never apart, as with the doubles)
+    b.lo[c] = float(l[c]);
+    if (double(b.lo[c]) > l[c]) b.lo[c] = std::nextafter(b.lo[c], -INFINITY);
+    b.hi[c] = float(h[c]);
+    if (double(b.hi[c]) < h[c]) b.hi[c] = std::nextafter(b.hi[c], INFINITY);
+  }
+  return b;
+}
+
 void SeqMesh::guard_insert(int32_t t, int f) {
-  each_guard_cell(t, f, [&](size_t cell) {
+  const uint32_t ver = ++gver_[4 * size_t(t) + size_t(f)];  // its earlier entries are stale now
+  const int32_t* q = tet(t);
+  const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]),
+                      point(q[geo::TC_TET_FACES[f][2]])};
+  const GuardBox box = guard_box(p);
+  each_guard_cell(p, [&](size_t cell) {
     // (unreachable at any size the method can hold in memory; were it thrown within collapse(),
     // the SeqMesh would be left half changed, and the run is abandoned)
     if (gface_.size() + 1 >= size_t(std::numeric_limits<int32_t>::max()))
       throw InputError("<mesh>", "the sequential method's surface guard needs more than 2^31 grid entries");
     gface_.push_back(4 * t + f);
+    gface_ver_.push_back(ver);
+    gface_box_.push_back(box);
     gnext_.push_back(ghead_[cell]);
     ghead_[cell] = int32_t(gface_.size() - 1);
   });
@@ -754,7 +804,10 @@ void SeqMesh::build_guard(double h) {
   guard_on_ = true;
   guard_h_req_ = h;
   gface_.clear();
+  gface_ver_.clear();
+  gface_box_.clear();
   gnext_.clear();
+  gver_.assign(4 * size_t(nt_), 0);
   gseen_.assign(4 * size_t(nt_), 0);
   gstamp_ = 0;
   // the S faces (all three vertices on S, owned), their mean extent and the bounding box
@@ -782,7 +835,7 @@ void SeqMesh::build_guard(double h) {
       extent += std::fmax(fhi.x - flo.x, std::fmax(fhi.y - flo.y, fhi.z - flo.z));
     }
   }
-  guard_h_ = faces.empty() ? h : extent / double(faces.size());  // a few S faces per cell
+  guard_h_ = faces.empty() ? h : extent / double(faces.size()) * (getenv("GHF") ? atof(getenv("GHF")) : 1.0);  // a few S faces per cell
   const double span = std::fmax(hi.x - lo.x, std::fmax(hi.y - lo.y, hi.z - lo.z));
   if (!(guard_h_ > 0) || !std::isfinite(guard_h_)) guard_h_ = std::isfinite(span) && span > 0 ? span : 1.0;
   guard_h_ = std::fmax(guard_h_, span / double(1 << 20));  // at most 2^20 cells per axis
@@ -801,11 +854,20 @@ void SeqMesh::build_guard(double h) {
   ghead_.assign(ncells, -1);
   gcell_off_.assign(ncells + 1, 0);
   for (int pass = 0; pass < 2; ++pass) {
-    for (int32_t e : faces)
-      each_guard_cell(e >> 2, e & 3, [&](size_t c) {
-        if (pass == 0) ++gcell_off_[c + 1];
-        else gbuilt_[gcell_off_[c]++] = e;  // the offsets moved one cell on (restored below)
+    for (int32_t e : faces) {
+      const int32_t* q = tet(e >> 2);
+      const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[e & 3][0]]), point(q[geo::TC_TET_FACES[e & 3][1]]),
+                          point(q[geo::TC_TET_FACES[e & 3][2]])};
+      const GuardBox box = pass == 1 ? guard_box(p) : GuardBox{};
+      each_guard_cell(p, [&](size_t c) {
+        if (pass == 0) {
+          ++gcell_off_[c + 1];
+        } else {  // the offsets moved one cell on (restored below)
+          gbuilt_box_[gcell_off_[c]] = box;
+          gbuilt_[gcell_off_[c]++] = e;
+        }
       });
+    }
     if (pass == 0) {
       for (size_t c = 0; c < ncells; ++c) {
         if (double(gcell_off_[c]) + double(gcell_off_[c + 1]) >= double(std::numeric_limits<int32_t>::max()))
@@ -813,6 +875,7 @@ void SeqMesh::build_guard(double h) {
         gcell_off_[c + 1] += gcell_off_[c];
       }
       gbuilt_.assign(gcell_off_[ncells], -1);
+      gbuilt_box_.resize(gcell_off_[ncells]);
     }
   }
   for (size_t c = ncells; c > 0; --c) gcell_off_[c] = gcell_off_[c - 1];
@@ -880,7 +943,7 @@ bool SeqMesh::guard_ok(int32_t a, int32_t b, uint8_t dir) {
     box_of(nt.pos, nlo, nhi);
     bool crossed = false;
     each_guard_cell(nt.pos, [&](size_t cell) {
-      crossed = crossed || any_guard_face(cell, [&](int32_t e) {
+      crossed = crossed || any_live_guard_face(cell, nlo, nhi, [&](int32_t e, const GuardBox&) {
                   if (gseen_[e] == gstamp_) return false;
                   gseen_[e] = gstamp_;
                   const int32_t t = e >> 2;
