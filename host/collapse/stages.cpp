@@ -9,9 +9,11 @@
 #include <functional>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
+#include <thread>
 
 #include "device/primitives.hpp"
 #include "tetcollapse/error.hpp"
@@ -181,16 +183,23 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
   dm.nv = uint32_t(nv);
   dm.nt = uint32_t(nt);
   const std::vector<int32_t>& tets = order ? spatial.tets : mesh.tets;
+  // The rings (a CPU device) on a second thread while this one gathers and uploads the rest: the
+  // device's threads are idle during the upload (W1: the rings ~0.02 s, the rest ~0.015 s).
+  dm.has_rings = ctx.info().type == "CPU";
+  std::vector<uint32_t> ring_off;
+  std::vector<int32_t> ring_vt;
+  std::exception_ptr ring_error;
+  std::jthread rings;
+  if (dm.has_rings)
+    rings = std::jthread([&] {
+      try {
+        host_rings(tets, dm.nv, ring_off, ring_vt);
+      } catch (...) {
+        ring_error = std::current_exception();
+      }
+    });
   dm.points = order ? DeviceBuffer<double>(ctx, gather(mesh.points, nv, 3, vold)) : DeviceBuffer<double>(ctx, mesh.points);
   dm.tets = DeviceBuffer<int32_t>(ctx, tets);
-  dm.has_rings = ctx.info().type == "CPU";
-  if (dm.has_rings) {
-    std::vector<uint32_t> off;
-    std::vector<int32_t> vt;
-    host_rings(tets, dm.nv, off, vt);
-    dm.vt_off = DeviceBuffer<uint32_t>(ctx, off);
-    dm.vt = DeviceBuffer<int32_t>(ctx, vt);
-  }
   dm.labels.clear();
   for (const Labels& l : mesh.tet_labels) {  // lengths checked by check_collapse_input
     dm.labels.emplace_back(ctx, order ? gather(l.values, nt, 1, told) : l.values);
@@ -223,6 +232,12 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
     throw std::invalid_argument("vertex_mask has " + std::to_string(o.vertex_mask.size()) + " entries for " +
                                 std::to_string(nv) + " vertices");
   dm.vmask = DeviceBuffer<uint8_t>(ctx, order && dm.has_mask ? gather(o.vertex_mask, nv, 1, vold) : o.vertex_mask);
+  if (dm.has_rings) {
+    rings.join();
+    if (ring_error) std::rethrow_exception(ring_error);
+    dm.vt_off = DeviceBuffer<uint32_t>(ctx, ring_off);
+    dm.vt = DeviceBuffer<int32_t>(ctx, ring_vt);
+  }
   if (vertex_new) *vertex_new = std::move(spatial.vertex_new);
 }
 
