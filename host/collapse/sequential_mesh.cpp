@@ -835,7 +835,7 @@ void SeqMesh::build_guard(double h) {
       extent += std::fmax(fhi.x - flo.x, std::fmax(fhi.y - flo.y, fhi.z - flo.z));
     }
   }
-  guard_h_ = faces.empty() ? h : extent / double(faces.size()) * (getenv("GHF") ? atof(getenv("GHF")) : 1.0);  // a few S faces per cell
+  guard_h_ = faces.empty() ? h : extent / double(faces.size());  // a few S faces per cell
   const double span = std::fmax(hi.x - lo.x, std::fmax(hi.y - lo.y, hi.z - lo.z));
   if (!(guard_h_ > 0) || !std::isfinite(guard_h_)) guard_h_ = std::isfinite(span) && span > 0 ? span : 1.0;
   guard_h_ = std::fmax(guard_h_, span / double(1 << 20));  // at most 2^20 cells per axis
