@@ -152,6 +152,7 @@ bool SequentialRun::step() {
                              [](const QueueEntry& x, const QueueEntry& y) { return x.a == y.a && x.b == y.b; }),
                  edges_.end());
   } else if (!seed_edges_.empty()) {  // the device's, of this mesh (TailSeed::edges)
+    edges_.reserve(seed_edges_.size() / 2);
     for (size_t i = 0; i + 1 < seed_edges_.size(); i += 2) {
       const int32_t a = seed_edges_[i], b = seed_edges_[i + 1];
       edges_.push_back({sm_.length(a, b), a, b, 0});
