@@ -491,17 +491,12 @@ __kernel void conn_surface_flags(uint nv, __global const int* tets, __global con
   __global const int* upper = nb + (nb_off[v + 1] - up); /* N(v) above v, in edge order */
   const int on_s = vflags[v] != 0;
   if (carry && !ndirty[v]) { /* ring(v), which decides the class and the owned edges' flags, is unchanged */
+    /* and N(v) is the previous one renumbered in order (conn_ring_sort_and_gather): its part above
+     * v is the previous part above vold[v], entry for entry (as verdict_carry reads it) */
     const int o = vold[v];
     vclass[v] = prev_vclass[o];
-    for (uint i = 0; i < up; ++i) {
-      const int u = upper[i];
-      uchar fl = 0;
-      if (on_s && vflags[u]) {
-        const int eo = tcc_edge_id(prev_nb_off, prev_nb, prev_nb_edge, o, vold[u]);
-        fl = eo >= 0 ? prev_eflags[eo] : tcc_edge_flags_of((int)v, u, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, eps_r);
-      }
-      eflags[e0 + i] = fl;
-    }
+    __global const int* prev_upper_edge = prev_nb_edge + (prev_nb_off[o + 1] - up);
+    for (uint i = 0; i < up; ++i) eflags[e0 + i] = on_s && vflags[upper[i]] ? prev_eflags[prev_upper_edge[i]] : (uchar)0;
     return;
   }
   if (!on_s) {
