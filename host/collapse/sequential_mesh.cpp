@@ -613,11 +613,13 @@ void SeqMesh::compact(std::vector<int32_t>& vmap, std::vector<int32_t>& kept) {
   // the guard's grid kept, its faces renumbered (those of removed tets dropped), unless the
   // collapses since it was built added more than half as many entries again (stale ones,
   // checked on use): then built again below
-  const bool rebuild_guard = guard_on_ && 2 * gface_.size() > gbuilt_.size() + 1024;
+  const bool rebuild_guard = guard_on_ && 2 * gnodes_.size() > gbuilt_.size() + 1024;
   if (guard_on_ && !rebuild_guard) {
-    for (std::vector<int32_t>* list : {&gbuilt_, &gface_})
-      for (int32_t& e : *list)
-        if (e >= 0) e = tmap[size_t(e >> 2)] < 0 ? -1 : 4 * tmap[size_t(e >> 2)] + (e & 3);
+    auto renumber = [&](int32_t& e) {
+      if (e >= 0) e = tmap[size_t(e >> 2)] < 0 ? -1 : 4 * tmap[size_t(e >> 2)] + (e & 3);
+    };
+    for (int32_t& e : gbuilt_) renumber(e);
+    for (GuardNode& node : gnodes_) renumber(node.face);
     // the registrations follow their faces (a kept tet's new index is at most its old one)
     for (size_t t = 0; t < tmap.size(); ++t)
       if (tmap[t] >= 0)
@@ -708,19 +710,17 @@ int64_t SeqMesh::verify_guard() {
     if (!talive_[t]) continue;
     for (int f = 0; f < 4; ++f) {
       if (!owned_sface(t, f)) continue;
-      const int32_t* q = tet(t);
-      const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]),
-                          point(q[geo::TC_TET_FACES[f][2]])};
+      tc_d3 p[3];
+      face_points(t, f, p);
       tc_d3 lo, hi;
       box_of(p, lo, hi);
       each_guard_cell(p, [&](size_t cell) {
         // an entry of the face whose box holds the face's box now
-        missing += any_live_guard_face(cell, lo, hi, [&](int32_t e, const GuardBox& b) {
-                     return e == 4 * t + f && b.lo[0] <= lo.x && b.lo[1] <= lo.y && b.lo[2] <= lo.z &&
-                            hi.x <= b.hi[0] && hi.y <= b.hi[1] && hi.z <= b.hi[2];
-                   })
-                       ? 0
-                       : 1;
+        auto holds = [&](int32_t e, const GuardBox& b) {
+          return e == 4 * t + f && b.lo[0] <= lo.x && b.lo[1] <= lo.y && b.lo[2] <= lo.z && hi.x <= b.hi[0] &&
+                 hi.y <= b.hi[1] && hi.z <= b.hi[2];
+        };
+        missing += any_live_guard_face(cell, lo, hi, holds, false) ? 0 : 1;
       });
     }
   }
@@ -729,10 +729,13 @@ int64_t SeqMesh::verify_guard() {
   std::vector<int32_t> ids;
   for (size_t cell = 0; cell + 1 < gcell_off_.size(); ++cell) {
     ids.clear();
-    any_live_guard_face(cell, all_lo, all_hi, [&](int32_t e, const GuardBox&) {
-      ids.push_back(e);
-      return false;
-    });
+    any_live_guard_face(
+        cell, all_lo, all_hi,
+        [&](int32_t e, const GuardBox&) {
+          ids.push_back(e);
+          return false;
+        },
+        false);
     std::sort(ids.begin(), ids.end());
     missing += int64_t(ids.size()) - (std::unique(ids.begin(), ids.end()) - ids.begin());
   }
@@ -771,11 +774,13 @@ SeqMesh::GuardBox SeqMesh::guard_box(const tc_d3* p) {
   box_of(p, lo, hi);
   const double l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z};
   GuardBox b;
+  constexpr double kMax = std::numeric_limits<float>::max();
   for (int c = 0; c < 3; ++c) {
-    // rounded outward (a NaN stays NaN: never apart, as with the doubles)
-    b.lo[c] = float(l[c]);
+    // rounded outward; beyond the float range to infinity (a double-to-float conversion of a
+    // value out of range is undefined); a NaN stays NaN: never apart, as with the doubles
+    b.lo[c] = l[c] > kMax ? float(kMax) : l[c] < -kMax ? -INFINITY : float(l[c]);
     if (double(b.lo[c]) > l[c]) b.lo[c] = std::nextafter(b.lo[c], -INFINITY);
-    b.hi[c] = float(h[c]);
+    b.hi[c] = h[c] < -kMax ? -float(kMax) : h[c] > kMax ? INFINITY : float(h[c]);
     if (double(b.hi[c]) < h[c]) b.hi[c] = std::nextafter(b.hi[c], INFINITY);
   }
   return b;
@@ -783,30 +788,23 @@ SeqMesh::GuardBox SeqMesh::guard_box(const tc_d3* p) {
 
 void SeqMesh::guard_insert(int32_t t, int f) {
   const uint32_t ver = ++gver_[4 * size_t(t) + size_t(f)];  // its earlier entries are stale now
-  const int32_t* q = tet(t);
-  const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]),
-                      point(q[geo::TC_TET_FACES[f][2]])};
+  tc_d3 p[3];
+  face_points(t, f, p);
   const GuardBox box = guard_box(p);
   each_guard_cell(p, [&](size_t cell) {
     // (unreachable at any size the method can hold in memory; were it thrown within collapse(),
     // the SeqMesh would be left half changed, and the run is abandoned)
-    if (gface_.size() + 1 >= size_t(std::numeric_limits<int32_t>::max()))
+    if (gnodes_.size() + 1 >= size_t(std::numeric_limits<int32_t>::max()))
       throw InputError("<mesh>", "the sequential method's surface guard needs more than 2^31 grid entries");
-    gface_.push_back(4 * t + f);
-    gface_ver_.push_back(ver);
-    gface_box_.push_back(box);
-    gnext_.push_back(ghead_[cell]);
-    ghead_[cell] = int32_t(gface_.size() - 1);
+    gnodes_.push_back({4 * t + f, ghead_[cell], ver, box});
+    ghead_[cell] = int32_t(gnodes_.size() - 1);
   });
 }
 
 void SeqMesh::build_guard(double h) {
   guard_on_ = true;
   guard_h_req_ = h;
-  gface_.clear();
-  gface_ver_.clear();
-  gface_box_.clear();
-  gnext_.clear();
+  gnodes_.clear();
   gver_.assign(4 * size_t(nt_), 0);
   gseen_.assign(4 * size_t(nt_), 0);
   gstamp_ = 0;
@@ -828,8 +826,8 @@ void SeqMesh::build_guard(double h) {
       for (int j = 0; j < 4 && all_s; ++j) all_s = j == f || vflags_[q[j]] != 0;
       if (!all_s || !owned_sface(t, f)) continue;
       faces.push_back(4 * t + f);
-      const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]),
-                          point(q[geo::TC_TET_FACES[f][2]])};
+      tc_d3 p[3];
+      face_points(t, f, p);
       tc_d3 flo, fhi;
       box_of(p, flo, fhi);
       extent += std::fmax(fhi.x - flo.x, std::fmax(fhi.y - flo.y, fhi.z - flo.z));
@@ -855,9 +853,8 @@ void SeqMesh::build_guard(double h) {
   gcell_off_.assign(ncells + 1, 0);
   for (int pass = 0; pass < 2; ++pass) {
     for (int32_t e : faces) {
-      const int32_t* q = tet(e >> 2);
-      const tc_d3 p[3] = {point(q[geo::TC_TET_FACES[e & 3][0]]), point(q[geo::TC_TET_FACES[e & 3][1]]),
-                          point(q[geo::TC_TET_FACES[e & 3][2]])};
+      tc_d3 p[3];
+      face_points(e >> 2, e & 3, p);
       const GuardBox box = pass == 1 ? guard_box(p) : GuardBox{};
       each_guard_cell(p, [&](size_t c) {
         if (pass == 0) {
@@ -882,7 +879,7 @@ void SeqMesh::build_guard(double h) {
   gcell_off_[0] = 0;
 }
 
-bool SeqMesh::guard_ok(int32_t a, int32_t b, uint8_t dir) {
+bool SeqMesh::guard_ok(int32_t a, int32_t b, uint8_t dir, bool scan_all) {
   if (!guard_on_) return true;
   if (a > b) std::swap(a, b);
   const bool remove_b = (dir & TCC_DIR_REMOVE_V1) != 0;
@@ -941,29 +938,35 @@ bool SeqMesh::guard_ok(int32_t a, int32_t b, uint8_t dir) {
     }
     tc_d3 nlo, nhi;
     box_of(nt.pos, nlo, nhi);
+    // does the new triangle cross face e (4 t + f) of a live tet, once per face
+    auto crosses = [&](int32_t e) {
+      if (gseen_[e] == gstamp_) return false;
+      gseen_[e] = gstamp_;
+      const int32_t t = e >> 2;
+      const int f = e & 3;
+      const int32_t* q = tet(t);
+      int32_t fid[3];
+      bool replaced = false;
+      for (int c = 0; c < 3; ++c) {
+        fid[c] = q[geo::TC_TET_FACES[f][c]];
+        replaced = replaced || fid[c] == x || (moves_y && fid[c] == y);
+      }
+      if (replaced) return false;  // a face the collapse moves or removes
+      const tc_d3 fpos[3] = {point(fid[0]), point(fid[1]), point(fid[2])};
+      tc_d3 flo, fhi;
+      box_of(fpos, flo, fhi);
+      if (boxes_apart(nlo, nhi, flo, fhi) || !owned_sface(t, f)) return false;
+      return geo::tc_sg_tri_tri(nt.id, nt.pos, fid, fpos) != 0;
+    };
     bool crossed = false;
-    each_guard_cell(nt.pos, [&](size_t cell) {
-      crossed = crossed || any_live_guard_face(cell, nlo, nhi, [&](int32_t e, const GuardBox&) {
-                  if (gseen_[e] == gstamp_) return false;
-                  gseen_[e] = gstamp_;
-                  const int32_t t = e >> 2;
-                  const int f = e & 3;
-                  if (!talive_[t]) return false;
-                  const int32_t* q = tet(t);
-                  int32_t fid[3];
-                  bool replaced = false;
-                  for (int c = 0; c < 3; ++c) {
-                    fid[c] = q[geo::TC_TET_FACES[f][c]];
-                    replaced = replaced || fid[c] == x || (moves_y && fid[c] == y);
-                  }
-                  if (replaced) return false;  // a face the collapse moves or removes
-                  const tc_d3 fpos[3] = {point(fid[0]), point(fid[1]), point(fid[2])};
-                  tc_d3 flo, fhi;
-                  box_of(fpos, flo, fhi);
-                  if (boxes_apart(nlo, nhi, flo, fhi) || !owned_sface(t, f)) return false;
-                  return geo::tc_sg_tri_tri(nt.id, nt.pos, fid, fpos) != 0;
-                });
-    });
+    if (scan_all) {  // every face of every live tet (the tests' reference)
+      for (int32_t t = 0; t < nt_ && !crossed; ++t)
+        for (int f = 0; f < 4 && !crossed && talive_[t]; ++f) crossed = crosses(4 * t + f);
+    } else {  // those of the grid's live entries in the triangle's cells (alive)
+      each_guard_cell(nt.pos, [&](size_t cell) {
+        crossed = crossed || any_live_guard_face(cell, nlo, nhi, [&](int32_t e, const GuardBox&) { return crosses(e); });
+      });
+    }
     if (crossed) return false;
   }
   return true;

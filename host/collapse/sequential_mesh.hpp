@@ -104,9 +104,9 @@ class SeqMesh {
   // ring scan's.
   int64_t verify_nbr() const;
   // The same for the surface guard's grid (after build_guard): the (S face, cell) pairs without
-  // a live entry whose box holds the face's box now (any_live_guard_face, which drops the stale
-  // entries on the way), over every S face of the live tets and every cell its box meets, and
-  // the live entries that repeat a face in a cell.
+  // a live entry whose box holds the face's box now (any_live_guard_face, without dropping the
+  // stale entries), over every S face of the live tets and every cell its box meets, and the
+  // live entries that repeat a face in a cell.
   int64_t verify_guard();
 
   // Surface guard (the device's: cl/collapse_guard.cl). build_guard() indexes the current
@@ -118,7 +118,10 @@ class SeqMesh {
   // with the device's triangle test (cl/collapse_guard_geometry.h).
   // Before build_guard() every collapse passes.
   void build_guard(double h);
-  bool guard_ok(int32_t a, int32_t b, uint8_t dir);
+  bool guard_ok(int32_t a, int32_t b, uint8_t dir) { return guard_ok(a, b, dir, false); }
+  // The same verdict from a scan of every face of every live tet instead of the grid (the tests'
+  // reference for the grid's entries).
+  bool guard_ok_scanning(int32_t a, int32_t b, uint8_t dir) { return guard_ok(a, b, dir, true); }
 
  private:
   struct FaceAt {  // a face through v: tet t, local face f (opposite vertex f), key y << 32 | z of
@@ -166,6 +169,7 @@ class SeqMesh {
   // tcc_owned_sface: the kind of the face if t owns it on S, else 0; *on_s (when given) its kind
   // on S whoever owns it
   uint8_t owned_sface(int32_t t, int f, uint8_t* on_s = nullptr) const;
+  bool guard_ok(int32_t a, int32_t b, uint8_t dir, bool scan_all);
   void guard_insert(int32_t t, int f);
   void guard_cells(const geo::tc_d3* p, int (&lo)[3], int (&hi)[3]) const;
   // fn(cell) for every cell of the guard's grid that the box of triangle p meets
@@ -177,27 +181,26 @@ class SeqMesh {
       for (int j = lo[1]; j <= hi[1]; ++j)
         for (int i = lo[0]; i <= hi[0]; ++i) fn(guard_cell(i, j, k));
   }
-  // The same for face f of tet t.
-  template <class Fn>
-  void each_guard_cell(int32_t t, int f, Fn&& fn) const {
+  // The positions of the vertices of face f of tet t, in the face's order.
+  void face_points(int32_t t, int f, geo::tc_d3 (&p)[3]) const {
     const int32_t* q = tet(t);
-    const geo::tc_d3 p[3] = {point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]),
-                             point(q[geo::TC_TET_FACES[f][2]])};
-    each_guard_cell(p, fn);
+    for (int k = 0; k < 3; ++k) p[k] = point(q[geo::TC_TET_FACES[f][k]]);
   }
   // fn(e, box) for the face ids e (4 t + f) of the cell's live entries (build_guard's, then
   // those inserted since) whose box (GuardBox: the face's at its registration) meets the box
   // [lo, hi], stopping at the first for which fn holds. An entry is live when its tet is alive
-  // and it is of the face's latest registration (gver_); the others met are dropped from the
-  // cell. Dropping them changes no guard verdict: a face's box changes only where collapse()
-  // registers it again, so an S face has live entries in every cell its current box meets, with
-  // that box; guard_ok tests a face only when its current box meets the new triangle's, and two
-  // boxes that meet share a cell (the cell of a coordinate is monotone in it). Before, the
-  // entries of every earlier registration stayed until the compaction, and each entry was
-  // checked by its tet and points: W1's host tail (from its iteration 4) visited ~6.4 million
-  // entries for 17,000 new triangles, 171,000 of them with boxes that meet.
+  // and it is of the face's latest registration (gver_); with prune, the others met are dropped
+  // from the cell. A live entry's face may no longer be owned on S: guard_ok checks that.
+  // Dropping the others changes no guard verdict, for finite coordinates and exact vflags_: a
+  // face's box and owner change only in a collapse() that leaves it holding the survivor, which
+  // registers it again when it is owned on S then (and build_guard registers every S face), so
+  // an owned S face has live entries, with its current box, in every cell that box meets;
+  // guard_ok tests a face only when its current box meets the new triangle's, and two boxes
+  // that meet share a cell (the cell of a finite coordinate is monotone in it). A NaN
+  // coordinate falls in cell 0 (guard_cells): such a triangle could meet a face there only
+  // through an entry of another cell (the volume test refuses a NaN placement first).
   template <class Fn>
-  bool any_live_guard_face(size_t cell, const geo::tc_d3& lo, const geo::tc_d3& hi, Fn&& fn) {
+  bool any_live_guard_face(size_t cell, const geo::tc_d3& lo, const geo::tc_d3& hi, Fn&& fn, bool prune = true) {
     auto apart = [&](const GuardBox& b) {
       return lo.x > b.hi[0] || lo.y > b.hi[1] || lo.z > b.hi[2] || b.lo[0] > hi.x || b.lo[1] > hi.y || b.lo[2] > hi.z;
     };
@@ -205,24 +208,24 @@ class SeqMesh {
       const int32_t e = gbuilt_[r];
       if (e < 0 || apart(gbuilt_box_[r])) continue;
       if (gver_[size_t(e)] != 0 || !talive_[size_t(e >> 2)]) {
-        gbuilt_[r] = -1;
+        if (prune) gbuilt_[r] = -1;
         continue;
       }
       if (fn(e, gbuilt_box_[r])) return true;
     }
     for (int32_t* link = &ghead_[cell]; *link >= 0;) {
-      const size_t node = size_t(*link);
-      const int32_t e = gface_[node];
-      if (e >= 0 && apart(gface_box_[node])) {
-        link = &gnext_[node];
+      GuardNode& node = gnodes_[size_t(*link)];
+      if (node.face >= 0 && apart(node.box)) {
+        link = &node.next;
         continue;
       }
-      if (e < 0 || gver_[size_t(e)] != gface_ver_[node] || !talive_[size_t(e >> 2)]) {
-        *link = gnext_[node];  // unlinked
+      if (node.face < 0 || gver_[size_t(node.face)] != node.ver || !talive_[size_t(node.face >> 2)]) {
+        if (prune) *link = node.next;  // unlinked
+        else link = &node.next;
         continue;
       }
-      if (fn(e, gface_box_[node])) return true;
-      link = &gnext_[node];
+      if (fn(node.face, node.box)) return true;
+      link = &node.next;
     }
     return false;
   }
@@ -265,27 +268,34 @@ class SeqMesh {
   double guard_h_req_ = 0, guard_h_ = 1;
   geo::tc_d3 guard_org_{0, 0, 0};
   int guard_dim_[3] = {1, 1, 1};
-  // A dense grid of at most max(2^16, 8 x the S faces) cells (build_guard makes the cells larger
-  // when the mean extent would need more): the faces build_guard placed, by cell (gbuilt_ from
-  // gcell_off_[c] to gcell_off_[c + 1]), and per cell a list of the faces inserted since
-  // (ghead_, then gface_ / gnext_ per node, -1 ends). No allocation per cell, and a build is
-  // two passes over the faces (a hash map of per-cell vectors took ~20 ms per build on W1's
-  // host tail). A face id is 4 t + f, -1 when dropped by compact().
-  std::vector<uint32_t> gcell_off_;
-  std::vector<int32_t> gbuilt_;
-  std::vector<int32_t> ghead_;
-  std::vector<int32_t> gface_, gnext_;
-  // per face id: how many times guard_insert registered it (build_guard's entries are of
-  // registration 0); per node of gface_: the registration it holds (any_live_guard_face)
-  std::vector<uint32_t> gver_, gface_ver_;
-  // Per entry (of gbuilt_, of gface_) the face's box at its registration, in floats rounded
-  // outward: a live entry's face has not moved since, so an entry whose box is apart from the
-  // new triangle's is passed over by its own data, before its liveness, tet and points are read.
+  // The box of a face at its registration, in floats rounded outward: a live entry's face has not
+  // moved since, so an entry whose box is apart from the new triangle's is passed over by its own
+  // data, before its liveness, tet and points are read.
   struct GuardBox {
     float lo[3], hi[3];
   };
   static GuardBox guard_box(const geo::tc_d3* p);
-  std::vector<GuardBox> gbuilt_box_, gface_box_;
+  // A face registered after the build, in its cell's list.
+  struct GuardNode {
+    int32_t face;  // 4 t + f, -1 when dropped by compact()
+    int32_t next;  // the next node of the cell's list, -1 ends
+    uint32_t ver;  // the face's registration (gver_) this node holds
+    GuardBox box;
+  };
+  // A dense grid of at most max(2^16, 8 x the S faces) cells (build_guard makes the cells larger
+  // when the mean extent would need more): the faces build_guard placed, by cell (gbuilt_ and
+  // gbuilt_box_ from gcell_off_[c] to gcell_off_[c + 1]), and per cell a list of the faces
+  // registered since (ghead_, then gnodes_). No allocation per cell, and a build is two passes
+  // over the faces (a hash map of per-cell vectors took ~20 ms per build on W1's host tail). A
+  // face id is 4 t + f, -1 when dropped by compact().
+  std::vector<uint32_t> gcell_off_;
+  std::vector<int32_t> gbuilt_;
+  std::vector<GuardBox> gbuilt_box_;
+  std::vector<int32_t> ghead_;
+  std::vector<GuardNode> gnodes_;
+  // per face id: how many times guard_insert registered it (build_guard's entries are of
+  // registration 0; any_live_guard_face)
+  std::vector<uint32_t> gver_;
   std::vector<uint32_t> gseen_;
   uint32_t gstamp_ = 0;
   std::vector<NewTri> newtris_;

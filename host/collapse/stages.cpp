@@ -13,6 +13,7 @@
 #include <limits>
 #include <numeric>
 #include <stdexcept>
+#include <system_error>
 #include <thread>
 
 #include "device/primitives.hpp"
@@ -189,15 +190,21 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
   std::vector<uint32_t> ring_off;
   std::vector<int32_t> ring_vt;
   std::exception_ptr ring_error;
-  std::jthread rings;
-  if (dm.has_rings)
-    rings = std::jthread([&] {
-      try {
-        host_rings(tets, dm.nv, ring_off, ring_vt);
-      } catch (...) {
-        ring_error = std::current_exception();
-      }
-    });
+  std::jthread rings;  // after what it reads and writes: joined first when this function throws
+  bool rings_here = false;
+  if (dm.has_rings) {
+    try {
+      rings = std::jthread([&tets, nv = dm.nv, &ring_off, &ring_vt, &ring_error] {
+        try {
+          host_rings(tets, nv, ring_off, ring_vt);
+        } catch (...) {
+          ring_error = std::current_exception();
+        }
+      });
+    } catch (const std::system_error&) {  // no thread to be had: on this one, below
+      rings_here = true;
+    }
+  }
   dm.points = order ? DeviceBuffer<double>(ctx, gather(mesh.points, nv, 3, vold)) : DeviceBuffer<double>(ctx, mesh.points);
   dm.tets = DeviceBuffer<int32_t>(ctx, tets);
   dm.labels.clear();
@@ -233,7 +240,8 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
                                 std::to_string(nv) + " vertices");
   dm.vmask = DeviceBuffer<uint8_t>(ctx, order && dm.has_mask ? gather(o.vertex_mask, nv, 1, vold) : o.vertex_mask);
   if (dm.has_rings) {
-    rings.join();
+    if (rings_here) host_rings(tets, dm.nv, ring_off, ring_vt);
+    else rings.join();
     if (ring_error) std::rethrow_exception(ring_error);
     dm.vt_off = DeviceBuffer<uint32_t>(ctx, ring_off);
     dm.vt = DeviceBuffer<int32_t>(ctx, ring_vt);

@@ -769,6 +769,63 @@ TEST(SequentialGuard, RefusesAfterACompaction) {
   EXPECT_GE(admitted, 1);
 }
 
+// The guard's grid drops stale entries as it meets them and passes over entries by their boxes
+// (SeqMesh::any_live_guard_face): its verdicts must be those of a scan of every face of every
+// live tet, after collapses and after compactions that renumber the grid. Greedy passes over the
+// vertices, each verdict compared (up to a count), the grid checked every 50 collapses and after
+// each pass; the dimple's collapses are refused, so both verdicts are compared.
+TEST(SequentialGuard, GridVerdictsAreThoseOfAScanOfEveryFace) {
+  int32_t first = 0;
+  std::vector<std::tuple<std::string, Mesh, double>> inputs;
+  inputs.emplace_back("dimple and tip beside a cube", cube_then_dimple(4, &first), 10.0);
+  inputs.emplace_back("bracket", read_mesh(test::project_mesh("bracket.msh")), 0.0);
+  const std::string wrench = test::shared_mesh("gen_gmsh_wrenchnut_27k.msh");
+  if (!wrench.empty()) inputs.emplace_back("wrenchnut 27k", read_mesh(wrench), 0.0);
+  else std::printf("wrenchnut 27k absent: the dimple and the bracket alone\n");
+  int64_t refused = 0;
+  for (auto& [name, in, target] : inputs) {
+    SCOPED_TRACE(name);
+    Mesh m = in;
+    CollapseOptions o;
+    o.min_quality = 0;
+    SeqMesh sm(m, seq_params_from(o));
+    const double limit = target > 0 ? target : 3 * median_edge_length(in);
+    sm.build_guard(limit);
+    std::vector<int32_t> nb, vmap, kept;
+    int64_t compared = 0, collapses = 0;
+    const int64_t most = m.num_tets() > 2000 ? 100 : 1500;  // each scan is long
+    for (int pass = 0; pass < 3 && compared < most; ++pass) {
+      for (int32_t a = 0; a < sm.num_vertices() && compared < most; ++a) {
+        if (!sm.alive(a)) continue;
+        sm.neighbours(a, nb, true);
+        for (int32_t b : nb) {
+          if (!sm.alive(a) || !sm.alive(b)) break;
+          if (!(sm.length(a, b) < limit)) continue;
+          const Verdict v = sm.check(a, b);
+          if (v.reason != kOk) continue;
+          const bool ok = sm.guard_ok(a, b, v.dir);
+          ASSERT_EQ(ok, sm.guard_ok_scanning(a, b, v.dir)) << "edge " << a << "-" << b << ", pass " << pass;
+          ++compared;
+          if (!ok) {
+            ++refused;
+            continue;
+          }
+          sm.collapse(a, b, v.dir);
+          if (++collapses % 50 == 0) {
+            ASSERT_EQ(sm.verify_guard(), 0) << "after collapse " << collapses;
+          }
+          break;
+        }
+      }
+      ASSERT_EQ(sm.verify_guard(), 0) << "after pass " << pass;
+      sm.compact(vmap, kept);
+      ASSERT_EQ(sm.verify_guard(), 0) << "after the compaction of pass " << pass;
+    }
+    EXPECT_GE(collapses, 50);
+  }
+  EXPECT_GE(refused, 1) << "no refusal: only passing verdicts were compared";
+}
+
 // Greedy (the host tail's mode): after an iteration in which the surface guard refused edges,
 // the next iteration lists only those. Sound when no other edge is admissible and passes the
 // guard then: checked over every edge of the mesh after each such iteration.
