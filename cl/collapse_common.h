@@ -69,18 +69,6 @@ inline int tcc_local(__global const int* tets, int t, int x) {
   return q[0] == x ? 0 : q[1] == x ? 1 : q[2] == x ? 2 : q[3] == x ? 3 : -1;
 }
 
-/* Edge id of (x, y), x != y, by binary search in N(min); -1 when absent. */
-inline int tcc_edge_id(__global const uint* nb_off, __global const int* nb, __global const int* nb_edge, int x,
-                       int y) {
-  int lo = (int)nb_off[x], hi = (int)nb_off[x + 1];
-  while (lo < hi) {
-    int mid = (lo + hi) >> 1;
-    if (nb[mid] < y) lo = mid + 1;
-    else hi = mid;
-  }
-  return (lo < (int)nb_off[x + 1] && nb[lo] == y) ? nb_edge[lo] : -1;
-}
-
 /* The face of tet t opposite local vertex f is shared with how many other tets? The first one
  * found goes to *other. The face's vertices are all in ring(x) for x = any face vertex. */
 inline int tcc_face_others(__global const int* tets, __global const uint* vt_off, __global const int* vt, int t, int f,
