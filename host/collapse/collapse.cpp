@@ -100,9 +100,9 @@ double volume_threshold(const Mesh& mesh, const CollapseOptions& options) {
 namespace {
 
 // CollapseOptions::host_tail on this device (negative: automatic).
-double host_tail_fraction(const CollapseOptions& o, const DeviceInfo& device) {
+double host_tail_fraction(const CollapseOptions& o, const Context& ctx) {
   if (o.host_tail >= 0) return o.host_tail;
-  if (device.type != "CPU") return 0.0;
+  if (!ctx.cpu_tuning()) return 0.0;
   return o.conflicts == CollapseOptions::Matching ? CollapseOptions::kHostTailCpuMatching : CollapseOptions::kHostTailCpu;
 }
 
@@ -234,7 +234,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   SurfaceGuard guard;
   bool host_tail = false;
   sequential_detail::TailSeed seed;
-  const double tail_fraction = host_tail_fraction(options, ctx.info());
+  const double tail_fraction = host_tail_fraction(options, ctx);
   p.target = options.target_length;
   const double t_loop = now();
   for (int it = 0; it < options.max_iterations && dm.nt > 0; ++it) {

@@ -186,7 +186,7 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
   const std::vector<int32_t>& tets = order ? spatial.tets : mesh.tets;
   // The rings (a CPU device) on a second thread while this one gathers and uploads the rest: the
   // device's threads are idle during the upload (W1: the rings ~0.02 s, the rest ~0.015 s).
-  dm.has_rings = ctx.info().type == "CPU";
+  dm.has_rings = ctx.cpu_tuning();
   std::vector<uint32_t> ring_off;
   std::vector<int32_t> ring_vt;
   std::exception_ptr ring_error;

@@ -179,9 +179,9 @@ void radix_sort_impl(Context& ctx, DeviceBuffer<uint64_t>& keys, DeviceBuffer<ui
 
 }  // namespace
 
-Tuning default_tuning(const DeviceInfo& info) {
+Tuning default_tuning(bool cpu) {
   Tuning t;
-  if (info.type == "CPU") {
+  if (cpu) {
     // Work items are loop iterations on a CPU: long serial chunks, no barriers, and 8-bit
     // digits (half the passes; 256 counters per work item are cheap in CPU memory).
     t.chunked_scan = true;
@@ -201,7 +201,7 @@ void set_tuning_override(const Tuning* tuning) {
   }
 }
 
-Tuning tuning_for(const Context& ctx) { return g_override ? *g_override : default_tuning(ctx.info()); }
+Tuning tuning_for(const Context& ctx) { return g_override ? *g_override : default_tuning(ctx.cpu_tuning()); }
 
 uint32_t exclusive_scan(Context& ctx, const DeviceBuffer<uint32_t>& in, DeviceBuffer<uint32_t>& out, size_t n) {
   check_n(n, "exclusive_scan");

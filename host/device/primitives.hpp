@@ -11,14 +11,14 @@
 
 namespace tc::dev {
 
-// How the primitives map onto a device. The default depends on the device type (see
+// How the primitives map onto a device. The default depends on Context::cpu_tuning (see
 // default_tuning); set_tuning_override lets tests and benches run every variant on any device.
 struct Tuning {
   bool chunked_scan = false;  // true: per-work-item serial chunks (CPU); false: local-memory tiles (GPU)
   int radix_bits = 4;         // digit width of the radix sort: 4 (16 private counters) or 8
   unsigned sort_chunk = 256;  // elements per work item in a radix sort pass
 };
-Tuning default_tuning(const DeviceInfo& info);
+Tuning default_tuning(bool cpu);
 // Process-wide; nullptr restores the per-device default.
 void set_tuning_override(const Tuning* tuning);
 Tuning tuning_for(const Context& ctx);

@@ -318,6 +318,7 @@ Context::Context(const DeviceInfo& info) {
 Context::~Context() = default;
 
 void Context::init(const DeviceInfo&) {
+  cpu_tuning_ = info_.type == "CPU";
   detail::cl_call("clCreateContext", [&] { context_ = cl::Context(device_); });
   detail::cl_call("clCreateCommandQueue", [&] { queue_ = cl::CommandQueue(context_, device_); });
 }
@@ -380,7 +381,7 @@ void Context::launch(cl::Kernel& kernel, size_t n, const char* what, size_t loca
   if (n == 0) return;
   if (local == 0) {
     local = group_size_for(kernel);
-    if (work_group_size_ == 0 && info_.type == "CPU") {
+    if (work_group_size_ == 0 && cpu_tuning_) {
       const size_t min_groups = 4 * size_t(std::max<uint32_t>(info_.compute_units, 1));
       while (local > 1 && (n + local - 1) / local < min_groups) local /= 2;
     }
@@ -414,18 +415,24 @@ std::string Context::cache_dir() {
 }
 
 cl::Program& Context::program(const std::string& file, const std::string& options) {
-  auto key = std::make_pair(file, options);
-  if (auto it = programs_.find(key); it != programs_.end()) {
-    last_build_source_ = BuildSource::Memory;
-    return it->second;
-  }
   const char* text = kernels::find(file.c_str());
   if (!text) throw DeviceError("embedded kernel file '" + file + "' not found (is it in cl/?)");
   return build(file, text, options);
 }
 
 cl::Program& Context::build(const std::string& file, const std::string& text, const std::string& options) {
-  auto key = std::make_pair(file, options);
+  std::string opts = "-cl-std=CL1.2";
+  // CPU devices run a work-group's items one after another, so a kernel may prefetch for its
+  // next items (the selections' decisions and match_apply: tcc_prefetch_test in
+  // cl/collapse_select.h, tcc_prefetch_decide and tcc_prefetch_apply in cl/collapse_matching.cl).
+  // Measured on PoCL; a CPU runtime that runs work items side by side in vector lanes would make
+  // those loads for nothing (no result changes either way).
+  if (cpu_tuning_) opts += " -DTCC_PREFETCH";
+  if (!options.empty()) opts += " " + options;
+  if (const char* extra = std::getenv("TETCOLLAPSE_CL_OPTIONS"); extra && *extra) opts += std::string(" ") + extra;
+  // in memory under the options as built: a change of cpu_tuning or of the environment's
+  // options between two calls builds again
+  auto key = std::make_pair(file, opts);
   if (auto it = programs_.find(key); it != programs_.end()) {
     last_build_source_ = BuildSource::Memory;
     return it->second;
@@ -433,15 +440,6 @@ cl::Program& Context::build(const std::string& file, const std::string& text, co
   std::string source;
   std::set<std::string> seen{file};
   expand_text(text, source, seen, 0);
-  std::string opts = "-cl-std=CL1.2";
-  // CPU devices run a work-group's items one after another, so a kernel may prefetch for its
-  // next items (the selections' decisions and match_apply: tcc_prefetch_test in
-  // cl/collapse_select.h, tcc_prefetch_decide and tcc_prefetch_apply in cl/collapse_matching.cl).
-  // Measured on PoCL; a CPU runtime that runs work items side by side in vector lanes would make
-  // those loads for nothing (no result changes either way).
-  if (info_.type == "CPU") opts += " -DTCC_PREFETCH";
-  if (!options.empty()) opts += " " + options;
-  if (const char* extra = std::getenv("TETCOLLAPSE_CL_OPTIONS"); extra && *extra) opts += std::string(" ") + extra;
 
   std::string cache_key = info_.name + '\n' + info_.vendor + '\n' + info_.driver_version + '\n' + info_.platform_version +
                           '\n' + opts + '\n' + source;

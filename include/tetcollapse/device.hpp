@@ -79,6 +79,13 @@ class Context {
   // device limits. Results never depend on it; tests set it to check exactly that.
   void set_work_group_size(size_t wg) { work_group_size_ = wg; }
   size_t work_group_size() const { return work_group_size_; }
+  // Whether the library tunes itself for a CPU device (default: the device's type is "CPU"):
+  // kernels that prefetch for their next work items, the rings built on the host, the
+  // primitives' CPU variants (tc::dev::Tuning), at least 4 work-groups per compute unit per
+  // launch, and the host tail (CollapseOptions::host_tail). Otherwise the GPU choices. Results
+  // never depend on it: tests set it to false to run the GPU code paths on PoCL.
+  void set_cpu_tuning(bool cpu) { cpu_tuning_ = cpu; }
+  bool cpu_tuning() const { return cpu_tuning_; }
   // The work-group size a launch of `kernel` uses: the set one (clamped to what the kernel
   // and the device allow) or the default, always a power of two >= 1.
   size_t group_size_for(const cl::Kernel& kernel) const;
@@ -89,7 +96,8 @@ class Context {
   // the cache when possible; a build failure throws DeviceError with the build log.
   cl::Program& program(const std::string& file, const std::string& options = "");
   // The same from source text given here (named `name` in messages); #include lines still refer
-  // to embedded files. Cached in memory under (name, options) and on disk like program().
+  // to embedded files. Cached in memory under (name, the options as built: with cpu_tuning's
+  // and the environment's) and on disk like program().
   cl::Program& build(const std::string& name, const std::string& source, const std::string& options = "");
   // A fresh kernel object of that program (kernels hold their arguments, so callers own them).
   cl::Kernel kernel(const std::string& file, const std::string& name, const std::string& options = "");
@@ -120,6 +128,7 @@ class Context {
   cl::Context context_;
   cl::CommandQueue queue_;
   size_t work_group_size_ = 0;
+  bool cpu_tuning_ = false;
   std::map<std::pair<std::string, std::string>, cl::Program> programs_;
   BuildSource last_build_source_ = BuildSource::Memory;
 };

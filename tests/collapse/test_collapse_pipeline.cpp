@@ -324,3 +324,87 @@ TEST(CollapsePipeline, SecondSelectionRoundStaysValid) {
   o.conflicts = CollapseOptions::Greedy;
   EXPECT_THROW(collapse(bad, o, ctx), std::invalid_argument);
 }
+
+// The GPU code paths (Context::cpu_tuning false: kernels without prefetching, the volume test's
+// short chunks, the rings built on the device, the primitives' local-memory scans and 4-bit
+// sorts, launches without the CPU minimum of work-groups) give the CPU paths' result bit for
+// bit, with every conflict detection and boundary mode, with and without a host tail. These are
+// the paths a deployment on a GPU takes; PoCL runs them here.
+TEST(CollapsePipeline, GpuTuningGivesTheCpuTuningsResult) {
+  Context cpu, gpu;
+  cpu.set_cpu_tuning(true);
+  gpu.set_cpu_tuning(false);
+  std::vector<std::pair<std::string, Mesh>> inputs;
+  {
+    Mesh cube = test::cube_tets(5);
+    Labels l{"material", {}};
+    Field tf{"tq", 1, {}}, vf{"vx", 3, {}};
+    for (int64_t t = 0; t < cube.num_tets(); ++t) {
+      l.values.push_back(cube.points[3 * cube.tets[4 * t] + 1] < 0.4 ? 1 : 2);
+      tf.values.push_back(double(t));
+    }
+    for (int64_t v = 0; v < cube.num_vertices(); ++v)
+      for (int c = 0; c < 3; ++c) vf.values.push_back(cube.points[3 * v + c] * 10);
+    cube.tet_labels.push_back(l);
+    cube.tet_fields.push_back(tf);
+    cube.vertex_fields.push_back(vf);
+    inputs.emplace_back("cube", cube);
+  }
+  for (const char* name : {"polyfem_screw.msh", "gen_gmsh_wrenchnut_27k.msh"}) {
+    const std::string path = test::shared_mesh(name);
+    if (path.empty()) {
+      std::printf("[ note ] %s absent: compared on the cube only\n", name);
+      continue;
+    }
+    inputs.emplace_back(name, read_mesh(path));
+  }
+  int compared = 0, tails = 0;
+  for (const auto& [name, in] : inputs)
+    for (auto conflicts :
+         {CollapseOptions::Matching, CollapseOptions::Greedy, CollapseOptions::TwoPass, CollapseOptions::AtomicMin})
+      for (auto mode : {CollapseOptions::Features, CollapseOptions::Strict, CollapseOptions::Free})
+        for (double tail : {-1.0, 0.0, 0.05}) {
+          if (conflicts == CollapseOptions::AtomicMin && !cpu.info().int64_atomics_extended) continue;
+          if (conflicts == CollapseOptions::AtomicMin && tail > 0) continue;  // no host tail with it
+          // keeps it short: the shared meshes with the default selection
+          if (name != "cube" && (mode != CollapseOptions::Features || tail < 0 || conflicts != CollapseOptions::Matching))
+            continue;
+          SCOPED_TRACE(name + " conflicts " + std::to_string(int(conflicts)) + " mode " + std::to_string(int(mode)) +
+                       " host_tail " + std::to_string(tail));
+          CollapseOptions o;
+          o.conflicts = conflicts;
+          o.boundary = mode;
+          o.target_factor = 2;
+          o.host_tail = tail;
+          Mesh a = in, b = in;
+          const CollapseReport ra = collapse(a, o, cpu), rb = collapse(b, o, gpu);
+          auto on_host = [](const CollapseReport& r) {
+            return std::any_of(r.iterations.begin(), r.iterations.end(), [](const IterationStats& s) { return s.on_host; });
+          };
+          if (tail < 0) {
+            // automatic: a host tail on the CPU only (when the run has one), so only validity is compared
+            EXPECT_FALSE(on_host(rb));
+            EXPECT_TRUE(check(b, &in).valid);
+            continue;
+          }
+          EXPECT_EQ(on_host(ra), on_host(rb));
+          tails += on_host(ra) ? 1 : 0;
+          EXPECT_EQ(a.points, b.points);
+          EXPECT_EQ(a.tets, b.tets);
+          ASSERT_EQ(a.tet_labels.size(), b.tet_labels.size());
+          for (size_t l = 0; l < a.tet_labels.size(); ++l) EXPECT_EQ(a.tet_labels[l].values, b.tet_labels[l].values);
+          ASSERT_EQ(a.vertex_fields.size(), b.vertex_fields.size());
+          for (size_t f = 0; f < a.vertex_fields.size(); ++f)
+            EXPECT_EQ(a.vertex_fields[f].values, b.vertex_fields[f].values);
+          for (size_t f = 0; f < a.tet_fields.size(); ++f) EXPECT_EQ(a.tet_fields[f].values, b.tet_fields[f].values);
+          ASSERT_EQ(ra.iterations.size(), rb.iterations.size());
+          for (size_t i = 0; i < ra.iterations.size(); ++i) {
+            EXPECT_EQ(ra.iterations[i].tested, rb.iterations[i].tested) << "iteration " << i;
+            EXPECT_EQ(ra.iterations[i].collapsed, rb.iterations[i].collapsed) << "iteration " << i;
+          }
+          EXPECT_LT(a.num_tets(), in.num_tets());
+          ++compared;
+        }
+  EXPECT_GE(compared, 21);  // the cube: 3 modes x (3 conflict detections x 2 tails + atomic-min's one)
+  EXPECT_GT(tails, 0);      // the host tail ran on both
+}

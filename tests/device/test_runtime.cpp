@@ -226,6 +226,24 @@ __kernel void orient(__global const double* p, __global double* out) {
   EXPECT_DOUBLE_EQ(out.download()[0], ref);
 }
 
+// The in-memory cache is keyed by the options as built: switching cpu_tuning (which adds or drops
+// the prefetching define) builds the program again instead of handing back the other variant.
+TEST_F(RuntimeCtx, CpuTuningSwitchBuildsItsOwnProgram) {
+  const std::string opts = "-DTC_TEST_NONCE=" + std::to_string(std::random_device{}());
+  const bool cpu = ctx_->cpu_tuning();
+  EXPECT_EQ(cpu, ctx_->info().type == "CPU");
+  ctx_->program("scan.cl", opts);
+  EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Source);
+  ctx_->set_cpu_tuning(!cpu);
+  ctx_->program("scan.cl", opts);
+  EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Source);
+  ctx_->program("scan.cl", opts);
+  EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Memory);
+  ctx_->set_cpu_tuning(cpu);
+  ctx_->program("scan.cl", opts);
+  EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Memory);
+}
+
 TEST_F(RuntimeCtx, BinaryCacheIsUsedOnSecondStartAndSurvivesCorruption) {
   // A unique option makes a fresh cache key even if the folder were shared.
   std::string opts = "-DTC_TEST_NONCE=" + std::to_string(std::random_device{}());
