@@ -11,6 +11,7 @@
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include "device/program_cache.hpp"
@@ -319,6 +320,14 @@ Context::~Context() = default;
 
 void Context::init(const DeviceInfo&) {
   cpu_tuning_ = info_.type == "CPU";
+  // TETCOLLAPSE_TUNING=gpu|cpu overrides the device type's choice (e.g. the whole test suite
+  // on PoCL with the GPU choices); anything else is an error, not a silent default
+  if (const char* t = std::getenv("TETCOLLAPSE_TUNING"); t && *t) {
+    const std::string v = t;
+    if (v != "gpu" && v != "cpu")
+      throw DeviceError("TETCOLLAPSE_TUNING must be 'gpu' or 'cpu', not '" + v + "'");
+    cpu_tuning_ = v == "cpu";
+  }
   detail::cl_call("clCreateContext", [&] { context_ = cl::Context(device_); });
   detail::cl_call("clCreateCommandQueue", [&] { queue_ = cl::CommandQueue(context_, device_); });
 }

@@ -83,7 +83,9 @@ class Context {
   // kernels that prefetch for their next work items, the rings built on the host, the
   // primitives' CPU variants (tc::dev::Tuning), at least 4 work-groups per compute unit per
   // launch, and the host tail (CollapseOptions::host_tail). Otherwise the GPU choices. Results
-  // never depend on it: tests set it to false to run the GPU code paths on PoCL.
+  // never depend on it: tests set it to false to run the GPU code paths on PoCL. The environment
+  // variable TETCOLLAPSE_TUNING=gpu|cpu sets it for every new context (DeviceError
+  // for another value).
   void set_cpu_tuning(bool cpu) { cpu_tuning_ = cpu; }
   bool cpu_tuning() const { return cpu_tuning_; }
   // The work-group size a launch of `kernel` uses: the set one (clamped to what the kernel

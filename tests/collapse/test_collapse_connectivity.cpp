@@ -70,7 +70,7 @@ void compare_with_reference(Context& ctx, const Mesh& mesh, bool classes_capped 
   StageParams p = params_from(o);
   DeviceMesh dm;
   upload_mesh(ctx, mesh, o, dm);
-  EXPECT_EQ(dm.has_rings, ctx.info().type == "CPU");
+  EXPECT_EQ(dm.has_rings, ctx.cpu_tuning());
   if (device_rings) dm.has_rings = false;
   Connectivity c;
   build_connectivity(ctx, dm, c, p);

@@ -153,7 +153,7 @@ __kernel void layout(__global uint* out, uint n) {
   const size_t cap = 2 + 2 * 4096;
   tc::DeviceBuffer<uint32_t> out(*ctx_, cap);
   k.setArg(0, out.buffer());
-  const bool cpu = ctx_->info().type == "CPU";
+  const bool cpu = ctx_->cpu_tuning();
   const size_t cu = std::max<uint32_t>(ctx_->info().compute_units, 1), full = ctx_->group_size_for(k);
   for (size_t n : {size_t(1), size_t(7), size_t(126), size_t(1000), size_t(4096)}) {
     k.setArg(1, cl_uint(n));
@@ -226,12 +226,33 @@ __kernel void orient(__global const double* p, __global double* out) {
   EXPECT_DOUBLE_EQ(out.download()[0], ref);
 }
 
+// cpu_tuning: the device's type unless TETCOLLAPSE_TUNING says gpu or cpu; another value is
+// refused by name.
+TEST(Runtime, TuningFollowsTheDeviceTypeOrTheEnvironment) {
+  {
+    EnvVar v("TETCOLLAPSE_TUNING", "");
+    tc::Context c;
+    EXPECT_EQ(c.cpu_tuning(), c.info().type == "CPU");
+  }
+  {
+    EnvVar v("TETCOLLAPSE_TUNING", "gpu");
+    EXPECT_FALSE(tc::Context().cpu_tuning());
+  }
+  {
+    EnvVar v("TETCOLLAPSE_TUNING", "cpu");
+    EXPECT_TRUE(tc::Context().cpu_tuning());
+  }
+  EnvVar v("TETCOLLAPSE_TUNING", "fast");
+  const std::string m = message_of([] { tc::Context c; });
+  EXPECT_NE(m.find("TETCOLLAPSE_TUNING"), std::string::npos) << m;
+  EXPECT_NE(m.find("'fast'"), std::string::npos) << m;
+}
+
 // The in-memory cache is keyed by the options as built: switching cpu_tuning (which adds or drops
 // the prefetching define) builds the program again instead of handing back the other variant.
 TEST_F(RuntimeCtx, CpuTuningSwitchBuildsItsOwnProgram) {
   const std::string opts = "-DTC_TEST_NONCE=" + std::to_string(std::random_device{}());
   const bool cpu = ctx_->cpu_tuning();
-  EXPECT_EQ(cpu, ctx_->info().type == "CPU");
   ctx_->program("scan.cl", opts);
   EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Source);
   ctx_->set_cpu_tuning(!cpu);
