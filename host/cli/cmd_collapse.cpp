@@ -254,7 +254,8 @@ void register_collapse(CLI::App& app, int& exit_code) {
                  "sequential method's checks, greedily (the last iterations collapse a few edges each\n"
                  "at the price of passes over the whole mesh).\n"
                  "Default: 0.005 with the matching conflict detection and 0.002 with the others on CPU\n"
-                 "devices, 0 (all on the device) on GPUs")
+                 "devices, 0 (all on the device) on GPUs and others ($TETCOLLAPSE_TUNING=cpu|gpu\n"
+                 "overrides the device type)")
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--device", c->device, "OpenCL device: index or name substring (see 'tetcollapse devices');\n"
                                         "default: $TETCOLLAPSE_DEVICE, else the first GPU, else the first CPU");

@@ -147,7 +147,7 @@ void check_collapse_input(const Mesh& mesh) {
 namespace {
 
 // ring(v) for every vertex: counted, then filled in tet order, so each ring is ascending. Why
-// on the host for a CPU device: one sequential pass over the tets (W1: a few ms on one core)
+// on the host for a CPU device (Context::cpu_tuning): one sequential pass over the tets (W1: a few ms on one core)
 // against the device's atomic count and scatter and a sort of every ring (conn_count,
 // conn_scatter, conn_ring_sort_and_gather's sort), ~0.025 s on both cores; the tets are in
 // spatial order, so the writes are near each other. A GPU does its own.
@@ -184,7 +184,7 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
   dm.nv = uint32_t(nv);
   dm.nt = uint32_t(nt);
   const std::vector<int32_t>& tets = order ? spatial.tets : mesh.tets;
-  // The rings (a CPU device) on a second thread while this one gathers and uploads the rest: the
+  // The rings (Context::cpu_tuning: a CPU device) on a second thread while this one gathers and uploads the rest: the
   // device's threads are idle during the upload (W1: the rings ~0.02 s, the rest ~0.015 s).
   dm.has_rings = ctx.cpu_tuning();
   std::vector<uint32_t> ring_off;
@@ -335,7 +335,7 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   ensure(c.cursor, ctx, nv);
   // rings and tet_nbr carried through the compaction (collapse_update.cl)
   const bool updated = carry && carry->has_prev && carry->has_update;
-  // the rings are sorted: carried (updated) or the host's (the first build on a CPU device)
+  // the rings are sorted: carried (updated) or the host's (the first build with cpu_tuning)
   const bool sorted = updated || dm.has_rings;
   if (updated) {
     std::swap(c.vt_off, carry->upd_vt_off);

@@ -25,7 +25,8 @@ struct DeviceMesh {
   DeviceBuffer<double> vfields, tfields;
   bool has_mask = false;
   DeviceBuffer<uint8_t> vmask;
-  // ring(v) of every vertex (ascending), filled on the host by upload_mesh for a CPU device;
+  // ring(v) of every vertex (ascending), filled on the host by upload_mesh with
+  // Context::cpu_tuning (a CPU device);
   // the first build_connectivity takes them (has_rings then false)
   bool has_rings = false;
   DeviceBuffer<uint32_t> vt_off;  // nv + 1

@@ -183,9 +183,10 @@ struct CollapseOptions {
   // method collapse a few edges each (a cascade: a collapse makes a neighbour admissible) at
   // the price of passes over the whole mesh, which on a CPU device cost more than collapsing
   // them one by one: W1 (bench/README.md) saves ~0.2 s of ~3 s. On a
-  // GPU those passes are cheap. Negative (default): on CPU devices kHostTailCpu
-  // (kHostTailCpuMatching with the matching selection, whose tail iterations are each a pass
-  // over the mesh for fewer collapses: W1 5% faster, 1% fewer tets), 0 on others; 0: every
+  // GPU those passes are cheap. Negative (default): with Context::cpu_tuning (default: a CPU
+  // device) kHostTailCpu (kHostTailCpuMatching with the matching selection, whose tail
+  // iterations are each a pass over the mesh for fewer collapses: W1 5% faster, 1% fewer
+  // tets), else 0; 0: every
   // iteration on the device. Decided by counts only: the output stays deterministic.
   static constexpr double kHostTailCpu = 0.002, kHostTailCpuMatching = 0.005;
   double host_tail = -1;

@@ -81,11 +81,13 @@ class Context {
   size_t work_group_size() const { return work_group_size_; }
   // Whether the library tunes itself for a CPU device (default: the device's type is "CPU"):
   // kernels that prefetch for their next work items, the rings built on the host, the
-  // primitives' CPU variants (tc::dev::Tuning), at least 4 work-groups per compute unit per
-  // launch, and the host tail (CollapseOptions::host_tail). Otherwise the GPU choices. Results
+  // primitives' CPU variants (tc::dev::Tuning; a process-wide dev::set_tuning_override comes
+  // first), at least 4 work-groups per compute unit per launch (with work_group_size() 0), and
+  // the automatic host tail (CollapseOptions::host_tail). Otherwise the GPU choices. Results
   // never depend on it: tests set it to false to run the GPU code paths on PoCL. The environment
-  // variable TETCOLLAPSE_TUNING=gpu|cpu sets it for every new context (DeviceError
-  // for another value).
+  // variable TETCOLLAPSE_TUNING=gpu|cpu sets it for every new context (DeviceError for another
+  // value). It may change at any time; the next program of a variant not built yet in this
+  // context is compiled (or read from the disk cache) then.
   void set_cpu_tuning(bool cpu) { cpu_tuning_ = cpu; }
   bool cpu_tuning() const { return cpu_tuning_; }
   // The work-group size a launch of `kernel` uses: the set one (clamped to what the kernel

@@ -176,8 +176,8 @@ TEST(CollapseHostTail, OnlyWhenRunningUntilNothingCollapses) {
     Mesh m = in;
     EXPECT_EQ(count_on_host(collapse(m, slow, ctx)), 0);
   }
-  // the default: on CPU devices (Context::cpu_tuning) from 0.2% on, elsewhere never (the device
-  // decides, not the run)
+  // the default: with Context::cpu_tuning (a CPU device unless TETCOLLAPSE_TUNING says
+  // otherwise) from 0.2% on, else never (the context decides, not the run)
   CollapseOptions d;
   d.target_factor = 2;
   EXPECT_LT(d.host_tail, 0);

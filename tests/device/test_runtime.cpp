@@ -252,16 +252,23 @@ TEST(Runtime, TuningFollowsTheDeviceTypeOrTheEnvironment) {
 // the prefetching define) builds the program again instead of handing back the other variant.
 TEST_F(RuntimeCtx, CpuTuningSwitchBuildsItsOwnProgram) {
   const std::string opts = "-DTC_TEST_NONCE=" + std::to_string(std::random_device{}());
+  // the prefetching define is in the options a program was built with exactly when cpu_tuning
+  auto prefetching = [&](cl::Program& p) {
+    return p.getBuildInfo<CL_PROGRAM_BUILD_OPTIONS>(ctx_->device()).find("-DTCC_PREFETCH") != std::string::npos;
+  };
   const bool cpu = ctx_->cpu_tuning();
-  ctx_->program("scan.cl", opts);
+  cl::Program& first = ctx_->program("scan.cl", opts);
   EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Source);
+  EXPECT_EQ(prefetching(first), cpu);
   ctx_->set_cpu_tuning(!cpu);
-  ctx_->program("scan.cl", opts);
+  cl::Program& other = ctx_->program("scan.cl", opts);
   EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Source);
-  ctx_->program("scan.cl", opts);
+  EXPECT_NE(&other, &first);
+  EXPECT_EQ(prefetching(other), !cpu);
+  EXPECT_EQ(&ctx_->program("scan.cl", opts), &other);
   EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Memory);
   ctx_->set_cpu_tuning(cpu);
-  ctx_->program("scan.cl", opts);
+  EXPECT_EQ(&ctx_->program("scan.cl", opts), &first);
   EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Memory);
 }
 
