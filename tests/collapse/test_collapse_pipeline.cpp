@@ -411,4 +411,21 @@ TEST(CollapsePipeline, GpuTuningGivesTheCpuTuningsResult) {
   const int atomic = cpu.info().int64_atomics_extended ? 1 : 0;
   EXPECT_EQ(compared, 3 * (3 * 2 + atomic) + 2 * int(inputs.size() - 1));
   EXPECT_GT(tails, 0);      // the host tail ran on both
+  // and at the work-group sizes of GPUs (a warp, a wavefront, a large group): the same again
+  for (size_t wg : {32, 64, 256})
+    for (auto conflicts : {CollapseOptions::Matching, CollapseOptions::TwoPass}) {
+      SCOPED_TRACE("work-group size " + std::to_string(wg) + " conflicts " + std::to_string(int(conflicts)));
+      CollapseOptions o;
+      o.conflicts = conflicts;
+      o.target_factor = 2;
+      o.host_tail = 0;
+      Mesh a = inputs[0].second, b = inputs[0].second;
+      collapse(a, o, cpu);
+      gpu.set_work_group_size(wg);
+      collapse(b, o, gpu);
+      gpu.set_work_group_size(0);
+      EXPECT_EQ(a.points, b.points);
+      EXPECT_EQ(a.tets, b.tets);
+      EXPECT_EQ(a.tet_labels[0].values, b.tet_labels[0].values);
+    }
 }
