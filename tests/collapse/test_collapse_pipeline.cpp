@@ -23,6 +23,24 @@ CheckReport check(const Mesh& m, const Mesh* ref = nullptr) {
   return check_mesh(m, o, ref);
 }
 
+// cube_tets(n) with a label array (1 where a tet's first vertex has x < 0.5, else 2: a material
+// interface at x = 0.5), a tet field (the tet's index) and a vertex field (10 x the position)
+Mesh cube_with_labels_and_fields(int n) {
+  Mesh in = test::cube_tets(n);
+  Labels l{"material", {}};
+  Field tf{"tq", 1, {}}, vf{"vx", 3, {}};
+  for (int64_t t = 0; t < in.num_tets(); ++t) {
+    l.values.push_back(in.points[3 * in.tets[4 * t]] < 0.5 ? 1 : 2);
+    tf.values.push_back(double(t));
+  }
+  for (int64_t v = 0; v < in.num_vertices(); ++v)
+    for (int c = 0; c < 3; ++c) vf.values.push_back(in.points[3 * v + c] * 10);
+  in.tet_labels.push_back(l);
+  in.tet_fields.push_back(tf);
+  in.vertex_fields.push_back(vf);
+  return in;
+}
+
 std::set<std::tuple<double, double, double>> boundary_points(const Mesh& m) {
   Topology t = build_topology(m);
   std::set<std::tuple<double, double, double>> s;
@@ -106,19 +124,7 @@ TEST(CollapsePipeline, PaperBoundaryRuleAdmitsFewerEdges) {
 
 TEST(CollapsePipeline, DeterministicAcrossWorkGroupSizes) {
   Context ctx;
-  Mesh in = test::cube_tets(5);
-  // a label array and fields travel along
-  Labels l{"material", {}};
-  Field tf{"tq", 1, {}}, vf{"vx", 3, {}};
-  for (int64_t t = 0; t < in.num_tets(); ++t) {
-    l.values.push_back(in.points[3 * in.tets[4 * t]] < 0.5 ? 1 : 2);
-    tf.values.push_back(double(t));
-  }
-  for (int64_t v = 0; v < in.num_vertices(); ++v)
-    for (int c = 0; c < 3; ++c) vf.values.push_back(in.points[3 * v + c] * 10);
-  in.tet_labels.push_back(l);
-  in.tet_fields.push_back(tf);
-  in.vertex_fields.push_back(vf);
+  const Mesh in = cube_with_labels_and_fields(5);  // a label array and fields travel along
   CollapseOptions o;
   o.target_factor = 2.5;
   Mesh first;
@@ -335,21 +341,7 @@ TEST(CollapsePipeline, GpuTuningGivesTheCpuTuningsResult) {
   cpu.set_cpu_tuning(true);
   gpu.set_cpu_tuning(false);
   std::vector<std::pair<std::string, Mesh>> inputs;
-  {
-    Mesh cube = test::cube_tets(5);
-    Labels l{"material", {}};
-    Field tf{"tq", 1, {}}, vf{"vx", 3, {}};
-    for (int64_t t = 0; t < cube.num_tets(); ++t) {
-      l.values.push_back(cube.points[3 * cube.tets[4 * t] + 1] < 0.4 ? 1 : 2);
-      tf.values.push_back(double(t));
-    }
-    for (int64_t v = 0; v < cube.num_vertices(); ++v)
-      for (int c = 0; c < 3; ++c) vf.values.push_back(cube.points[3 * v + c] * 10);
-    cube.tet_labels.push_back(l);
-    cube.tet_fields.push_back(tf);
-    cube.vertex_fields.push_back(vf);
-    inputs.emplace_back("cube", cube);
-  }
+  inputs.emplace_back("cube", cube_with_labels_and_fields(5));
   for (const char* name : {"polyfem_screw.msh", "gen_gmsh_wrenchnut_27k.msh"}) {
     const std::string path = test::shared_mesh(name);
     if (path.empty()) {
