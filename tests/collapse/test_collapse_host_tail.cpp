@@ -15,9 +15,11 @@
 #include "tetcollapse/check.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/io.hpp"
+#include "collapse_test_util.hpp"
 #include "test_support.hpp"
 
 using namespace tc;
+using tc::test::count_on_host;
 
 namespace {
 
@@ -58,10 +60,6 @@ CollapseOptions tail_early() {
   o.host_tail = 0.05;  // from the first iteration collapsing fewer than 5% of its tets
   o.host_tail_min_iterations = 0;  // however fast the counts shrink
   return o;
-}
-
-int count_on_host(const CollapseReport& r) {
-  return int(std::count_if(r.iterations.begin(), r.iterations.end(), [](const IterationStats& s) { return s.on_host; }));
 }
 
 }  // namespace

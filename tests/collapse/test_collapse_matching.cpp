@@ -25,6 +25,7 @@
 
 using namespace tc;
 using namespace tc::collapse_detail;
+using tc::test::expect_same_mesh;
 
 namespace {
 
@@ -157,13 +158,6 @@ std::vector<int> host_matching(const MatchStage& st, Mesh& work, const CollapseO
   std::vector<int32_t> vmap, kept;
   sm.compact(vmap, kept);
   return taken;
-}
-
-void expect_same_mesh(const Mesh& a, const Mesh& b, const std::string& what) {
-  EXPECT_EQ(a.points, b.points) << what;
-  EXPECT_EQ(a.tets, b.tets) << what;
-  ASSERT_EQ(a.tet_labels.size(), b.tet_labels.size()) << what;
-  for (size_t l = 0; l < a.tet_labels.size(); ++l) EXPECT_EQ(a.tet_labels[l].values, b.tet_labels[l].values) << what;
 }
 
 // Without the early tests the device takes exactly the host's edges in the same directions, and

@@ -10,6 +10,7 @@
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/io.hpp"
 #include "tetcollapse/topology.hpp"
+#include "collapse_test_util.hpp"
 #include "test_support.hpp"
 
 using namespace tc;
@@ -150,11 +151,7 @@ TEST(CollapsePipeline, DeterministicAcrossWorkGroupSizes) {
       }
       continue;
     }
-    EXPECT_EQ(m.points, first.points) << "work-group size " << wg;
-    EXPECT_EQ(m.tets, first.tets) << "work-group size " << wg;
-    EXPECT_EQ(m.tet_labels[0].values, first.tet_labels[0].values);
-    EXPECT_EQ(m.tet_fields[0].values, first.tet_fields[0].values);
-    EXPECT_EQ(m.vertex_fields[0].values, first.vertex_fields[0].values);
+    test::expect_same_mesh(m, first, "work-group size " + std::to_string(wg));
   }
 }
 
@@ -370,26 +367,15 @@ TEST(CollapsePipeline, GpuTuningGivesTheCpuTuningsResult) {
           o.host_tail = tail;
           Mesh a = in, b = in;
           const CollapseReport ra = collapse(a, o, cpu), rb = collapse(b, o, gpu);
-          auto on_host = [](const CollapseReport& r) {
-            return std::any_of(r.iterations.begin(), r.iterations.end(), [](const IterationStats& s) { return s.on_host; });
-          };
           if (tail < 0) {
             // automatic: a host tail on the CPU only (when the run has one), so only validity is compared
-            EXPECT_FALSE(on_host(rb));
+            EXPECT_EQ(test::count_on_host(rb), 0);
             EXPECT_TRUE(check(b, &in).valid);
             continue;
           }
-          EXPECT_EQ(on_host(ra), on_host(rb));
-          tails += on_host(ra) ? 1 : 0;
-          EXPECT_EQ(a.points, b.points);
-          EXPECT_EQ(a.tets, b.tets);
-          ASSERT_EQ(a.tet_labels.size(), b.tet_labels.size());
-          for (size_t l = 0; l < a.tet_labels.size(); ++l) EXPECT_EQ(a.tet_labels[l].values, b.tet_labels[l].values);
-          ASSERT_EQ(a.vertex_fields.size(), b.vertex_fields.size());
-          for (size_t f = 0; f < a.vertex_fields.size(); ++f)
-            EXPECT_EQ(a.vertex_fields[f].values, b.vertex_fields[f].values);
-          ASSERT_EQ(a.tet_fields.size(), b.tet_fields.size());
-          for (size_t f = 0; f < a.tet_fields.size(); ++f) EXPECT_EQ(a.tet_fields[f].values, b.tet_fields[f].values);
+          EXPECT_EQ(test::count_on_host(ra), test::count_on_host(rb));
+          tails += test::count_on_host(ra) > 0 ? 1 : 0;
+          test::expect_same_mesh(a, b);
           ASSERT_EQ(ra.iterations.size(), rb.iterations.size());
           for (size_t i = 0; i < ra.iterations.size(); ++i) {
             EXPECT_EQ(ra.iterations[i].tested, rb.iterations[i].tested) << "iteration " << i;
@@ -416,8 +402,6 @@ TEST(CollapsePipeline, GpuTuningGivesTheCpuTuningsResult) {
       gpu.set_work_group_size(wg);
       collapse(b, o, gpu);
       gpu.set_work_group_size(0);
-      EXPECT_EQ(a.points, b.points);
-      EXPECT_EQ(a.tets, b.tets);
-      EXPECT_EQ(a.tet_labels[0].values, b.tet_labels[0].values);
+      test::expect_same_mesh(a, b);
     }
 }

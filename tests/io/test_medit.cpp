@@ -13,6 +13,7 @@
 #include "test_support.hpp"
 
 using namespace tc;
+using tc::test::same_bits;
 using tc::test::TempDir;
 using tc::test::write_text;
 
@@ -33,10 +34,6 @@ std::string read_error(const std::string& path) {
     return e.what();
   }
   return "";
-}
-
-bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
 }
 
 // A mesh with every attribute the writers carry: awkward coordinates (full precision,

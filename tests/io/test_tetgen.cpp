@@ -2,7 +2,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <filesystem>
 #include <random>
 
@@ -11,6 +10,7 @@
 #include "test_support.hpp"
 
 using namespace tc;
+using tc::test::same_bits;
 using tc::test::TempDir;
 using tc::test::write_text;
 
@@ -30,10 +30,6 @@ std::string read_error(const std::string& path) {
     return e.what();
   }
   return "";
-}
-
-bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
 }
 
 double orient(const Mesh& m, int64_t t) {

@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <map>
 #include <string>
@@ -42,30 +41,6 @@ inline Mesh attribute_mesh() {
   }
   m.tet_fields = {quality, grad, stress};
   return m;
-}
-
-inline bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
-  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
-}
-
-inline void expect_same_mesh(const Mesh& a, const Mesh& b) {
-  EXPECT_TRUE(same_bits(a.points, b.points)) << "points differ";
-  EXPECT_EQ(a.tets, b.tets);
-  ASSERT_EQ(a.tet_labels.size(), b.tet_labels.size());
-  for (size_t i = 0; i < a.tet_labels.size(); ++i) {
-    EXPECT_EQ(a.tet_labels[i].name, b.tet_labels[i].name);
-    EXPECT_EQ(a.tet_labels[i].values, b.tet_labels[i].values) << a.tet_labels[i].name;
-  }
-  auto same_fields = [](const std::vector<Field>& x, const std::vector<Field>& y) {
-    ASSERT_EQ(x.size(), y.size());
-    for (size_t i = 0; i < x.size(); ++i) {
-      EXPECT_EQ(x[i].name, y[i].name);
-      EXPECT_EQ(x[i].components, y[i].components) << x[i].name;
-      EXPECT_TRUE(same_bits(x[i].values, y[i].values)) << "field " << x[i].name << " differs";
-    }
-  };
-  same_fields(a.vertex_fields, b.vertex_fields);
-  same_fields(a.tet_fields, b.tet_fields);
 }
 
 inline std::map<int32_t, int64_t> histogram(const std::vector<int32_t>& v) {

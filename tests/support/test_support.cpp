@@ -1,9 +1,12 @@
 #include "test_support.hpp"
 
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <random>
 #include <sstream>
@@ -13,6 +16,30 @@
 #include "tetcollapse/topology.hpp"
 
 namespace tc::test {
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
+}
+
+void expect_same_mesh(const Mesh& a, const Mesh& b, const std::string& what) {
+  EXPECT_TRUE(same_bits(a.points, b.points)) << "points differ " << what;
+  EXPECT_EQ(a.tets, b.tets) << what;
+  ASSERT_EQ(a.tet_labels.size(), b.tet_labels.size()) << what;
+  for (size_t i = 0; i < a.tet_labels.size(); ++i) {
+    EXPECT_EQ(a.tet_labels[i].name, b.tet_labels[i].name) << what;
+    EXPECT_EQ(a.tet_labels[i].values, b.tet_labels[i].values) << a.tet_labels[i].name << " " << what;
+  }
+  auto same_fields = [&](const std::vector<Field>& x, const std::vector<Field>& y) {
+    ASSERT_EQ(x.size(), y.size()) << what;
+    for (size_t i = 0; i < x.size(); ++i) {
+      EXPECT_EQ(x[i].name, y[i].name) << what;
+      EXPECT_EQ(x[i].components, y[i].components) << x[i].name << " " << what;
+      EXPECT_TRUE(same_bits(x[i].values, y[i].values)) << "field " << x[i].name << " differs " << what;
+    }
+  };
+  same_fields(a.vertex_fields, b.vertex_fields);
+  same_fields(a.tet_fields, b.tet_fields);
+}
 
 std::string shared_meshes_dir() {
   std::filesystem::path p(TC_SHARED_MESHES);

@@ -50,6 +50,13 @@ class EnvVar {
 void write_text(const std::string& path, const std::string& text);
 std::string read_text(const std::string& path);
 
+// The same doubles bit for bit (NaN and -0 included), and as many.
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b);
+// Two meshes are the same bit for bit: points, tets (their vertex order too), every label array
+// and every tet and vertex field with their names (gtest expectations; `what` goes into their
+// messages).
+void expect_same_mesh(const Mesh& a, const Mesh& b, const std::string& what = "");
+
 // Small meshes built in code.
 Mesh single_tet();             // the unit right-corner tet, positively oriented
 Mesh cube_tets(int n);         // [0,1]^3 split into n^3 cubes of 6 tets each (Kuhn), labels none
