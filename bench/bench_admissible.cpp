@@ -1,7 +1,7 @@
 // The link and volume test of the admissible filter alone (cl/collapse_admissible.cl,
 // tcc_link_and_volume), on every marked edge of a mesh's first iteration: the stage
 // `admissible()`, which tests each candidate once, in edge order. The lazy filter of the
-// pipeline runs the same test on fewer edges (W1: ~57,000 of 483,000 in iteration 0); this
+// pipeline runs the same test on far fewer edges (counts in bench/README.md); this
 // program measures the test's cost per edge without the rounds around it, so that a change to
 // the test can be timed on its own. Prints the median of N launches and the verdict counts
 // (which a change that keeps the decisions must keep).

@@ -1,4 +1,4 @@
-// Times the checker on a ~1M-tet mesh (issue 4 target: under 5 s without Hausdorff).
+// Times the checker on a ~1M-tet mesh (the target: under 5 s without Hausdorff).
 //
 //   bench_check [MESH] [RUNS]
 // MESH defaults to the shared gen_tetgen_rocker-arm_964k.msh; when it cannot be read, a

@@ -1,4 +1,4 @@
-// Workload W1 of issue 5: the robot mesh (514k tets) coarsened to 2 x its median edge length,
+// Workload W1: the robot mesh (514k tets) coarsened to 2 x its median edge length,
 // eps_c = 0 and eps_c = 700 (paper Sec. 4.4, Fig. 9, Table 2). File I/O is excluded.
 //
 //   bench_collapse [MESH] [--runs N] [--json FILE] [--wg N] [--max-iterations N]

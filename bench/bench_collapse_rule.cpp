@@ -1,4 +1,4 @@
-// What the default boundary rule gains over the paper's (issue 5): the default lets an interior
+// What the default boundary rule gains over the paper's: the default lets an interior
 // vertex collapse onto a boundary vertex (which stays put); paper_boundary_rule refuses every
 // non-boundary edge touching the boundary. Both with --boundary features, target = F x median.
 //

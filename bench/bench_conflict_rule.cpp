@@ -1,4 +1,4 @@
-// What a looser conflict rule would give per iteration (a what-if for issue 5's speed goal; nothing
+// What a looser conflict rule would give per iteration (a what-if for the speed goal; nothing
 // in the pipeline uses the other rules). On a mesh's first iteration, in the greedy selection's
 // priority order (cl/collapse_admissible.cl, greedy_*: 64 steps per target length, then the
 // index hash), it counts the collapses each rule takes:

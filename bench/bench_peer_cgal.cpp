@@ -1,4 +1,4 @@
-// Peer of issue 6: CGAL's tetrahedral isotropic remeshing on the same input and target as
+// A peer: CGAL's tetrahedral isotropic remeshing on the same input and target as
 // tetcollapse, with the boundary (and the interfaces between labels) protected.
 //
 //   bench_peer_cgal IN OUT TARGET_LENGTH [--iterations N]

@@ -1,4 +1,4 @@
-// The selection stage alone (issue 5): the greedy selection (greedy_selection) and the matching
+// The selection stage alone: the greedy selection (greedy_selection) and the matching
 // selection (matching_selection) of one iteration, repeated on the same connectivity, so that a
 // change to either can be timed without the rest of the pipeline and the machine's noise over a
 // whole run. Iteration K's input is made by running K whole iterations of the pipeline's

@@ -5,8 +5,8 @@
  *           survivor and the placement (edge_dir, see collapse_common.h);
  *   volume  every tet of ring(a) U ring(b) that survives, with the moved vertex at the placement,
  *           has a volume of at least eps_v (and, with the quality guard, the quality rule);
- *           before the link condition: about a third of its cost, and it refuses most of the
- *           edges that are refused (W1 iteration 0: 12,140 by volume, 3,541 by the link);
+ *           before the link condition: it costs less, and it refuses most of the edges that
+ *           are refused;
  *   link    the link condition of Dey et al. for 3-manifolds with boundary, the boundary closed
  *           by a virtual vertex w joined to every S-face (boundary and material interfaces):
  *           (i)   every common neighbour of a and b is a vertex of lk(ab), and if a and b are
@@ -183,8 +183,8 @@ inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* sta
  *              (tcc_wake, collapse_select.h).
  * Only the vertices where something was decided are looked at, so a pass costs about the
  * number of candidates times the vertex degree, where rescanning every undecided candidate in
- * every round (pass1_claim + conflict_pass1_decide) costs that times the number of rounds (about
- * 100 on W1). Same decisions as those rounds: a decision depends only on final decisions of
+ * every round (pass1_claim + conflict_pass1_decide) costs that times the number of rounds (many on
+ * large meshes). Same decisions as those rounds: a decision depends only on final decisions of
  * edges before it (see collapse_conflict.cl). Turn-list edges share no vertex, so their
  * decisions do not race. The first turn list: the claims of lazy_init, then lazy_p1_first_turns.
  *
@@ -243,8 +243,7 @@ __kernel void lazy_p1_recompute(uint n, __global const uint* dlist, __global con
                                 __global int* slot, __global double* slotp, int with_slotp) {
   /* spread (tcc_spread_index): the list is the vertices listed by the decisions, then by
    * match_apply or greedy_block, in the order their atomics gave; spread over the work-groups
-   * the two cores share it better (bench_selection, W1 iteration 0, 12 alternations: the
-   * selection's median 0.536 s against 0.568 s indexed by the global id, 9 of 12 faster) */
+   * the cores share it better than indexed by the global id (measured in bench/README.md) */
   const uint i = tcc_spread_index(), st = (uint)get_num_groups(0);
   if (i >= n) return;
 #ifdef TCC_PREFETCH_OK
@@ -269,7 +268,7 @@ __kernel void lazy_p1_turns(uint n, __global const uint* dlist, __global const i
 }
 
 /* The remaining rounds in one work-group, once the turn list is short: a round then costs
- * barriers instead of launches and read-backs (about 90 us each on PoCL). Entry: the n edges
+ * barriers instead of launches and read-backs, which cost far more. Entry: the n edges
  * of turn list `cur` (t0 or t1) are round `round`'s; cnt[0..3] (turn-list lengths,
  * vertex-list length, untested turns) are 0. Once a new turn list has more than max_tests
  * edges to test (a single work-group would test them one after another), the loop stops and
@@ -326,9 +325,8 @@ __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __glo
  *
  * The two-pass detection keeps a set of the same kind, but chooses it among pass 1's winners
  * only (an edge that lost pass 1 to an edge that then lost pass 2 is not taken), and tests every
- * pass-1 winner although most of them lose pass 2. W1's first iteration: two-pass 57,736 tests,
- * 42,055 pass-1 winners, 8,843 collapses; greedy 30,915 tests (the volume part only for most),
- * 10,095 collapses.
+ * pass-1 winner although most of them lose pass 2. So the greedy selection runs fewer tests (the
+ * volume part only for most) and takes more collapses (measured in bench/README.md).
  *
  * Driven, as lazy pass 1, by the vertices where something was decided: slot[x] is the first
  * undecided candidate at x (lazy_init's claims, then tcc_p1_recompute), and an edge first at
@@ -362,9 +360,9 @@ __kernel void lazy_p1_loop(uint n, int cur, uint round, __global uint* t0, __glo
 
 /* The priority with levels > 0: the cost in `levels` steps per target length and, within a
  * step, an order that is a bijective hash of the index. In the exact (cost, index) order the
- * turns follow chains of slowly growing cost and W1's first iteration takes ~200 rounds; in 64
- * steps ~25, and it takes as many edges within 2% (a simulation of the greedy without the tests:
- * 10,843 exact, 10,626 in 64 steps, 10,292 in 16). Unmarked edges keep their cost. */
+ * turns follow chains of slowly growing cost and an iteration takes many rounds; in steps far
+ * fewer, for nearly as many edges (a simulation of the greedy without the tests, measured in
+ * bench/README.md). Unmarked edges keep their cost. */
 __kernel void greedy_priority(uint ne, __global const double* cost, __global const uint* marked, double target,
                               double levels, __global double* prio) {
   uint e = get_global_id(0);

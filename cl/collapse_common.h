@@ -30,7 +30,7 @@
 
 /* Adds flag (0 or 1) of every work item of the group to *counter, with one global atomic per
  * work-group instead of one per item: on a CPU device a global counter incremented by every
- * item bounces its cache line between the cores (W1: ~5 million marked edges over a run).
+ * item bounces its cache line between the cores.
  * Every work item of the group must call it (barriers); lc is a __local uint of the kernel. */
 inline void tcc_group_count(uint flag, volatile __local uint* lc, __global uint* counter) {
   if (get_local_id(0) == 0) *lc = 0u;
@@ -318,8 +318,8 @@ inline int tcc_pass1_turn(uint i, int first, __global const uint* list, __global
 
 /* Pass-2 rivals of e = (a, b): the pass-1 edges recorded (vaff) at a vertex of a tet of
  * ring(a) or ring(b), before e. The vertices of the tets of ring(x) are x and N(x) (every edge
- * lies in a tet), so N(a) and N(b) are scanned: about 30 vertices instead of the 4 corners of
- * some 45 tets. Returns as tcc_stored_rivals. */
+ * lies in a tet), so N(a) and N(b) are scanned: each vertex once instead of the 4 corners of
+ * every tet of the rings, which repeat them. Returns as tcc_stored_rivals. */
 inline int tcc_pass2_wait(int e, int a, int b, __global const uint* nb_off, __global const int* nb,
                           __global const int* vaff, __global const double* cost, __global const uchar* state,
                           __global uint* rv, __global uint* rcount) {

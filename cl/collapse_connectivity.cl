@@ -179,9 +179,8 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
   }
   /* When the other corners of ring(v) span fewer than TCC_GATHER_BITS ids (the usual case: the
    * vertices are in spatial order), N(v) is a bitmap over that span, read out in order: sorted
-   * and unique by construction: one bit per corner instead of an insertion into a sorted list.
-   * W1's first build: 76% of the vertices (Morton order), the kernel 0.05-0.07 s instead of
-   * 0.08-0.11 s (bench/README.md, session 14). */
+   * and unique by construction: one bit per corner instead of an insertion into a sorted list
+   * (measured in bench/README.md). */
   int lo = INT_MAX, hi = INT_MIN;
   for (uint i = 0; i < n; ++i) {
     const int4 q = vload4(vt[b + i], tets);
@@ -211,7 +210,7 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
     up_count[v] = up;
     return;
   }
-  /* Else N(v) is built by insertion into a sorted private list (short: ~15 entries), spilling to
+  /* Else N(v) is built by insertion into a sorted private list (short: the valence), spilling to
    * the global scratch area only when it outgrows TCC_MAX_NB */
   int loc[TCC_MAX_NB];
   uint m = 0;
@@ -303,8 +302,8 @@ __kernel void conn_lower_edges(uint nv, __global const uint* nb_off, __global co
 #endif
 
 /* tet_nbr (see collapse_common.h). Each face is matched by its smallest vertex v: the faces of
- * ring(v) whose other two vertices are both above v are paired in private memory (about 20 per
- * vertex) by sorting their keys, instead of a ring scan per face. A vertex with more such faces
+ * ring(v) whose other two vertices are both above v are paired in private memory (they are few
+ * per vertex) by sorting their keys, instead of a ring scan per face. A vertex with more such faces
  * than TCC_MAX_MIN_FACES falls back to the ring scan for its faces. */
 /* Carried tet_nbr for the faces owned by (whose smallest vertex is) a clean vertex v
  * (ndirty[v] == 0): ring(v) is unchanged since the previous iteration (collapse_verdicts.cl),
@@ -373,7 +372,7 @@ __kernel void conn_tet_neighbours(uint n, __global const int* tets, __global con
     }
     return;
   }
-  /* Sorted by key (insertion sort: ~20 entries), each run of equal keys is one face: one entry
+  /* Sorted by key (insertion sort: few entries), each run of equal keys is one face: one entry
    * is a boundary face, two are the two tets of an inner face, more an invalid input. */
   for (int i = 1; i < k; ++i) {
     ulong kk = key[i];

@@ -290,8 +290,8 @@ __kernel void sguard_tris(uint nq, __global const int* qedge, __global const uin
  * alone (and of B when in A alone), by sguard_pairs of q when in both; each refuses q on a
  * hit. With it, only for the query whose survivor has the lowest id of those (qof: the query of
  * each survivor of the run, -1 for other vertices; tmin: per triangle, the lowest survivor among
- * its vertices), and a hit refuses all of them (tcc_sg_refuse_all): the same refusals, about
- * half the pairs (W1's first iteration: most S faces have a survivor). */
+ * its vertices), and a hit refuses all of them (tcc_sg_refuse_all): the same refusals, fewer
+ * pairs (most S faces of the result hold a survivor, so most pairs would be tested twice). */
 inline int tcc_sg_first_survivor(const int* id, __global const int* qof) {
   int m = INT_MAX;
   for (int k = 0; k < 3; ++k)

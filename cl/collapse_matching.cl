@@ -6,8 +6,8 @@
  * edges sharing an end point with a taken one are skipped: the taken edges are a matching, and
  * their collapses may share tets. The greedy selection (collapse_admissible.cl) skips every
  * edge within reach of a taken one instead (no two of its collapses touch a common tet), which
- * leaves about three quarters of what this one takes to later iterations (W1's first iteration:
- * 10,095 against ~41,000; bench/bench_conflict_rule), each of them a pass over the mesh.
+ * leaves most of what this one takes to later iterations (bench/bench_conflict_rule, measured in
+ * bench/README.md), each of them a pass over the mesh.
  *
  * Rounds as in the greedy selection (slot[x]: the first undecided candidate at x; an edge first
  * at both end points is in the turn list, and it decides once no undecided candidate before it
@@ -157,8 +157,8 @@ inline uchar tcc_match_test(int e, int a, int b, int live, int full, int* dir, T
 #ifdef TCC_PREFETCH_OK
 /* The loads of the next items of match_decide besides their tests' (CPU devices, as
  * tcc_prefetch_test): two items ahead the edge's own entries, each in an array of its own (its
- * state, blocker, early test, priority, kept verdict and flags: W1's first iteration ~11% faster
- * with them, 10 of 10 pairs; its writes, reason, edge_dir, queued and wnext, gained nothing);
+ * state, blocker, early test, priority, kept verdict and flags, whose loads it would wait for;
+ * its writes, reason, edge_dir, queued and wnext, gain nothing: measured in bench/README.md);
  * for the blocker scan four items ahead the entries of nb_off, three ahead the lists N(a), N(b),
  * one ahead the slot, its priority and vaff of each vertex in them. */
 inline void tcc_prefetch_decide(uint i, uint n, __global const uint* tlist, __global const int* edges,
@@ -343,7 +343,7 @@ inline void tcc_match_apply(int e, __global const int* edges, __global const int
 /* The loads of the next items of a work item of match_apply (CPU devices, as tcc_prefetch_test;
  * the next item is `step` entries on, tcc_spread_index): two items ahead the rings' lists and the
  * edge lists N(a), N(b); one ahead the rings' tets, their tdead and rows of tet_nbr (the removed
- * tets' are glued across), and the edges' states (W1: match_apply's kernel time ~35% lower). */
+ * tets' are glued across), and the edges' states (each read otherwise waits for memory). */
 inline void tcc_prefetch_apply(uint i, uint n, uint step, __global const uint* inlist, __global const int* edges,
                                __global const uint* vt_off, __global const int* vt, __global const int* tets,
                                __global const uchar* tdead, __global const int* tet_nbr, __global const uint* nb_off,
@@ -414,10 +414,9 @@ __kernel void match_loop(uint n, int cur, uint round, __global uint* t0, __globa
 
 /* --- Collapses the surface guard refuses (SurfaceGuard::run_applied) are undone, with every
  * taken collapse whose tests saw one of them: the taken ones of a later round within reach of
- * one undone, and so on (match_undo_reach, match_undo_grow; W1: 10 refused, 143 undone, of
- * 18,711). The others keep their collapses: each saw only collapses that stay. Undone in the
- * reverse order of their rounds (the host sorts them), each the inverse of match_apply; the
- * guard then tests the result again. --- */
+ * one undone, and so on (match_undo_reach, match_undo_grow). The others keep their collapses:
+ * each saw only collapses that stay. Undone in the reverse order of their rounds (the host
+ * sorts them), each the inverse of match_apply; the guard then tests the result again. --- */
 
 /* reachmin[v]: the first round of the listed collapses with v in N[a] U N[b]. */
 __kernel void match_undo_reach(uint n, __global const uint* list, __global const int* edges, __global const uint* nb_off,

@@ -39,7 +39,7 @@ inline int tcc_in(const int* list, int n, int x) {
 
 /* x in v[0..8) (pads of -1 never match a vertex): eight compares, no branch. The link test's
  * small sets are kept so when they fit: a lookup by loop exits at a data-dependent place, and
- * those mispredicted exits were about a third of a passing test on W1 (bench_admissible). */
+ * those mispredicted exits were a large part of a passing test (bench_admissible). */
 #define TCC_ANY8(v, x)                                                                                     \
   (((x) == (v)[0]) | ((x) == (v)[1]) | ((x) == (v)[2]) | ((x) == (v)[3]) | ((x) == (v)[4]) | ((x) == (v)[5]) | \
    ((x) == (v)[6]) | ((x) == (v)[7]))
@@ -84,7 +84,7 @@ inline uchar tcc_volume_test(int a, int b, int dir, __global const int* tets, __
     if (px.x == p.x && px.y == p.y && px.z == p.z) continue; /* x does not move: its tets keep their shape */
     /* In chunks, two loops: first the vertices of the tets (independent loads, so that the
      * processor has many cache misses in flight; branch-free), then their volumes. One loop
-     * doing both waited for each tet's vertices in turn: about half of the test's time. */
+     * doing both waited for each tet's vertices in turn. */
     for (uint i0 = vt_off[x], iend = vt_off[x + 1]; i0 < iend; i0 += TCC_VOL_CHUNK) {
       int4 qs[TCC_VOL_CHUNK];
       int ts[TCC_VOL_CHUNK];
@@ -465,8 +465,8 @@ inline int tcc_queue_once(int e, volatile __global uint* queued, uint stamp, __g
  * changes only when its edge decides, and then z is listed (tcc_refused_ends, match_apply,
  * greedy_block), so tcc_p1_turn wakes the list in the vertex part of the round in which the
  * blocker decided: e is in the next turn list, the first in which it would have found its
- * blocker decided. The same rounds and decisions, fewer visits (W1 iteration 0, matching:
- * 257,000 of the 415,000 turn-list entries only found their blocker undecided). The lists are
+ * blocker decided. The same rounds and decisions, fewer visits (without the lists most
+ * turn-list entries of the matching selection only find their blocker undecided). The lists are
  * written in the decisions and read in the vertex part, after them; a woken edge is on no list
  * and is visited before it waits again, so it is on one list at most. */
 inline void tcc_wait_on(int e, int z, __global int* whead, __global int* wnext) {
@@ -535,17 +535,15 @@ inline int tcc_loop_next(uint* n, int* cur, uint* round, uint max_n, __global ui
 #ifdef TCC_PREFETCH_OK
 /* CPU devices (the host sets TCC_PREFETCH) run a work-group's items one after another: start the
  * memory traffic of the next items' tests, whose loops otherwise wait for each of their tets in
- * turn (W1, lazy pass 1: the test's share of the CPU samples 23% -> 21%; the matching selection's
- * first iteration ~7% faster with the points): a load per step, each step one item nearer, so
- * that each reads what the step before fetched: five items ahead the edge's end points, four
- * ahead their entries of vt_off, three ahead the rings' lists (two lines each), two ahead the
- * rings' tets, one ahead their points (loading the lists and the offsets without their own steps
- * was ~25% of this function's samples, then the selection's first iteration ~10% faster with
- * them). In match_decide (tdead non-null) also, two items ahead, tdead of each tet and, at an end
- * point on S (vflags), its row of tet_nbr, which a live test reads (whether it is live is known
+ * turn: a load per step, each step one item nearer, so that each reads what the step before
+ * fetched: five items ahead the edge's end points, four ahead their entries of vt_off, three ahead
+ * the rings' lists (two lines each), two ahead the rings' tets, one ahead their points (the lists
+ * and the offsets get steps of their own: loaded in the step of what they index, they stalled this
+ * function). In match_decide (tdead non-null) also, two items ahead, tdead of each tet and, at an
+ * end point on S (vflags), its row of tet_nbr, which a live test reads (whether it is live is known
  * only after the blocker scan, so for every item). With the quality guard (q_min > 0), two items
- * ahead each tet's quality at the iteration's start (W1 at min_quality 0.1: 1.04x and 1.07x in 10
- * and 12 paired runs). Prefetches change no result: they write
+ * ahead each tet's quality at the iteration's start. Each of these loads pays on a CPU device
+ * (measured in bench/README.md). Prefetches change no result: they write
  * nothing, and every load here reads what the items' own work may read, in a launch that does
  * not write it. */
 inline void tcc_prefetch_test(uint i, uint n, __global const uint* tlist, __global const int* edges,
@@ -599,8 +597,8 @@ inline void tcc_prefetch_test(uint i, uint n, __global const uint* tlist, __glob
  * id times the number of work-groups plus the group's id (a bijection on the launch), so the
  * first m entries are spread over every work-group. Indexed by the global id, they would all
  * fall in the first few groups, which the CPU drivers run on one thread: PoCL hands each thread
- * a range of consecutive work-groups (W1: match_apply, launched over the turn list for the
- * ~10% of it taken, ran no faster on two cores than on one). */
+ * a range of consecutive work-groups (match_apply, launched over the turn list for the few
+ * entries of it taken, ran no faster on two cores than on one). */
 inline uint tcc_spread_index(void) { return (uint)(get_local_id(0) * get_num_groups(0) + get_group_id(0)); }
 
 inline void tcc_greedy_list_vertex(int v, volatile __global uint* vstamp, uint round, __global uint* dlist,

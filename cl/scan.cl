@@ -102,7 +102,7 @@ __kernel void compact_u64(__global const ulong* values, __global const uint* fla
 /* Chunked variant for CPU devices (selected by the host): each work item scans `chunk`
  * consecutive values serially, with no local memory and no barriers. On a CPU work items are
  * iterations of a loop, so barrier-separated local scans cost far more than they save
- * (bench_primitives: 170 ms against 9 ms for 10M values on PoCL before this variant).
+ * (bench_primitives; measured in bench/README.md).
  *   scan_chunk_sums   sums[g] = sum of chunk g,
  *   (host)            exclusive scan of sums, recursively,
  *   scan_chunk_apply  serial exclusive scan of chunk g starting at offsets[g]; the last chunk

@@ -1,5 +1,5 @@
 // A minimal JSON writer for reports (--json, --stats). Why our own: we only emit, never
-// parse, and a streaming writer of ~80 lines is simpler than a dependency.
+// parse, and a small streaming writer is simpler than a dependency.
 #pragma once
 
 #include <cmath>

@@ -1,19 +1,18 @@
 // Device primitives: scan, compaction, radix sort, segments. Kernels: cl/scan.cl, cl/sort.cl,
 // cl/segments.cl.
 //
-// Why our own kernels rather than Boost.Compute (bench/bench_primitives.cpp, same run, PoCL 3.1
-// on 2 loaded cores, medians of 5):
-//  - sort, 10M 64-bit keys + 32-bit payload: ours 1245 ms (64 key bits) / 662 ms (40 bits);
-//    Boost.Compute stable_sort_by_key (merge sort on CPU devices) 2672 ms, its radix_sort_by_key
-//    5276 ms; std::sort of the keys alone 1772 ms. Ours is 2-8x faster, so the sort is ours.
-//  - exclusive scan, 10M uint32: ours 23 ms, Boost.Compute 11.5 ms, std::exclusive_scan 14 ms.
-//    Boost.Compute is faster here, but we still keep ours: Boost.Compute compiles its programs
-//    in every process (its offline cache needs Boost.Filesystem), so it would bypass our
-//    binary cache and add seconds to every start; its headers only compile after
-//    <CL/opencl.hpp> and without BOOST_COMPUTE_MAX_CL_VERSION (target 3.0 clash); its errors
-//    are not DeviceError; and the scan is a small share of every stage that uses it (16 ms of
-//    a 660 ms sort). A CPU variant with a few long chunks per compute unit, Boost's layout,
-//    was slower on PoCL (27 ms at 10M) and was dropped.
+// Why our own kernels rather than Boost.Compute (bench/bench_primitives.cpp; measured in
+// bench/README.md):
+//  - sort of 64-bit keys with a 32-bit payload: ours beats Boost.Compute's stable_sort_by_key
+//    (a merge sort on CPU devices) and radix_sort_by_key, and std::sort of the keys alone, so
+//    the sort is ours.
+//  - exclusive scan: Boost.Compute is faster here, but we still keep ours: Boost.Compute
+//    compiles its programs in every process (its offline cache needs Boost.Filesystem), so it
+//    would bypass our binary cache and add a compilation to every start; its headers only
+//    compile after <CL/opencl.hpp> and without BOOST_COMPUTE_MAX_CL_VERSION (target 3.0
+//    clash); its errors are not DeviceError; and the scan is a small share of every stage that
+//    uses it. A CPU variant with a few long chunks per compute unit, Boost's layout, was slower
+//    on PoCL and was dropped.
 #include "device/primitives.hpp"
 
 #include <algorithm>

@@ -29,7 +29,7 @@ namespace topology_detail {
 
 // Stable LSD radix sort of (key, payload) records by key, 8 bits per pass, skipping the
 // passes whose byte is the same in every key. We write it ourselves rather than calling
-// std::stable_sort because it is 3-5x faster on the millions of 64-bit keys a mesh gives, and
+// std::stable_sort because it is faster on the millions of 64-bit keys a mesh gives, and
 // it sorts exactly like the device's stable radix sort (equal keys keep their input order).
 void radix_sort(std::vector<KeyPayload>& a) {
   const size_t n = a.size();

@@ -1,4 +1,4 @@
-// Validity and quality checker for tetrahedral meshes (issue 4).
+// Validity and quality checker for tetrahedral meshes.
 //
 //   tc::CheckReport r = tc::check_mesh(mesh, options, &reference);   // reference optional
 //   if (!r.valid) ...               // r.errors: one line each, naming the first offenders

@@ -111,7 +111,7 @@ class Context {
   // in error messages. local = 0 means group_size_for(kernel), on a CPU device with no size set
   // (set_work_group_size) halved while the launch would have fewer than 4 work-groups per
   // compute unit: the CPU drivers run a work-group on one thread, so a small launch in one or
-  // two large groups would leave cores idle (W1's chunked scans: 126 items in one group).
+  // two large groups (a chunked scan's, say) would leave cores idle.
   void launch(cl::Kernel& kernel, size_t n, const char* what, size_t local = 0);
   // Enqueues one work-group of group_size_for(kernel) items (kernels that loop with barriers).
   void launch_one_group(cl::Kernel& kernel, const char* what);

@@ -1,4 +1,4 @@
-// The CI sample of the robustness campaign (issue 6, scripts/robustness.py): every mesh of
+// The CI sample of the robustness campaign (scripts/robustness.py): every mesh of
 // meshes/corpus/ (a fixed subset of the corpus made by scripts/make_corpus.py, one per line in
 // meshes/corpus/README.md) is coarsened to its median edge length through the CLI
 //   1. with the default boundary protection and --check: exit 0 and "check": "valid";

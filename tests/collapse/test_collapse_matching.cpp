@@ -491,7 +491,7 @@ Mesh run_guarded_matching(Context& ctx, const Mesh& in, double factor, const Gua
 // After the undo of refused collapses, the surface guard tests only the queries near the
 // undone ones (SurfaceGuard::restrict_to_undone): on every iteration of runs where the guard
 // refuses (guard_refusal_runs), it refuses what a guard testing every query of the result
-// refuses (each pair once per query of the pair, the rule before session 18), and the results
+// refuses (each pair once per query of the pair, as without dedup), and the results
 // are valid.
 TEST(CollapseMatching, GuardAfterUndoTestsWhatTheUndoChanged) {
   const auto runs = guard_refusal_runs();

@@ -154,7 +154,7 @@ TEST(DeviceConnectivity, SharedMeshes) {
   int done = 0;
   for (const std::string& path : test::shared_volume_meshes()) {
     Mesh m = read_mesh(path);  // every shared mesh must load (tests/io checks the counts)
-    if (m.num_tets() > 300000) {  // keeps the test well under a minute; bench_connectivity compares those
+    if (m.num_tets() > 300000) {  // keeps the test short; bench_connectivity compares those
       std::printf("[ skipped  ] %s: %lld tets, compared by bench_connectivity instead\n", path.c_str(),
                   (long long)m.num_tets());
       continue;
