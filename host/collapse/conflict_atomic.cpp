@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "collapse/launch.hpp"
 #include "collapse/stages.hpp"
 #include "tetcollapse/error.hpp"
 
@@ -19,9 +20,6 @@ cl_uint index_bits(uint32_t ne) {
   while (k < 32 && (uint64_t(1) << k) < ne) ++k;
   return k;
 }
-
-// TETCOLLAPSE_PROFILE=1 prints the wall time of every kernel launch on stderr.
-const bool kProfile = std::getenv("TETCOLLAPSE_PROFILE") != nullptr;
 
 }  // namespace
 
@@ -41,24 +39,11 @@ uint32_t conflicts_atomic_min(Context& ctx, DeviceMesh& dm, Connectivity& c, Edg
   if (c.scratch.size() < size_t(nt) * 2) ensure(c.scratch, ctx, size_t(nt) * 2);
   const cl::Buffer& desc = c.scratch.buffer();
   auto run = [&](const char* name, size_t n, const auto&... args) {
-    cl::Kernel kern = ctx.kernel(F, name);
-    detail::cl_call(name, [&] {
-      cl_uint i = 0;
-      (kern.setArg(i++, args), ...);
-    });
-    const auto t0 = std::chrono::steady_clock::now();
-    ctx.launch(kern, n, name);
-    if (kProfile) {  // as the stages of stages.cpp do
-      ctx.finish();
-      std::fprintf(stderr, "  %-28s n=%-9zu %8.4f s\n", name, n,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-    }
+    collapse_detail::run(ctx, F, name, n, args...);
   };
-  run("atomic_min_reset", nt, nt, desc);
-  run("atomic_min_propagate", ne, ne, c.edges.buffer(), s.adm.buffer(), s.cost.buffer(), c.vt_off.buffer(),
-      c.vt.buffer(), k, desc);
-  run("atomic_min_select", ne, ne, c.edges.buffer(), s.adm.buffer(), s.cost.buffer(), c.vt_off.buffer(),
-      c.vt.buffer(), k, desc, s.fin.buffer(), s.p1.buffer(), s.vaff.buffer(), s.counters.buffer());
+  run("atomic_min_reset", nt, arg("nt", nt), arg("desc", desc));
+  run("atomic_min_propagate", ne, arg("ne", ne), arg("edges", c.edges), arg("adm", s.adm), arg("cost", s.cost), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("idx_bits", k), arg("desc", desc));
+  run("atomic_min_select", ne, arg("ne", ne), arg("edges", c.edges), arg("adm", s.adm), arg("cost", s.cost), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("idx_bits", k), arg("desc", desc), arg("fin", s.fin), arg("p1", s.p1), arg("vaff", s.vaff), arg("counters", s.counters));
   uint32_t n = 0;
   s.counters.download(&n, 1, 3);
   return n;

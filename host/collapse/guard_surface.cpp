@@ -26,17 +26,9 @@ void ensure_nonempty(DeviceBuffer<T>& b, Context& ctx, size_t n) {
   ensure(b, ctx, std::max<size_t>(n, 1));
 }
 
-// TETCOLLAPSE_PROFILE=1 prints the grid and the refusals on stderr (and the launches' times).
-const bool kProfile = std::getenv("TETCOLLAPSE_PROFILE") != nullptr;
-
-template <class... A>
-void launch(Context& ctx, const StageParams& p, const char* name, size_t n, const A&... args) {
-  cl::Kernel k = stage_kernel(ctx, p, "collapse_guard.cl", name);  // the placement may be the user's
-  detail::cl_call(name, [&] {
-    cl_uint i = 0;
-    (k.setArg(i++, args), ...);
-  });
-  launch_profiled(ctx, k, name, n);
+template <class... T>
+void launch(Context& ctx, const StageParams& p, const char* name, size_t n, const Arg<T>&... args) {
+  run_stage(ctx, p, "collapse_guard.cl", name, n, args...);  // the placement may be the user's
 }
 
 // The cell of coordinate v on one axis (ih = 1 / the cell size); the same arithmetic as
@@ -65,10 +57,7 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   qcount.fill(0u);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   const cl::Buffer& labels = dm.labels[0].buffer();
-  launch(ctx, p, "sguard_queries", c.ne, cl_uint(c.ne), c.edges.buffer(), s.fin.buffer(), s.dir.buffer(),
-         dm.points.buffer(), dm.vfields.buffer(), cl_uint(dm.vfield_comps), dm.tets.buffer(), c.vt_off.buffer(),
-         c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels, c.vflags.buffer(), qedge.buffer(), qbox.buffer(),
-         qntri.buffer(), qcount.buffer());
+  launch(ctx, p, "sguard_queries", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("fin", s.fin), arg("dir", s.dir), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("labels", labels), arg("use_labels", use_labels), arg("vflags", c.vflags), arg("qedge", qedge), arg("qbox", qbox), arg("qntri", qntri), arg("qcount", qcount));
   uint32_t nq = 0;
   qcount.download(&nq, 1);
   last_queries = nq;
@@ -76,10 +65,7 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
 
   // the new triangles of each query, stored once (offsets by a scan of their counts)
   reserve_triangles(ctx, nq, query_offsets(ctx, nq));
-  launch(ctx, p, "sguard_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(), s.dir.buffer(),
-         dm.points.buffer(), dm.vfields.buffer(), cl_uint(dm.vfield_comps), dm.tets.buffer(), c.vt_off.buffer(),
-         c.vt.buffer(), c.tet_nbr.buffer(), labels, use_labels, tid.buffer(), tpos.buffer(), tbox.buffer(),
-         tplane.buffer(), qrep.buffer());
+  launch(ctx, p, "sguard_tris", nq, arg("nq", nq), arg("qedge", qedge), arg("qoff", qoff), arg("edges", c.edges), arg("dir", s.dir), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("labels", labels), arg("use_labels", use_labels), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("qrep", qrep));
   // the tets owning an S face (conn_vertex_flags_faces), listed once per connectivity
   if (stets_generation != c.generation) {
     ensure_nonempty(stets, ctx, dm.nt);
@@ -100,8 +86,7 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   ensure_nonempty(applied_owns_s, ctx, dm.nt);
   ensure_nonempty(applied_smask, ctx, dm.nt);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
-  launch(ctx, p, "sguard_applied_smask", dm.nt, cl_uint(dm.nt), c.tet_nbr.buffer(), dm.labels[0].buffer(), use_labels,
-         s.tdead.buffer(), applied_owns_s.buffer(), applied_smask.buffer());
+  launch(ctx, p, "sguard_applied_smask", dm.nt, arg("nt", dm.nt), arg("tet_nbr", c.tet_nbr), arg("labels", dm.labels[0]), arg("use_labels", use_labels), arg("tdead", s.tdead), arg("owns_s", applied_owns_s), arg("smask", applied_smask));
   ensure_nonempty(qedge, ctx, chosen);
   ensure_nonempty(qbox, ctx, size_t(chosen) * 6);
   ensure_nonempty(qntri, ctx, chosen);
@@ -112,10 +97,7 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   if (only) ensure_nonempty(requery, ctx, c.ne);  // (filled by restrict_to_undone)
   ensure_nonempty(qof, ctx, dm.nv);
   qof.fill(-1);
-  launch(ctx, p, "sguard_applied_queries", c.ne, cl_uint(c.ne), c.edges.buffer(), s.fin.buffer(), s.dir.buffer(),
-         dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), s.tdead.buffer(),
-         applied_smask.buffer(), c.vflags.buffer(), qedge.buffer(), qntri.buffer(), qcount.buffer(), cl_int(only ? 1 : 0),
-         only ? requery.buffer() : applied_smask.buffer(), qof.buffer());
+  launch(ctx, p, "sguard_applied_queries", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("fin", s.fin), arg("dir", s.dir), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tdead", s.tdead), arg("smask", applied_smask), arg("vflags", c.vflags), arg("qedge", qedge), arg("qntri", qntri), arg("qcount", qcount), arg("only_flagged", cl_int(only ? 1 : 0)), arg("requery", only ? requery.buffer() : applied_smask.buffer()), arg("qof", qof));
   uint32_t nq = 0;
   qcount.download(&nq, 1);
   last_queries = nq;
@@ -123,10 +105,7 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   const uint32_t ntri = query_offsets(ctx, nq);
   reserve_triangles(ctx, nq, ntri);
   ensure_nonempty(tmin, ctx, ntri);
-  launch(ctx, p, "sguard_applied_tris", nq, cl_uint(nq), qedge.buffer(), qoff.buffer(), c.edges.buffer(),
-         s.dir.buffer(), dm.points.buffer(), dm.tets.buffer(), c.vt_off.buffer(), c.vt.buffer(), s.tdead.buffer(),
-         applied_smask.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(), tplane.buffer(), qrep.buffer(), qof.buffer(),
-         tmin.buffer(), qbox.buffer());
+  launch(ctx, p, "sguard_applied_tris", nq, arg("nq", nq), arg("qedge", qedge), arg("qoff", qoff), arg("edges", c.edges), arg("dir", s.dir), arg("pts", dm.points), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tdead", s.tdead), arg("smask", applied_smask), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("qrep", qrep), arg("qof", qof), arg("tmin", tmin), arg("qbox", qbox));
   ensure_nonempty(applied_stets, ctx, dm.nt);
   const uint32_t n_applied = dev::compact_indices(ctx, applied_owns_s, applied_stets, dm.nt);
   return test_queries(ctx, dm, c, s, p, chosen, nq, applied_smask, applied_stets, n_applied, each_pair_once);
@@ -140,12 +119,10 @@ void SurfaceGuard::restrict_to_undone(Context& ctx, DeviceMesh& dm, Connectivity
   ensure_nonempty(undone_list, ctx, nu);
   undone_list.upload(undone.data(), nu);
   ensure_nonempty(undone_boxes, ctx, size_t(nu) * 6);
-  launch(ctx, p, "sguard_undone_boxes", nu, cl_uint(nu), undone_list.buffer(), c.edges.buffer(), s.dir.buffer(),
-         c.nb_off.buffer(), c.nb.buffer(), s.vaff.buffer(), dm.points.buffer(), undone_boxes.buffer());
+  launch(ctx, p, "sguard_undone_boxes", nu, arg("n", nu), arg("undone", undone_list), arg("edges", c.edges), arg("dir", s.dir), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("vaff", s.vaff), arg("pts", dm.points), arg("boxes", undone_boxes));
   ensure_nonempty(requery, ctx, c.ne);
   requery.fill(0);
-  launch(ctx, p, "sguard_requery", last_queries, cl_uint(last_queries), qedge.buffer(), qbox.buffer(), cl_uint(nu),
-         undone_boxes.buffer(), requery.buffer());
+  launch(ctx, p, "sguard_requery", last_queries, arg("nq", last_queries), arg("qedge", qedge), arg("qbox", qbox), arg("nu", nu), arg("boxes", undone_boxes), arg("requery", requery));
   only_requery = true;
 }
 
@@ -153,8 +130,7 @@ void SurfaceGuard::refused_edges(Context& ctx, DeviceBuffer<uint8_t>& flag, Devi
                                  DeviceBuffer<uint32_t>& count) {
   if (last_queries == 0) return;
   StageParams p;  // the kernel has no user code
-  launch(ctx, p, "sguard_refused_list", last_queries, cl_uint(last_queries), qedge.buffer(), qbad.buffer(),
-         flag.buffer(), list.buffer(), count.buffer());
+  launch(ctx, p, "sguard_refused_list", last_queries, arg("nq", last_queries), arg("qedge", qedge), arg("qbad", qbad), arg("flag", flag), arg("list", list), arg("count", count));
 }
 
 uint32_t SurfaceGuard::query_offsets(Context& ctx, uint32_t nq) {
@@ -252,21 +228,12 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
   const cl_int dedup = each_once ? 1 : 0;
   last_run_each_pair_once = each_once;
   ensure_nonempty(vcell, ctx, dm.nv);
-  launch(ctx, p, "sguard_vertex_cells", dm.nv, cl_uint(dm.nv), dm.points.buffer(), cl_double(lo[0]), cl_double(lo[1]),
-         cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), vcell.buffer());
-  launch(ctx, p, "sguard_surface", n_sweep, cl_uint(n_sweep), sweep_tets.buffer(), smask.buffer(), vcell.buffer(),
-         dm.points.buffer(), dm.tets.buffer(), qrep.buffer(), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(),
-         tbox.buffer(), tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih),
-         cl_int(g[0]), cl_int(g[1]), cl_int(g[2]), cell_off.buffer(), cell_q.buffer(), qbad.buffer(), dedup, qof.buffer(),
-         tmin.buffer());
-  launch(ctx, p, "sguard_pairs", nq, cl_uint(nq), qbox.buffer(), qoff.buffer(), tid.buffer(), tpos.buffer(), tbox.buffer(),
-         tplane.buffer(), cl_double(lo[0]), cl_double(lo[1]), cl_double(lo[2]), cl_double(ih), cl_int(g[0]), cl_int(g[1]),
-         cl_int(g[2]), cell_off.buffer(), cell_q.buffer(), qbad.buffer(), cl_int(s.in_place ? 0 : 1),
-         dedup, qrep.buffer(), qof.buffer(), tmin.buffer());
+  launch(ctx, p, "sguard_vertex_cells", dm.nv, arg("nv", dm.nv), arg("pts", dm.points), arg("ox", cl_double(lo[0])), arg("oy", cl_double(lo[1])), arg("oz", cl_double(lo[2])), arg("ih", cl_double(ih)), arg("gx", cl_int(g[0])), arg("gy", cl_int(g[1])), arg("gz", cl_int(g[2])), arg("vcell", vcell));
+  launch(ctx, p, "sguard_surface", n_sweep, arg("n", n_sweep), arg("stets", sweep_tets), arg("smask", smask), arg("vcell", vcell), arg("pts", dm.points), arg("tets", dm.tets), arg("qrep", qrep), arg("qbox", qbox), arg("qoff", qoff), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("ox", cl_double(lo[0])), arg("oy", cl_double(lo[1])), arg("oz", cl_double(lo[2])), arg("ih", cl_double(ih)), arg("gx", cl_int(g[0])), arg("gy", cl_int(g[1])), arg("gz", cl_int(g[2])), arg("cell_off", cell_off), arg("cell_q", cell_q), arg("qbad", qbad), arg("dedup", dedup), arg("qof", qof), arg("tmin", tmin));
+  launch(ctx, p, "sguard_pairs", nq, arg("nq", nq), arg("qbox", qbox), arg("qoff", qoff), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("ox", cl_double(lo[0])), arg("oy", cl_double(lo[1])), arg("oz", cl_double(lo[2])), arg("ih", cl_double(ih)), arg("gx", cl_int(g[0])), arg("gy", cl_int(g[1])), arg("gz", cl_int(g[2])), arg("cell_off", cell_off), arg("cell_q", cell_q), arg("qbad", qbad), arg("cross", cl_int(s.in_place ? 0 : 1)), arg("dedup", dedup), arg("qrep", qrep), arg("qof", qof), arg("tmin", tmin));
   qcount.fill(0u);
   const bool has_verdict = !s.in_place && s.verdict.size() >= c.ne && s.verdict.buffer()();
-  launch(ctx, p, "sguard_drop", nq, cl_uint(nq), qedge.buffer(), qbad.buffer(), s.marked.buffer(),
-         cl_int(has_verdict ? 1 : 0), has_verdict ? s.verdict.buffer() : qbad.buffer(), qcount.buffer());
+  launch(ctx, p, "sguard_drop", nq, arg("nq", nq), arg("qedge", qedge), arg("qbad", qbad), arg("marked", s.marked), arg("has_verdict", cl_int(has_verdict ? 1 : 0)), arg("verdict", has_verdict ? s.verdict.buffer() : qbad.buffer()), arg("count", qcount));
   uint32_t refused = 0;
   qcount.download(&refused, 1);
   if (kProfile) std::fprintf(stderr, "  surface guard: %u collapses chosen, %u change S, %u refused\n", chosen, nq, refused);

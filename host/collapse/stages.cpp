@@ -2,6 +2,7 @@
 #include "collapse/stages.hpp"
 #include "collapse/spatial_order.hpp"
 #include "collapse/guard_surface.hpp"
+#include "collapse/launch.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -23,73 +24,9 @@ namespace tc::collapse_detail {
 
 namespace {
 
-template <class... A>
-void set_args(cl::Kernel& k, const char* what, const A&... a) {
-  detail::cl_call(what, [&] {
-    cl_uint i = 0;
-    (k.setArg(i++, a), ...);
-  });
-}
-
-// Kernel arguments: buffers by their cl::Buffer, scalars as OpenCL types.
-template <class T>
-const cl::Buffer& B(const DeviceBuffer<T>& b) {
-  return b.buffer();
-}
-cl_uint U(size_t v) { return static_cast<cl_uint>(v); }
-cl_int I(int v) { return static_cast<cl_int>(v); }
-
-// TETCOLLAPSE_PROFILE=1 prints the wall time of every kernel launch of the stages on stderr.
-const bool kProfile = std::getenv("TETCOLLAPSE_PROFILE") != nullptr;
-
-void run(Context& ctx, const std::string& file, const char* name, size_t n, const std::string& options,
-         const auto&... args) {
-  cl::Kernel k = ctx.kernel(file, name, options);
-  set_args(k, name, args...);
-  launch_profiled(ctx, k, name, n);
-}
-
-// Exclusive scan of counts[0..n) into off[0..n], off[n] = total.
-uint32_t scan_offsets(Context& ctx, DeviceBuffer<uint32_t>& counts, DeviceBuffer<uint32_t>& off, size_t n) {
-  ensure(off, ctx, n + 1);
-  uint32_t total = dev::exclusive_scan(ctx, counts, off, n);
-  off.upload(&total, 1, n);
-  return total;
-}
-
 const cl::Buffer& primary_labels(DeviceMesh& dm) { return dm.labels[0].buffer(); }
 
-// Kernel `name` of the stage file `file` compiled after the user's OpenCL C `user`, with the
-// -D options `defines`: the shared helpers (which declare the user functions), the user's
-// source, the file. The Context caches programs by (name, options): the program's name (`what`,
-// also in build errors) carries a hash of the source.
-cl::Kernel user_kernel(Context& ctx, const std::string& what, const std::string& file, const char* name,
-                       const std::string& user, const std::string& defines) {
-  const std::string src = "#include \"collapse_common.h\"\n" + user + "\n#include \"" + file + "\"\n";
-  cl::Program& prog =
-      ctx.build(what + " (" + file + " " + std::to_string(std::hash<std::string>{}(src)) + ")", src, defines);
-  return detail::cl_call(("clCreateKernel(" + std::string(name) + ")").c_str(), [&] { return cl::Kernel(prog, name); });
-}
-
-// run() for the kernels that see the user's placement or predicate (stage_kernel).
-void run_stage(Context& ctx, const StageParams& p, const std::string& file, const char* name, size_t n,
-               const auto&... args) {
-  cl::Kernel k = stage_kernel(ctx, p, file, name);
-  set_args(k, name, args...);
-  launch_profiled(ctx, k, name, n);
-}
-
 }  // namespace
-
-void launch_profiled(Context& ctx, cl::Kernel& k, const char* name, size_t n) {
-  auto t0 = std::chrono::steady_clock::now();
-  ctx.launch(k, n, name);
-  if (kProfile) {
-    ctx.finish();
-    std::fprintf(stderr, "  %-28s n=%-9zu %8.4f s\n", name, n,
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-  }
-}
 
 StageParams params_from(const CollapseOptions& o) {
   StageParams p;
@@ -113,11 +50,6 @@ StageParams params_from(const CollapseOptions& o) {
     p.user_defines += " -DTCC_USER_PREDICATE";
   }
   return p;
-}
-
-cl::Kernel stage_kernel(Context& ctx, const StageParams& p, const std::string& file, const char* name) {
-  if (p.user_source.empty()) return ctx.kernel(file, name);
-  return user_kernel(ctx, "user placement / predicate", file, name, p.user_source, p.user_defines);
 }
 
 void check_collapse_input(const Mesh& mesh) {
@@ -261,16 +193,15 @@ uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, Edg
   uint32_t passed_q = 0;
   lazy_admissible_pass1(ctx, dm, c, s, p, passed_q, tested);
   const uint32_t total = conflict_pass2(ctx, dm, c, s);  // counters[3] counts both rounds
-  run(ctx, "collapse_verdicts.cl", "merge_rounds_edges", c.ne, "", U(c.ne), B(s.fin1), B(s.dir1), B(s.fin), B(s.dir));
-  run(ctx, "collapse_verdicts.cl", "merge_rounds_vertices", dm.nv, "", U(dm.nv), B(s.vaff1), B(s.vaff));
+  run(ctx, "collapse_verdicts.cl", "merge_rounds_edges", c.ne, arg("ne", c.ne), arg("fin1", s.fin1), arg("dir1", s.dir1), arg("fin", s.fin), arg("dir", s.dir));
+  run(ctx, "collapse_verdicts.cl", "merge_rounds_vertices", dm.nv, arg("nv", dm.nv), arg("vaff1", s.vaff1), arg("vaff", s.vaff));
   return total;
 }
 
 void remember_for_carry(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
   s.update_next = true;
   ensure(s.vdirty, ctx, dm.nv);
-  run(ctx, "collapse_verdicts.cl", "verdict_dirty", dm.nv, "", U(dm.nv), B(s.vaff), B(c.nb_off), B(c.nb),
-      B(s.vdirty));
+  run(ctx, "collapse_verdicts.cl", "verdict_dirty", dm.nv, arg("nv", dm.nv), arg("vaff", s.vaff), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("vdirty", s.vdirty));
   s.prev_nv = dm.nv;
   s.prev_nt = dm.nt;
 }
@@ -280,10 +211,9 @@ void note_compaction(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s
   ensure(s.vold, ctx, dm.nv);
   ensure(s.ndirty, ctx, dm.nv);
   ensure(s.dirty_flags, ctx, dm.nv);
-  run(ctx, "collapse_verdicts.cl", "verdict_vertex_old", s.prev_nv, "", U(s.prev_nv), B(c.count), B(c.cursor),
-      B(s.vdirty), B(s.vold), B(s.ndirty), B(s.dirty_flags));
+  run(ctx, "collapse_verdicts.cl", "verdict_vertex_old", s.prev_nv, arg("nv_prev", s.prev_nv), arg("keep", c.count), arg("newidx", c.cursor), arg("vdirty", s.vdirty), arg("vold", s.vold), arg("ndirty", s.ndirty), arg("dirty_flags", s.dirty_flags));
   ensure(s.told, ctx, dm.nt);
-  run(ctx, "collapse_verdicts.cl", "verdict_tet_old", s.prev_nt, "", U(s.prev_nt), B(s.tkeep), B(s.tnew), B(s.told));
+  run(ctx, "collapse_verdicts.cl", "verdict_tet_old", s.prev_nt, arg("nt_prev", s.prev_nt), arg("keep", s.tkeep), arg("newidx", s.tnew), arg("told", s.told));
   std::swap(s.prev_nb_off, c.nb_off);
   std::swap(s.prev_edge_off, c.edge_off);
   std::swap(s.prev_nb, c.nb);
@@ -299,15 +229,13 @@ void carry_verdicts(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s)
   ensure(s.verdict, ctx, c.ne);
   s.verdict_ready = s.has_prev;
   if (!s.has_prev) return;
-  run(ctx, "collapse_verdicts.cl", "verdict_carry", dm.nv, "", U(dm.nv), B(c.nb_off), B(c.nb), B(c.edge_off),
-      B(s.vold), B(s.vdirty), B(s.prev_nb_off), B(s.prev_nb_edge), B(s.prev_verdict), B(s.verdict));
+  run(ctx, "collapse_verdicts.cl", "verdict_carry", dm.nv, arg("nv", dm.nv), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("edge_off", c.edge_off), arg("vold", s.vold), arg("vdirty", s.vdirty), arg("prev_nb_off", s.prev_nb_off), arg("prev_nb_edge", s.prev_nb_edge), arg("prev_verdict", s.prev_verdict), arg("verdict", s.verdict));
   s.has_prev = false;
 }
 
 std::vector<uint8_t> tail_touched(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
   DeviceBuffer<uint8_t> touched(ctx, std::max<size_t>(dm.nv, 1));
-  run(ctx, "collapse_verdicts.cl", "tail_touched", dm.nv, "", U(dm.nv), B(s.ndirty), B(c.nb_off), B(c.nb_edge),
-      B(s.verdict), B(touched));
+  run(ctx, "collapse_verdicts.cl", "tail_touched", dm.nv, arg("nv", dm.nv), arg("ndirty", s.ndirty), arg("nb_off", c.nb_off), arg("nb_edge", c.nb_edge), arg("verdict", s.verdict), arg("touched", touched));
   return touched.download_range(0, dm.nv);
 }
 
@@ -351,9 +279,9 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
     c.count.fill(0);
     c.cursor.fill(0);
     ensure(c.vt, ctx, size_t(nt) * 4);
-    run(ctx, F, "conn_count", nt, "", B(dm.tets), U(nt), B(c.count));
+    run(ctx, F, "conn_count", nt, arg("tets", dm.tets), arg("nt", nt), arg("count", c.count));
     scan_offsets(ctx, c.count, c.vt_off, nv);
-    run(ctx, F, "conn_scatter", nt, "", B(dm.tets), U(nt), B(c.vt_off), B(c.cursor), B(c.vt));
+    run(ctx, F, "conn_scatter", nt, arg("tets", dm.tets), arg("nt", nt), arg("vt_off", c.vt_off), arg("cursor", c.cursor), arg("vt", c.vt));
   }
   ensure(c.scratch, ctx, size_t(nt) * 12);
   ensure(c.up_count, ctx, nv);
@@ -361,59 +289,50 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   const bool cy = carry && carry->has_prev;
   const cl_int ci = cy ? 1 : 0;
   // carried data when cy (collapse_verdicts.cl), placeholders otherwise
-  const cl::Buffer& nd = cy ? B(carry->ndirty) : B(c.count);
-  const cl::Buffer& vo = cy ? B(carry->vold) : B(c.count);
-  const cl::Buffer& vm = cy ? B(carry->vmap) : B(c.count);
-  const cl::Buffer& pno = cy ? B(carry->prev_nb_off) : B(c.count);
-  const cl::Buffer& pnb = cy ? B(carry->prev_nb) : B(c.count);
-  run(ctx, F, "conn_ring_sort_and_gather", nv, "", B(dm.tets), U(nv), B(c.vt_off), B(c.vt), B(c.scratch),
-      B(c.count), B(c.up_count), cl_int(sorted ? 0 : 1), ci, nd, vo, vm, pno, pnb, cl_int(updated ? 1 : 0),
-      updated ? B(carry->vaff) : B(c.count));
+  const cl::Buffer& nd = cy ? carry->ndirty.buffer() : c.count.buffer();
+  const cl::Buffer& vo = cy ? carry->vold.buffer() : c.count.buffer();
+  const cl::Buffer& vm = cy ? carry->vmap.buffer() : c.count.buffer();
+  const cl::Buffer& pno = cy ? carry->prev_nb_off.buffer() : c.count.buffer();
+  const cl::Buffer& pnb = cy ? carry->prev_nb.buffer() : c.count.buffer();
+  run(ctx, F, "conn_ring_sort_and_gather", nv, arg("tets", dm.tets), arg("nv", nv), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("scratch", c.scratch), arg("nb_count", c.count), arg("up_count", c.up_count), arg("sort", cl_int(sorted ? 0 : 1)), arg("carry", ci), arg("ndirty", nd), arg("vold", vo), arg("vmap", vm), arg("prev_nb_off", pno), arg("prev_nb", pnb), arg("rename", cl_int(updated ? 1 : 0)), arg("prev_vaff", updated ? carry->vaff.buffer() : c.count.buffer()));
   uint32_t nnb = scan_offsets(ctx, c.count, c.nb_off, nv);
   c.ne = scan_offsets(ctx, c.up_count, c.edge_off, nv);
   ensure(c.nb, ctx, nnb);
   ensure(c.nb_edge, ctx, nnb);
   ensure(c.edges, ctx, size_t(c.ne) * 2);
-  run(ctx, F, "conn_write_neighbours", nv, "", U(nv), B(c.vt_off), B(c.scratch), B(c.nb_off), B(c.edge_off), B(c.nb),
-      B(c.nb_edge), B(c.edges));
-  run(ctx, F, "conn_lower_edges", nv, "", U(nv), B(c.nb_off), B(c.nb), B(c.edge_off), B(c.nb_edge), ci, nd, vo, pno,
-      cy ? B(carry->prev_edge_off) : B(c.count), cy ? B(carry->prev_nb_edge) : B(c.count));
+  run(ctx, F, "conn_write_neighbours", nv, arg("nv", nv), arg("vt_off", c.vt_off), arg("scratch", c.scratch), arg("nb_off", c.nb_off), arg("edge_off", c.edge_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("edges", c.edges));
+  run(ctx, F, "conn_lower_edges", nv, arg("nv", nv), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("edge_off", c.edge_off), arg("nb_edge", c.nb_edge), arg("carry", ci), arg("ndirty", nd), arg("vold", vo), arg("prev_nb_off", pno), arg("prev_edge_off", cy ? carry->prev_edge_off.buffer() : c.count.buffer()), arg("prev_nb_edge", cy ? carry->prev_nb_edge.buffer() : c.count.buffer()));
   ensure(c.eflags, ctx, c.ne);
   ensure(c.vflags, ctx, nv);
   ensure(c.vclass, ctx, nv);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   ensure(c.tet_nbr, ctx, size_t(nt) * 4);
   // carried boundary data
-  const cl::Buffer& to = cy ? B(carry->told) : B(c.vt);
-  const cl::Buffer& tn = cy ? B(carry->tnew) : B(c.vt_off);
-  const cl::Buffer& pt = cy ? B(carry->prev_tet_nbr) : B(c.vt);
-  const cl::Buffer& pvc = cy ? B(carry->prev_vclass) : B(c.vflags);
-  const cl::Buffer& pef = cy ? B(carry->prev_eflags) : B(c.vflags);
-  const cl::Buffer& pne = cy ? B(carry->prev_nb_edge) : B(c.nb_edge);
+  const cl::Buffer& to = cy ? carry->told.buffer() : c.vt.buffer();
+  const cl::Buffer& tn = cy ? carry->tnew.buffer() : c.vt_off.buffer();
+  const cl::Buffer& pt = cy ? carry->prev_tet_nbr.buffer() : c.vt.buffer();
+  const cl::Buffer& pvc = cy ? carry->prev_vclass.buffer() : c.vflags.buffer();
+  const cl::Buffer& pef = cy ? carry->prev_eflags.buffer() : c.vflags.buffer();
+  const cl::Buffer& pne = cy ? carry->prev_nb_edge.buffer() : c.nb_edge.buffer();
   if (updated) {
     // c.tet_nbr taken over above
   } else if (cy) {
-    run(ctx, F, "conn_tet_neighbours_carry", nt, "", U(nt), B(dm.tets), B(c.tet_nbr), nd, to, tn, pt);
+    run(ctx, F, "conn_tet_neighbours_carry", nt, arg("nt", nt), arg("tets", dm.tets), arg("tet_nbr", c.tet_nbr), arg("ndirty", nd), arg("told", to), arg("tnew", tn), arg("prev_tet_nbr", pt));
     // the full matching only for the dirty vertices
     ensure(c.dirty_list, ctx, nv);
     const uint32_t nd_count = dev::compact_indices(ctx, carry->dirty_flags, c.dirty_list, nv);
-    run(ctx, F, "conn_tet_neighbours", nd_count, "", U(nd_count), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr),
-        cl_int(1), B(c.dirty_list));
+    run(ctx, F, "conn_tet_neighbours", nd_count, arg("n", nd_count), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("use_list", cl_int(1)), arg("list", c.dirty_list));
   } else {
-    run(ctx, F, "conn_tet_neighbours", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), cl_int(0),
-        B(c.vt_off));
+    run(ctx, F, "conn_tet_neighbours", nv, arg("n", nv), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("use_list", cl_int(0)), arg("list", c.vt_off));
   }
   c.up_count.fill(0);  // scratch reuse (its scan is done): S bits per vertex
   ensure(c.owns_s, ctx, nt);
   ensure(c.smask, ctx, nt);
   static std::atomic<uint64_t> generations{0};  // unique across Connectivity objects
   c.generation = ++generations;
-  run(ctx, F, "conn_vertex_flags_faces", nt, "", U(nt), B(dm.tets), B(c.tet_nbr), primary_labels(dm), use_labels,
-      B(c.up_count), B(c.owns_s), B(c.smask));
-  run(ctx, F, "conn_vertex_flags", nv, "", U(nv), B(c.up_count), B(c.vflags));
-  run(ctx, F, "conn_surface_flags", nv, "", U(nv), B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), primary_labels(dm),
-      use_labels, B(dm.points), p.eps_r, p.eps_f, B(c.nb_off), B(c.nb), B(c.edge_off), B(c.vflags), B(c.smask),
-      B(c.eflags), B(c.vclass), ci, nd, vo, pno, pnb, pne, pef, pvc);
+  run(ctx, F, "conn_vertex_flags_faces", nt, arg("nt", nt), arg("tets", dm.tets), arg("tet_nbr", c.tet_nbr), arg("labels", primary_labels(dm)), arg("use_labels", use_labels), arg("bits", c.up_count), arg("owns_s", c.owns_s), arg("smask", c.smask));
+  run(ctx, F, "conn_vertex_flags", nv, arg("nv", nv), arg("bits", c.up_count), arg("vflags", c.vflags));
+  run(ctx, F, "conn_surface_flags", nv, arg("nv", nv), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("labels", primary_labels(dm)), arg("use_labels", use_labels), arg("pts", dm.points), arg("eps_r", p.eps_r), arg("eps_f", p.eps_f), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("edge_off", c.edge_off), arg("vflags", c.vflags), arg("smask", c.smask), arg("eflags", c.eflags), arg("vclass", c.vclass), arg("carry", ci), arg("ndirty", nd), arg("vold", vo), arg("prev_nb_off", pno), arg("prev_nb", pnb), arg("prev_nb_edge", pne), arg("prev_eflags", pef), arg("prev_vclass", pvc));
 }
 
 namespace {
@@ -430,14 +349,13 @@ uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   ensure(s.cost, ctx, c.ne);
   ensure(s.marked, ctx, c.ne);
   // with a user cost, its function comes before the kernel (see collapse_cost.cl)
-  cl::Kernel k = p.cost_source.empty()
-                     ? ctx.kernel("collapse_cost.cl", "cost_and_mark")
+  Kernel k = p.cost_source.empty()
+                     ? kernel(ctx, "collapse_cost.cl", "cost_and_mark")
                      : user_kernel(ctx, "user cost", "collapse_cost.cl", "cost_and_mark",
                                    "#line 1 \"cost_cl_source\"\n" + p.cost_source, "-DTCC_USER_COST");
   const cl_int mask_mode = dm.has_mask ? p.mask_mode : 0;
-  set_args(k, "cost_and_mark", U(c.ne), B(c.edges), B(dm.points), B(dm.vfields), U(dm.vfield_comps),
-           I(dm.vfield_comps > 0 ? 1 : 0), B(dm.vmask), mask_mode, p.target, B(s.cost), B(s.marked), B(s.counters));
-  launch_profiled(ctx, k, "cost_and_mark", c.ne);
+  k.set(arg("ne", c.ne), arg("edges", c.edges), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("has_vfield", dm.vfield_comps > 0 ? 1 : 0), arg("vmask", dm.vmask), arg("mask_mode", mask_mode), arg("target", p.target), arg("cost", s.cost), arg("marked", s.marked), arg("counters", s.counters));
+  k.launch(ctx, c.ne);
   return counter(s, 0);
 }
 
@@ -455,8 +373,7 @@ const cl::Buffer& tet_qualities(Context& ctx, DeviceMesh& dm, const Connectivity
   if (s.quality_generation == c.generation && s.tet_quality.size() == dm.nt) return s.tet_quality.buffer();
   const cl_int only_missing = s.quality_carried && s.tet_quality.size() == dm.nt ? 1 : 0;
   ensure(s.tet_quality, ctx, dm.nt);
-  run(ctx, "collapse_admissible.cl", "tet_quality", dm.nt, "", U(dm.nt), B(dm.tets), B(dm.points), B(s.tet_quality),
-      only_missing);
+  run(ctx, "collapse_admissible.cl", "tet_quality", dm.nt, arg("nt", dm.nt), arg("tets", dm.tets), arg("pts", dm.points), arg("quality", s.tet_quality), arg("only_missing", only_missing));
   s.quality_carried = false;
   s.quality_generation = c.generation;
   return s.tet_quality.buffer();
@@ -469,18 +386,11 @@ uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
   ensure(s.dir, ctx, c.ne);
   ensure(s.reason, ctx, c.ne);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
-  run_stage(ctx, p, "collapse_admissible.cl", "admissible", c.ne, U(c.ne), B(c.edges), B(s.marked), B(dm.tets),
-            B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb), B(c.nb_edge), primary_labels(dm), use_labels,
-            B(dm.points), B(dm.vfields), U(dm.vfield_comps), B(c.vflags), B(c.vclass), B(c.eflags), I(p.mode),
-            I(p.paper_rule ? 1 : 0), p.eps_v, p.min_quality, tet_qualities(ctx, dm, c, s, p), B(s.adm), B(s.dir),
-            B(s.reason), B(s.counters));
+  run_stage(ctx, p, "collapse_admissible.cl", "admissible", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("marked", s.marked), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("labels", primary_labels(dm)), arg("use_labels", use_labels), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("vflags", c.vflags), arg("vclass", c.vclass), arg("eflags", c.eflags), arg("mode", p.mode), arg("paper_rule", p.paper_rule ? 1 : 0), arg("eps_v", p.eps_v), arg("q_min", p.min_quality), arg("tet_quality", tet_qualities(ctx, dm, c, s, p)), arg("adm", s.adm), arg("edge_dir", s.dir), arg("reason", s.reason), arg("counters", s.counters));
   return counter(s, 1);
 }
 
 namespace {
-// The first arguments of every round kernel: n, first, list, next, next_n, cand, rivals, rcount.
-constexpr cl_uint kRoundArgs = 8;
-
 // Compacts the candidate edges (flags[e] != 0) into s.cand_edges and prepares the per-slot
 // rival storage; returns their number.
 uint32_t prepare_candidates(Context& ctx, EdgeState& s, const DeviceBuffer<uint32_t>& flags, uint32_t ne) {
@@ -528,40 +438,21 @@ void rounds(Context& ctx, EdgeState& s, uint32_t n, const char* what, const Roun
   }
 }
 
-// Sets the round kernel's arguments from `first_arg` on.
-template <class... A>
-void set_args_from(cl::Kernel& k, cl_uint first_arg, const char* what, const A&... a) {
-  detail::cl_call(what, [&] {
-    cl_uint i = first_arg;
-    (k.setArg(i++, a), ...);
-  });
-}
-template <class... A>
-void set_round_args(cl::Kernel& k, const char* what, const A&... a) {
-  set_args_from(k, kRoundArgs, what, a...);
-}
-
-// The first arguments of a pass-1 decide kernel: n, first, list, next, next_n, cand, edges,
-// slot, slot_next, state, vaff.
-constexpr cl_uint kDecideArgs = 11;
-
-// Pass-1 rounds (collapse_conflict.cl: pass1_claim, then `decide`, whose arguments from
-// kDecideArgs on are already set) over the n candidates of s.cand_edges until none is left
+// Pass-1 rounds (collapse_conflict.cl: pass1_claim, then `decide`, whose arguments other than
+// the round's are already set) over the n candidates of s.cand_edges until none is left
 // undecided. s.vaff must be -1 everywhere; it ends with the IN edge at each vertex.
-void pass1_rounds(Context& ctx, cl::Kernel& decide, EdgeState& s, const Connectivity& c, uint32_t nv, uint32_t n,
+void pass1_rounds(Context& ctx, Kernel& decide, EdgeState& s, const Connectivity& c, uint32_t nv, uint32_t n,
                   const char* what) {
   ensure(s.slot[0], ctx, nv);
   ensure(s.slot[1], ctx, nv);
   s.slot[0].fill(-1);
   s.slot[1].fill(-1);
-  cl::Kernel claim = ctx.kernel("collapse_conflict.cl", "pass1_claim");
+  Kernel claim = kernel(ctx, "collapse_conflict.cl", "pass1_claim");
   auto round = [&](uint32_t m, cl_int first, int cur) {
-    set_args(claim, "pass1_claim", U(m), first, B(s.work[cur]), B(s.cand_edges), B(c.edges), B(s.cost), B(s.vaff),
-             B(s.slot[cur]), B(s.state));
-    ctx.launch(claim, m, "pass1_claim");
-    set_args(decide, what, U(m), first, B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n), B(s.cand_edges), B(c.edges),
-             B(s.slot[cur]), B(s.slot[1 - cur]), B(s.state), B(s.vaff));
-    ctx.launch(decide, m, what);
+    claim.set(arg("n", m), arg("first", first), arg("list", s.work[cur]), arg("cand", s.cand_edges), arg("edges", c.edges), arg("cost", s.cost), arg("vaff", s.vaff), arg("slot", s.slot[cur]), arg("state", s.state));
+    claim.launch(ctx, m);
+    decide.set(arg("n", m), arg("first", first), arg("list", s.work[cur]), arg("next", s.work[1 - cur]), arg("next_n", s.work_n), arg("cand", s.cand_edges), arg("edges", c.edges), arg("slot", s.slot[cur]), arg("slot_next", s.slot[1 - cur]), arg("state", s.state), arg("vaff", s.vaff));
+    decide.launch(ctx, m);
   };
   rounds(ctx, s, n, what, round);
 }
@@ -574,18 +465,15 @@ namespace {
 // (counted in s.work_n[1 - cur]; s.work_n[3]: those without a verdict). `recompute` and `turns`
 // are the kernels lazy_p1_recompute and lazy_p1_turns, made once by the caller. With slotp (the
 // matching selection) the slots' priorities are kept there too.
-void vertex_part(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kernel& recompute, cl::Kernel& turns,
+void vertex_part(Context& ctx, EdgeState& s, const Connectivity& c, Kernel& recompute, Kernel& turns,
                  const DeviceBuffer<double>& order, int cur, cl_uint round, DeviceBuffer<double>* slotp = nullptr,
                  bool waiting = false) {
   uint32_t nd = 0;
   s.work_n.download(&nd, 1, 2);
-  set_args(recompute, "lazy_p1_recompute", U(nd), B(s.dlist), B(c.nb_off), B(c.nb_edge), B(s.state), B(order),
-           B(s.slot[0]), slotp ? B(*slotp) : B(order), cl_int(slotp ? 1 : 0));
-  ctx.launch(recompute, nd, "lazy_p1_recompute");
-  set_args(turns, "lazy_p1_turns", U(nd), B(s.dlist), B(c.edges), B(s.slot[0]), B(s.work[1 - cur]), B(s.work_n),
-           cl_uint(1 - cur), B(s.queued), round + 1, B(s.verdict), cl_int(waiting ? 1 : 0),
-           waiting ? B(s.whead) : B(s.slot[0]), waiting ? B(s.wnext) : B(s.slot[0]));
-  ctx.launch(turns, nd, "lazy_p1_turns");
+  recompute.set(arg("n", nd), arg("dlist", s.dlist), arg("nb_off", c.nb_off), arg("nb_edge", c.nb_edge), arg("state", s.state), arg("cost", order), arg("slot", s.slot[0]), arg("slotp", slotp ? slotp->buffer() : order.buffer()), arg("with_slotp", cl_int(slotp ? 1 : 0)));
+  recompute.launch(ctx, nd);
+  turns.set(arg("n", nd), arg("dlist", s.dlist), arg("edges", c.edges), arg("slot", s.slot[0]), arg("tlist", s.work[1 - cur]), arg("cnt", s.work_n), arg("which", cl_uint(1 - cur)), arg("queued", s.queued), arg("round", round + 1), arg("verdict", s.verdict), arg("waiting", cl_int(waiting ? 1 : 0)), arg("whead", waiting ? s.whead.buffer() : s.slot[0].buffer()), arg("wnext", waiting ? s.wnext.buffer() : s.slot[0].buffer()));
+  turns.launch(ctx, nd);
 }
 
 // Pass 1 of the lazy filter over the candidates (s.cand[e] != 0 for e < ne; lazy_init made them
@@ -595,7 +483,7 @@ void vertex_part(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kernel& 
 // at most p.loop_tests edges to test (the others take the verdict carried from the previous
 // iteration, cheap) and at most p.loop_turns in all; the loop hands back to the per-round
 // kernels when a list has more than p.loop_exit_tests to test.
-void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kernel& decide, cl::Kernel& loop,
+void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, Kernel& decide, Kernel& loop,
                     const StageParams& p) {
   const std::string A = "collapse_admissible.cl";
   const uint32_t n = c.ne;  // bounds the candidates
@@ -608,12 +496,11 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kerne
   s.queued.fill(0xffffffffu);
   s.work_n.fill(0);
   if (n == 0) return;
-  run(ctx, A, "lazy_p1_first_turns", n, "", U(n), B(s.cand), B(c.edges), B(s.slot[0]), B(s.work[0]), B(s.work_n),
-      B(s.verdict));
+  run(ctx, A, "lazy_p1_first_turns", n, arg("ne", n), arg("cand", s.cand), arg("edges", c.edges), arg("slot", s.slot[0]), arg("tlist", s.work[0]), arg("cnt", s.work_n), arg("verdict", s.verdict));
   uint32_t cnt[4];
   s.work_n.download(cnt, 4);
   uint32_t nt = cnt[0], nu = cnt[3];
-  cl::Kernel recompute = ctx.kernel(A, "lazy_p1_recompute"), turns = ctx.kernel(A, "lazy_p1_turns");
+  Kernel recompute = kernel(ctx, A, "lazy_p1_recompute"), turns = kernel(ctx, A, "lazy_p1_turns");
   int cur = 0;  // the list of this round
   cl_uint round = 0;
   while (nt > 0) {
@@ -622,10 +509,8 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kerne
     const bool one_group = nu <= p.loop_tests && nt <= p.loop_turns;
     if (one_group) {
       s.resume.fill(0);
-      set_args(loop, "lazy_p1_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(s.dlist),
-               B(s.queued), B(c.edges), B(s.cost), B(s.slot[0]), B(s.state), B(s.vaff), cl_uint(p.loop_exit_tests),
-               B(s.resume));
-      ctx.launch_one_group(loop, "lazy_p1_loop");
+      loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.work[0]), arg("t1", s.work[1]), arg("cnt", s.work_n), arg("dlist", s.dlist), arg("queued", s.queued), arg("edges", c.edges), arg("cost", s.cost), arg("slot", s.slot[0]), arg("state", s.state), arg("vaff", s.vaff), arg("max_tests", cl_uint(p.loop_exit_tests)), arg("resume", s.resume));
+      loop.launch_one_group(ctx);
       uint32_t r[3];
       s.resume.download(r, 3);
       nt = r[0];  // 0: every round done; else the loop stopped before a list with many to test
@@ -633,9 +518,8 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, cl::Kerne
       cur = int(r[1]);
       round = r[2];
     } else {
-      set_args(decide, "lazy_p1_decide", U(nt), B(s.work[cur]), B(c.edges), B(s.state), B(s.vaff), B(s.slot[0]),
-               B(s.dlist), B(s.work_n));
-      ctx.launch(decide, nt, "lazy_p1_decide");
+      decide.set(arg("n", nt), arg("tlist", s.work[cur]), arg("edges", c.edges), arg("state", s.state), arg("vaff", s.vaff), arg("slot", s.slot[0]), arg("dlist", s.dlist), arg("cnt", s.work_n));
+      decide.launch(ctx, nt);
       vertex_part(ctx, s, c, recompute, turns, s.cost, cur, round);
       s.work_n.download(cnt, 4);
       nt = cnt[1 - cur];
@@ -659,12 +543,12 @@ uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
   ensure(s.state, ctx, c.ne);
   ensure(s.vaff, ctx, dm.nv);
   s.vaff.fill(-1);
-  run(ctx, F, "conflict_init", c.ne, "", U(c.ne), B(s.adm), B(s.state));
+  run(ctx, F, "conflict_init", c.ne, arg("ne", c.ne), arg("adm", s.adm), arg("state", s.state));
   ensure(s.cand_edges, ctx, c.ne);
   const uint32_t n = dev::compact_indices(ctx, s.adm, s.cand_edges, c.ne);
-  cl::Kernel decide = ctx.kernel(F, "conflict_pass1_decide");
+  Kernel decide = kernel(ctx, F, "conflict_pass1_decide");
   pass1_rounds(ctx, decide, s, c, dm.nv, n, "conflict_pass1_decide");
-  run(ctx, F, "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1), B(s.vaff), B(s.counters));
+  run(ctx, F, "conflict_pass1_finish", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("state", s.state), arg("p1", s.p1), arg("vaff", s.vaff), arg("counters", s.counters));
   return counter(s, 2);
 }
 
@@ -673,7 +557,7 @@ namespace {
 // (candidates, Q, carried refusals, the first claims in s.slot[0] in the order of `order`), and
 // the test's arguments of each kernel of `tests` (from the given argument index on).
 void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
-                const DeviceBuffer<double>& order, std::initializer_list<std::pair<cl::Kernel*, cl_uint>> tests,
+                const DeviceBuffer<double>& order, std::initializer_list<Kernel*> tests,
                 bool keep_refused = false) {
   const std::string A = "collapse_admissible.cl";
   s.in_place = false;
@@ -693,16 +577,16 @@ void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, con
   s.restrict_clean = false;
   ensure(s.slot[0], ctx, dm.nv);
   s.slot[0].fill(-1);
-  run_stage(ctx, p, A, "lazy_init", c.ne, U(c.ne), B(c.edges), B(s.marked), B(c.vflags), B(c.vclass), B(c.eflags),
-            mode, paper_rule, B(dm.points), B(dm.vfields), U(dm.vfield_comps), B(s.state), B(s.dir), B(s.reason),
-            B(s.cand), B(s.counters), cl_int(restrict_clean ? 1 : 0), restrict_clean ? B(s.vdirty) : B(c.vflags),
-            B(s.verdict), B(order), B(s.slot[0]), cl_int(keep_refused ? 1 : 0));
+  run_stage(ctx, p, A, "lazy_init", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("marked", s.marked), arg("vflags", c.vflags), arg("vclass", c.vclass), arg("eflags", c.eflags), arg("mode", mode), arg("paper_rule", paper_rule), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("state", s.state), arg("edge_dir", s.dir), arg("reason", s.reason), arg("cand", s.cand), arg("counters", s.counters), arg("restrict_clean", cl_int(restrict_clean ? 1 : 0)), arg("vdirty", restrict_clean ? s.vdirty.buffer() : c.vflags.buffer()), arg("verdict", s.verdict), arg("cost", order), arg("slot", s.slot[0]), arg("keep_refused", cl_int(keep_refused ? 1 : 0)));
   const cl::Buffer& quality = tet_qualities(ctx, dm, c, s, p);
-  for (auto [k, first] : tests)
-    set_args_from(*k, first, "lazy filter test", B(dm.tets), B(c.vt_off), B(c.vt), B(c.tet_nbr), B(c.nb_off), B(c.nb),
-                  B(c.nb_edge), primary_labels(dm), use_labels, B(dm.points), B(dm.vfields), U(dm.vfield_comps),
-                  B(c.vflags), B(c.vclass), B(c.eflags), mode, paper_rule, p.eps_v, p.min_quality, quality, B(s.dir),
-                  B(s.reason), B(s.counters), B(s.verdict));
+  for (Kernel* k : tests)
+    k->set(arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr),
+           arg("nb_off", c.nb_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("labels", primary_labels(dm)),
+           arg("use_labels", use_labels), arg("pts", dm.points), arg("vfield", dm.vfields),
+           arg("vfield_stride", dm.vfield_comps), arg("vflags", c.vflags), arg("vclass", c.vclass),
+           arg("eflags", c.eflags), arg("mode", mode), arg("paper_rule", paper_rule), arg("eps_v", p.eps_v),
+           arg("q_min", p.min_quality), arg("tet_quality", quality), arg("edge_dir", s.dir), arg("reason", s.reason),
+           arg("counters", s.counters), arg("verdict", s.verdict));
 }
 }  // namespace
 
@@ -710,11 +594,10 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
                                uint32_t& passed_q, uint32_t& tested) {
   const std::string A = "collapse_admissible.cl";
   // the test's arguments, the same for the per-round kernel and the one-work-group loop
-  cl::Kernel decide = stage_kernel(ctx, p, A, "lazy_p1_decide"), loop = stage_kernel(ctx, p, A, "lazy_p1_loop");
-  lazy_start(ctx, dm, c, s, p, s.cost, {{&decide, 8}, {&loop, 15}});
+  Kernel decide = stage_kernel(ctx, p, A, "lazy_p1_decide"), loop = stage_kernel(ctx, p, A, "lazy_p1_loop");
+  lazy_start(ctx, dm, c, s, p, s.cost, {&decide, &loop});
   lazy_p1_rounds(ctx, s, c, decide, loop, p);
-  run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, "", U(c.ne), B(c.edges), B(s.state), B(s.p1),
-      B(s.vaff), B(s.counters));
+  run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("state", s.state), arg("p1", s.p1), arg("vaff", s.vaff), arg("counters", s.counters));
   uint32_t cnt[6];
   s.counters.download(cnt, 6);
   passed_q = cnt[5];
@@ -728,8 +611,7 @@ namespace {
 const DeviceBuffer<double>& selection_priority(Context& ctx, Connectivity& c, EdgeState& s, const StageParams& p) {
   if (!(p.priority_levels > 0)) return s.cost;
   ensure(s.prio, ctx, c.ne);
-  run(ctx, "collapse_admissible.cl", "greedy_priority", c.ne, "", U(c.ne), B(s.cost), B(s.marked), p.target,
-      p.priority_levels, B(s.prio));
+  run(ctx, "collapse_admissible.cl", "greedy_priority", c.ne, arg("ne", c.ne), arg("cost", s.cost), arg("marked", s.marked), arg("target", p.target), arg("levels", p.priority_levels), arg("prio", s.prio));
   return s.prio;
 }
 
@@ -765,8 +647,7 @@ template <class Round, class Loop>
 uint32_t selection_rounds(Context& ctx, Connectivity& c, EdgeState& s, const StageParams& p, const char* name,
                           const Round& one_round, const Loop& loop, uint32_t& passed_q, uint32_t& tested) {
   const std::string A = "collapse_admissible.cl";
-  run(ctx, A, "lazy_p1_first_turns", c.ne, "", U(c.ne), B(s.cand), B(c.edges), B(s.slot[0]), B(s.work[0]), B(s.work_n),
-      B(s.verdict));
+  run(ctx, A, "lazy_p1_first_turns", c.ne, arg("ne", c.ne), arg("cand", s.cand), arg("edges", c.edges), arg("slot", s.slot[0]), arg("tlist", s.work[0]), arg("cnt", s.work_n), arg("verdict", s.verdict));
   uint32_t nt = 0;
   s.work_n.download(&nt, 1);
   int cur = 0;  // the turn list of this round
@@ -794,7 +675,7 @@ uint32_t selection_rounds(Context& ctx, Connectivity& c, EdgeState& s, const Sta
                    one_group ? " (one work-group)" : "");
     }
   }
-  run(ctx, A, "greedy_finish", c.ne, "", U(c.ne), B(s.state), B(s.p1), B(s.fin), B(s.counters));
+  run(ctx, A, "greedy_finish", c.ne, arg("ne", c.ne), arg("state", s.state), arg("p1", s.p1), arg("fin", s.fin), arg("counters", s.counters));
   uint32_t cnt[6];
   s.counters.download(cnt, 6);
   passed_q = cnt[5];
@@ -806,29 +687,24 @@ uint32_t selection_rounds(Context& ctx, Connectivity& c, EdgeState& s, const Sta
 uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                           uint32_t& passed_q, uint32_t& tested) {
   const std::string A = "collapse_admissible.cl";
-  cl::Kernel decide = stage_kernel(ctx, p, A, "greedy_decide"), loop = stage_kernel(ctx, p, A, "greedy_loop");
+  Kernel decide = stage_kernel(ctx, p, A, "greedy_decide"), loop = stage_kernel(ctx, p, A, "greedy_loop");
   // the priority first: lazy_init claims the first slots in its order
   const DeviceBuffer<double>& prio = selection_priority(ctx, c, s, p);
-  lazy_start(ctx, dm, c, s, p, prio, {{&decide, 19}, {&loop, 21}});
+  lazy_start(ctx, dm, c, s, p, prio, {&decide, &loop});
   selection_buffers(ctx, dm, c, s);
   const cl_int W = p.waiting_lists ? 1 : 0;
-  cl::Kernel block = ctx.kernel(A, "greedy_block"), recompute = ctx.kernel(A, "lazy_p1_recompute"),
-             turns = ctx.kernel(A, "lazy_p1_turns");
+  Kernel block = kernel(ctx, A, "greedy_block"), recompute = kernel(ctx, A, "lazy_p1_recompute"),
+             turns = kernel(ctx, A, "lazy_p1_turns");
   auto one_round = [&](uint32_t nt, int cur, cl_uint round) {
-    set_args_from(decide, 0, "greedy_decide", U(nt), cl_uint(cur), B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n),
-                  B(c.edges), B(prio), B(s.slot[0]), B(s.blocker), B(s.queued), round, B(s.inlist), B(s.vstamp),
-                  B(s.dlist), B(s.state), B(s.vaff), W, B(s.whead), B(s.wnext));
-    ctx.launch(decide, nt, "greedy_decide");
-    set_args(block, "greedy_block", B(s.inlist), B(s.work_n), B(c.edges), B(c.nb_off), B(c.nb), B(c.nb_edge),
-             B(s.slot[0]), B(s.vstamp), round, B(s.dlist), B(s.state));
-    ctx.launch(block, nt, "greedy_block");  // over the round's taken edges (cnt[4] <= nt)
+    decide.set(arg("n", nt), arg("cur", cl_uint(cur)), arg("tlist", s.work[cur]), arg("tnext", s.work[1 - cur]), arg("cnt", s.work_n), arg("edges", c.edges), arg("prio", prio), arg("slot", s.slot[0]), arg("blocker", s.blocker), arg("queued", s.queued), arg("round", round), arg("inlist", s.inlist), arg("vstamp", s.vstamp), arg("dlist", s.dlist), arg("state", s.state), arg("vaff", s.vaff), arg("waiting", W), arg("whead", s.whead), arg("wnext", s.wnext));
+    decide.launch(ctx, nt);
+    block.set(arg("inlist", s.inlist), arg("cnt", s.work_n), arg("edges", c.edges), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("slot", s.slot[0]), arg("vstamp", s.vstamp), arg("round", round), arg("dlist", s.dlist), arg("state", s.state));
+    block.launch(ctx, nt);  // over the round's taken edges (cnt[4] <= nt)
     vertex_part(ctx, s, c, recompute, turns, prio, cur, round, nullptr, p.waiting_lists);
   };
   auto in_one_group = [&](uint32_t nt, int cur, cl_uint round) {
-    set_args(loop, "greedy_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
-             B(prio), B(s.slot[0]), B(s.blocker), B(s.queued), B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state),
-             B(s.vaff), U(p.greedy_loop_exit), B(s.resume), W, B(s.whead), B(s.wnext));
-    ctx.launch_one_group(loop, "greedy_loop");
+    loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.work[0]), arg("t1", s.work[1]), arg("cnt", s.work_n), arg("edges", c.edges), arg("prio", prio), arg("slot", s.slot[0]), arg("blocker", s.blocker), arg("queued", s.queued), arg("inlist", s.inlist), arg("vstamp", s.vstamp), arg("dlist", s.dlist), arg("state", s.state), arg("vaff", s.vaff), arg("max_n", p.greedy_loop_exit), arg("resume", s.resume), arg("waiting", W), arg("whead", s.whead), arg("wnext", s.wnext));
+    loop.launch_one_group(ctx);
   };
   return selection_rounds(ctx, c, s, p, "greedy_round", one_round, in_one_group, passed_q, tested);
 }
@@ -836,43 +712,36 @@ uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
 uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                             uint32_t& passed_q, uint32_t& tested) {
   const std::string A = "collapse_admissible.cl", M = "collapse_matching.cl";
-  cl::Kernel decide = stage_kernel(ctx, p, M, "match_decide"), apply = stage_kernel(ctx, p, M, "match_apply"),
+  Kernel decide = stage_kernel(ctx, p, M, "match_decide"), apply = stage_kernel(ctx, p, M, "match_apply"),
              loop = stage_kernel(ctx, p, M, "match_loop");
   // the priority first: lazy_init claims the first slots in its order
   const DeviceBuffer<double>& prio = selection_priority(ctx, c, s, p);
   // the test's arguments (TCC_MATCH_PARAMS): the lazy filter's, then the live test's
-  constexpr cl_uint kDecide = 22, kApply = 10, kLoop = 25, kTestArgs = 24;
-  lazy_start(ctx, dm, c, s, p, prio, {{&decide, kDecide}, {&apply, kApply}, {&loop, kLoop}}, true);
+  lazy_start(ctx, dm, c, s, p, prio, {&decide, &apply, &loop}, true);
   s.in_place = true;
   ensure(s.tdead, ctx, std::max<size_t>(dm.nt, 1));
   ensure(s.tkill, ctx, std::max<size_t>(dm.nt, 1));
   ensure(s.dround, ctx, c.ne);
   s.tdead.fill(0);
-  for (auto [k, first] : {std::pair{&decide, kDecide}, {&apply, kApply}, {&loop, kLoop}})
-    set_args_from(*k, first + kTestArgs, "match test", p.eps_r, p.eps_f, B(s.tdead));
+  for (Kernel* k : {&decide, &apply, &loop})
+    k->set(arg("eps_r", p.eps_r), arg("eps_f", p.eps_f), arg("tdead", s.tdead));
   selection_buffers(ctx, dm, c, s);
   ensure(s.spec, ctx, c.ne);
   s.spec.fill(p.match_early_tests ? 0 : 1);  // 1: the early test counts as done
   ensure(s.slotp, ctx, dm.nv);
-  run(ctx, A, "slot_priority", dm.nv, "", U(dm.nv), B(s.slot[0]), B(prio), B(s.slotp));
+  run(ctx, A, "slot_priority", dm.nv, arg("nv", dm.nv), arg("slot", s.slot[0]), arg("prio", prio), arg("slotp", s.slotp));
   const cl_int W = p.waiting_lists ? 1 : 0;
-  cl::Kernel recompute = ctx.kernel(A, "lazy_p1_recompute"), turns = ctx.kernel(A, "lazy_p1_turns");
+  Kernel recompute = kernel(ctx, A, "lazy_p1_recompute"), turns = kernel(ctx, A, "lazy_p1_turns");
   auto one_round = [&](uint32_t nt, int cur, cl_uint round) {
-    set_args_from(decide, 0, "match_decide", U(nt), cl_uint(cur), B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n),
-                  B(c.edges), B(prio), B(s.slot[0]), B(s.slotp), B(s.blocker), B(s.spec), B(s.dround), B(s.queued),
-                  round, B(s.inlist), B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff), W, B(s.whead), B(s.wnext));
-    ctx.launch(decide, nt, "match_decide");
-    set_args_from(apply, 0, "match_apply", B(s.inlist), B(s.work_n), B(c.edges), B(s.slot[0]), B(s.vstamp), round,
-                  B(s.dlist), B(s.state), B(s.vaff), B(s.tkill));
-    ctx.launch(apply, nt, "match_apply");  // over the round's taken edges (cnt[4] <= nt)
+    decide.set(arg("n", nt), arg("cur", cl_uint(cur)), arg("tlist", s.work[cur]), arg("tnext", s.work[1 - cur]), arg("cnt", s.work_n), arg("edges", c.edges), arg("prio", prio), arg("slot", s.slot[0]), arg("slotp", s.slotp), arg("blocker", s.blocker), arg("spec", s.spec), arg("dround", s.dround), arg("queued", s.queued), arg("round", round), arg("inlist", s.inlist), arg("vstamp", s.vstamp), arg("dlist", s.dlist), arg("state", s.state), arg("vaff", s.vaff), arg("waiting", W), arg("whead", s.whead), arg("wnext", s.wnext));
+    decide.launch(ctx, nt);
+    apply.set(arg("inlist", s.inlist), arg("cnt", s.work_n), arg("edges", c.edges), arg("slot", s.slot[0]), arg("vstamp", s.vstamp), arg("round", round), arg("dlist", s.dlist), arg("state", s.state), arg("vaff", s.vaff), arg("tkill", s.tkill));
+    apply.launch(ctx, nt);  // over the round's taken edges (cnt[4] <= nt)
     vertex_part(ctx, s, c, recompute, turns, prio, cur, round, &s.slotp, p.waiting_lists);
   };
   auto in_one_group = [&](uint32_t nt, int cur, cl_uint round) {
-    set_args(loop, "match_loop", U(nt), cl_int(cur), round, B(s.work[0]), B(s.work[1]), B(s.work_n), B(c.edges),
-             B(prio), B(s.slot[0]), B(s.slotp), B(s.blocker), B(s.spec), B(s.dround), B(s.queued), B(s.inlist),
-             B(s.vstamp), B(s.dlist), B(s.state), B(s.vaff), B(s.tkill), U(p.greedy_loop_exit), B(s.resume), W,
-             B(s.whead), B(s.wnext));
-    ctx.launch_one_group(loop, "match_loop");
+    loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.work[0]), arg("t1", s.work[1]), arg("cnt", s.work_n), arg("edges", c.edges), arg("prio", prio), arg("slot", s.slot[0]), arg("slotp", s.slotp), arg("blocker", s.blocker), arg("spec", s.spec), arg("dround", s.dround), arg("queued", s.queued), arg("inlist", s.inlist), arg("vstamp", s.vstamp), arg("dlist", s.dlist), arg("state", s.state), arg("vaff", s.vaff), arg("tkill", s.tkill), arg("max_n", p.greedy_loop_exit), arg("resume", s.resume), arg("waiting", W), arg("whead", s.whead), arg("wnext", s.wnext));
+    loop.launch_one_group(ctx);
   };
   return selection_rounds(ctx, c, s, p, "match_round", one_round, in_one_group, passed_q, tested);
 }
@@ -924,11 +793,9 @@ uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
     // (the list's new part starts at done: marked through an offset sub-range of work[0])
     std::vector<uint32_t> fresh = s.work[0].download_range(done, n - done);
     s.work[1].upload(fresh.data(), fresh.size());
-    run(ctx, M, "match_undo_reach", fresh.size(), "", U(fresh.size()), B(s.work[1]), B(c.edges), B(c.nb_off), B(c.nb),
-        B(s.dround), B(s.reachmin));
+    run(ctx, M, "match_undo_reach", fresh.size(), arg("n", fresh.size()), arg("list", s.work[1]), arg("edges", c.edges), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("dround", s.dround), arg("reachmin", s.reachmin));
     done = n;
-    run(ctx, M, "match_undo_grow", taken, "", U(taken), B(s.cand_edges), B(c.edges), B(s.dround), B(s.reachmin),
-        B(s.undo), B(s.work[0]), B(s.work_n));
+    run(ctx, M, "match_undo_grow", taken, arg("n", taken), arg("taken", s.cand_edges), arg("edges", c.edges), arg("dround", s.dround), arg("reachmin", s.reachmin), arg("undo", s.undo), arg("list", s.work[0]), arg("count", s.work_n));
     s.work_n.download(&n, 1);
   }
   // undone in the reverse order of their rounds (then of their index: any order within a round)
@@ -947,37 +814,31 @@ uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   for (uint32_t i = 0; i < n; ++i) sorted[i] = order[idx[i]];
   s.work[1].upload(sorted.data(), n);
   if (undone) *undone = sorted;
-  run(ctx, M, "match_undo", 1, "", U(n), B(s.work[1]), B(s.refused), B(c.edges), B(s.dir), B(dm.tets), B(c.vt_off),
-      B(c.vt), B(c.tet_nbr), B(s.tdead), B(s.tkill), B(dm.points), B(dm.vfields), U(dm.vfield_comps), B(s.points0),
-      B(s.vfields0), B(s.vaff), B(s.state), B(s.fin), B(s.reason));
+  run(ctx, M, "match_undo", 1, arg("n", n), arg("order", s.work[1]), arg("refused", s.refused), arg("edges", c.edges), arg("edge_dir", s.dir), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("tdead", s.tdead), arg("tkill", s.tkill), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("pts0", s.points0), arg("vfield0", s.vfields0), arg("vaff", s.vaff), arg("state", s.state), arg("fin", s.fin), arg("reason", s.reason));
   return n;
 }
 
 uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s, uint32_t loop_size) {
   const std::string F = "collapse_conflict.cl";
   ensure(s.fin, ctx, c.ne);
-  run(ctx, F, "conflict_pass2_init", c.ne, "", U(c.ne), B(s.p1), B(s.state));
+  run(ctx, F, "conflict_pass2_init", c.ne, arg("ne", c.ne), arg("p1", s.p1), arg("state", s.state));
   const uint32_t n = prepare_candidates(ctx, s, s.p1, c.ne);
-  cl::Kernel round = ctx.kernel(F, "conflict_pass2_round"), loop = ctx.kernel(F, "conflict_pass2_loop");
-  set_round_args(round, "conflict_pass2_round", B(c.edges), B(s.cost), B(c.nb_off), B(c.nb), B(s.vaff), B(s.state));
-  set_args_from(loop, kRoundArgs + 1, "conflict_pass2_loop", B(c.edges), B(s.cost), B(c.nb_off), B(c.nb), B(s.vaff),
-                B(s.state));
+  Kernel round = kernel(ctx, F, "conflict_pass2_round"), loop = kernel(ctx, F, "conflict_pass2_loop");
+  round.set(arg("edges", c.edges), arg("cost", s.cost), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("vaff", s.vaff), arg("state", s.state));
+  loop.set(arg("edges", c.edges), arg("cost", s.cost), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("vaff", s.vaff), arg("state", s.state));
   // the last rounds (at most loop_size candidates left) in one work-group
   auto tail = [&](uint32_t m, cl_int first, int cur) {
-    set_args(loop, "conflict_pass2_loop", U(m), first, cl_int(cur), B(s.work[0]), B(s.work[1]), B(s.work_n),
-             B(s.cand_edges), B(s.rivals), B(s.rcount));
-    ctx.launch_one_group(loop, "conflict_pass2_loop");
+    loop.set(arg("n", m), arg("first", first), arg("cur", cl_int(cur)), arg("l0", s.work[0]), arg("l1", s.work[1]), arg("next_n", s.work_n), arg("cand", s.cand_edges), arg("rivals", s.rivals), arg("rcount", s.rcount));
+    loop.launch_one_group(ctx);
   };
   rounds(
       ctx, s, n, "conflict_pass2_round",
       [&](uint32_t m, cl_int first, int cur) {
-        set_args(round, "conflict_pass2_round", U(m), first, B(s.work[cur]), B(s.work[1 - cur]), B(s.work_n),
-                 B(s.cand_edges), B(s.rivals), B(s.rcount));
-        ctx.launch(round, m, "conflict_pass2_round");
+        round.set(arg("n", m), arg("first", first), arg("list", s.work[cur]), arg("next", s.work[1 - cur]), arg("next_n", s.work_n), arg("cand", s.cand_edges), arg("rivals", s.rivals), arg("rcount", s.rcount));
+        round.launch(ctx, m);
       },
       &tail, loop_size);
-  run(ctx, F, "conflict_finalize", c.ne, "", U(c.ne), B(c.edges), B(s.p1), B(s.state), B(s.fin), B(s.vaff),
-      B(s.counters));
+  run(ctx, F, "conflict_finalize", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("p1", s.p1), arg("state", s.state), arg("fin", s.fin), arg("vaff", s.vaff), arg("counters", s.counters));
   return counter(s, 3);
 }
 
@@ -988,11 +849,11 @@ void collapse_and_compact(Context& ctx, const StageParams& p, DeviceMesh& dm, De
   // vertices
   DeviceBuffer<uint32_t>& vkeep = c.count;  // scratch reuse: nv entries
   DeviceBuffer<uint32_t>& vnew = c.cursor;
-  run(ctx, F, "vertex_keep", nv, "", U(nv), B(s.vaff), B(c.edges), B(s.dir), B(vkeep));
+  run(ctx, F, "vertex_keep", nv, arg("nv", nv), arg("vaff", s.vaff), arg("edges", c.edges), arg("edge_dir", s.dir), arg("keep", vkeep));
   const uint32_t nv2 = dev::exclusive_scan(ctx, vkeep, vnew, nv);
   DeviceBuffer<int32_t>& vmap = s.vmap;  // kept for build_connectivity's carry
   ensure(vmap, ctx, nv);
-  run(ctx, F, "vertex_map", nv, "", U(nv), B(s.vaff), B(c.edges), B(s.dir), B(vnew), B(vkeep), B(vmap));
+  run(ctx, F, "vertex_map", nv, arg("nv", nv), arg("vaff", s.vaff), arg("edges", c.edges), arg("edge_dir", s.dir), arg("newidx", vnew), arg("keep", vkeep), arg("vmap", vmap));
   next.nv = nv2;
   ensure(next.points, ctx, size_t(nv2) * 3);
   ensure(next.vfields, ctx, size_t(nv2) * dm.vfield_comps);
@@ -1002,53 +863,46 @@ void collapse_and_compact(Context& ctx, const StageParams& p, DeviceMesh& dm, De
   next.has_mask = dm.has_mask;
   next.has_labels = dm.has_labels;
   const cl_int in_place = s.in_place ? 1 : 0;
-  run_stage(ctx, p, F, "vertex_write", nv, U(nv), B(s.vaff), B(c.edges), B(s.dir), B(vkeep), B(vnew), B(dm.points),
-      B(next.points), U(dm.vfield_comps), B(dm.vfields), B(next.vfields), I(dm.has_mask ? 1 : 0), B(dm.vmask),
-      B(next.vmask), in_place);
+  run_stage(ctx, p, F, "vertex_write", nv, arg("nv", nv), arg("vaff", s.vaff), arg("edges", c.edges), arg("edge_dir", s.dir), arg("keep", vkeep), arg("newidx", vnew), arg("pts", dm.points), arg("out_pts", next.points), arg("ncomp", dm.vfield_comps), arg("vfields", dm.vfields), arg("out_vfields", next.vfields), arg("has_mask", dm.has_mask ? 1 : 0), arg("vmask", dm.vmask), arg("out_vmask", next.vmask), arg("in_place", in_place));
   // tets
   DeviceBuffer<uint32_t>& tkeep = s.tkeep;  // kept for note_compaction
   DeviceBuffer<uint32_t>& tnew = s.tnew;
   ensure(tkeep, ctx, nt);
   ensure(tnew, ctx, nt);
-  run(ctx, F, "tet_keep", nt, "", U(nt), B(dm.tets), B(s.vaff), B(c.edges), B(tkeep), in_place,
-      s.in_place ? B(s.tdead) : B(vkeep));
+  run(ctx, F, "tet_keep", nt, arg("nt", nt), arg("tets", dm.tets), arg("vaff", s.vaff), arg("edges", c.edges), arg("keep", tkeep), arg("in_place", in_place), arg("tdead", s.in_place ? s.tdead.buffer() : vkeep.buffer()));
   const uint32_t nt2 = dev::exclusive_scan(ctx, tkeep, tnew, nt);
   next.nt = nt2;
   ensure(next.tets, ctx, size_t(nt2) * 4);
-  run(ctx, F, "tet_write", nt, "", U(nt), B(dm.tets), B(tkeep), B(tnew), B(vmap), B(next.tets));
+  run(ctx, F, "tet_write", nt, arg("nt", nt), arg("tets", dm.tets), arg("keep", tkeep), arg("newidx", tnew), arg("vmap", vmap), arg("out_tets", next.tets));
   // the quality guard's qualities of the tets no collapse touched (tet_qualities); like the
   // connectivity, only when carrying was asked for (remember_for_carry), so that
   // reuse_across_iterations = false computes every quality afresh and the tests compare both
   s.quality_carried = s.update_next && s.quality_generation == c.generation && s.tet_quality.size() == nt && nt2 > 0;
   if (s.quality_carried) {
     ensure(s.tet_quality_next, ctx, nt2);
-    run(ctx, "collapse_admissible.cl", "tet_quality_carry", nt, "", U(nt), B(dm.tets), B(tkeep), B(tnew), B(s.vaff),
-        B(s.tet_quality), B(s.tet_quality_next));
+    run(ctx, "collapse_admissible.cl", "tet_quality_carry", nt, arg("nt", nt), arg("tets", dm.tets), arg("keep", tkeep), arg("newidx", tnew), arg("vaff", s.vaff), arg("quality", s.tet_quality), arg("out", s.tet_quality_next));
     std::swap(s.tet_quality, s.tet_quality_next);
   }
   next.labels.resize(dm.labels.size());
   for (size_t l = 0; l < dm.labels.size(); ++l) {
     ensure(next.labels[l], ctx, dm.labels[l].size() == 0 ? 0 : nt2);
     if (dm.labels[l].size() != 0)
-      run(ctx, F, "compact_ints", nt, "", U(nt), B(tkeep), B(tnew), U(1), B(dm.labels[l]), B(next.labels[l]));
+      run(ctx, F, "compact_ints", nt, arg("n", nt), arg("keep", tkeep), arg("newidx", tnew), arg("ncomp", 1), arg("in", dm.labels[l]), arg("out", next.labels[l]));
   }
   ensure(next.tfields, ctx, size_t(nt2) * dm.tfield_comps);
   if (dm.tfield_comps > 0)
-    run(ctx, F, "compact_doubles", nt, "", U(nt), B(tkeep), B(tnew), U(dm.tfield_comps), B(dm.tfields), B(next.tfields));
-  if (n_origin > 0) run(ctx, F, "origin_update", n_origin, "", U(n_origin), B(vmap), B(origin));
+    run(ctx, F, "compact_doubles", nt, arg("n", nt), arg("keep", tkeep), arg("newidx", tnew), arg("ncomp", dm.tfield_comps), arg("in", dm.tfields), arg("out", next.tfields));
+  if (n_origin > 0) run(ctx, F, "origin_update", n_origin, arg("n", n_origin), arg("vmap", vmap), arg("origin", origin));
   if (s.update_next) {
     // the next iteration's rings and tet_nbr from this one's (collapse_update.cl)
     const std::string U8 = "collapse_update.cl";
     ensure(s.upd_count, ctx, nv2);
-    run(ctx, U8, "ring_update_count", nv, "", U(nv), B(vkeep), B(vnew), B(s.vaff), B(c.edges), B(c.vt_off), B(c.vt),
-        B(tkeep), B(s.upd_count));
+    run(ctx, U8, "ring_update_count", nv, arg("nv_prev", nv), arg("vkeep", vkeep), arg("vnew", vnew), arg("vaff", s.vaff), arg("edges", c.edges), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tkeep", tkeep), arg("count", s.upd_count));
     const uint32_t nring = scan_offsets(ctx, s.upd_count, s.upd_vt_off, nv2);
     ensure(s.upd_vt, ctx, nring);
-    run(ctx, U8, "ring_update_write", nv, "", U(nv), B(vkeep), B(vnew), B(s.vaff), B(c.edges), B(c.vt_off), B(c.vt),
-        B(tkeep), B(tnew), B(s.upd_vt_off), B(s.upd_vt));
+    run(ctx, U8, "ring_update_write", nv, arg("nv_prev", nv), arg("vkeep", vkeep), arg("vnew", vnew), arg("vaff", s.vaff), arg("edges", c.edges), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tkeep", tkeep), arg("tnew", tnew), arg("new_vt_off", s.upd_vt_off), arg("new_vt", s.upd_vt));
     ensure(s.upd_tet_nbr, ctx, size_t(nt2) * 4);
-    run(ctx, U8, "tet_nbr_update", nt, "", U(nt), B(dm.tets), B(tkeep), B(tnew), B(s.vaff), B(c.edges), B(c.tet_nbr),
-        B(s.upd_tet_nbr), in_place);
+    run(ctx, U8, "tet_nbr_update", nt, arg("nt_prev", nt), arg("tets", dm.tets), arg("tkeep", tkeep), arg("tnew", tnew), arg("vaff", s.vaff), arg("edges", c.edges), arg("tet_nbr", c.tet_nbr), arg("new_tet_nbr", s.upd_tet_nbr), arg("in_place", in_place));
     s.update_next = false;
     s.has_update = true;
   }

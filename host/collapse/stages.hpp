@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "collapse/launch.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/device.hpp"
 #include "tetcollapse/mesh.hpp"
@@ -121,13 +122,6 @@ struct EdgeState {
   DeviceBuffer<int32_t> upd_vt, upd_tet_nbr;
 };
 
-// A device buffer of n elements: allocated on first use, else resized (DeviceBuffer::resize).
-template <class T>
-void ensure(DeviceBuffer<T>& b, Context& ctx, size_t n) {
-  if (!b.buffer()()) b = DeviceBuffer<T>(ctx, n);
-  else b.resize(n);
-}
-
 // The refusals both methods share (tc::InputError): array lengths, sizes beyond 32-bit indices
 // (12 nt scratch slots must fit), tet vertex indices out of range or repeated, label arrays of
 // the wrong length.
@@ -178,14 +172,6 @@ struct StageParams {
   bool match_early_tests = true;
 };
 StageParams params_from(const CollapseOptions& o);
-
-// Launches k over n work items; with TETCOLLAPSE_PROFILE set, waits for it and prints its wall
-// time on stderr.
-void launch_profiled(Context& ctx, cl::Kernel& k, const char* name, size_t n);
-
-// Kernel `name` of the stage file `file`, compiled with the user's placement and predicate
-// (p.user_source) when there are any: a program of its own per source, cached by the Context.
-cl::Kernel stage_kernel(Context& ctx, const StageParams& p, const std::string& file, const char* name);
 
 // With vertex_new, the device mesh is renumbered in spatial order (spatial_order.hpp) and
 // *vertex_new receives the map input vertex -> device vertex; else it keeps the input's order.

@@ -436,6 +436,9 @@ cl::Program& Context::build(const std::string& file, const std::string& text, co
   // Measured on PoCL; a CPU runtime that runs work items side by side in vector lanes would make
   // those loads for nothing (no result changes either way).
   if (cpu_tuning_) opts += " -DTCC_PREFETCH";
+  // the kernels' parameter names, by which the collapse stages set their arguments
+  // (host/collapse/launch.hpp)
+  opts += " -cl-kernel-arg-info";
   if (!options.empty()) opts += " " + options;
   if (const char* extra = std::getenv("TETCOLLAPSE_CL_OPTIONS"); extra && *extra) opts += std::string(" ") + extra;
   // in memory under the options as built: a change of cpu_tuning or of the environment's
@@ -461,6 +464,11 @@ cl::Program& Context::build(const std::string& file, const std::string& text, co
       std::vector<cl_int> status;
       prog = cl::Program(context_, {device_}, bins, &status);
       prog.build({device_}, opts.c_str());
+      // a driver may keep no argument names in a binary: then from source
+      std::vector<cl::Kernel> kernels;
+      prog.createKernels(&kernels);
+      if (!kernels.empty() && kernels[0].getInfo<CL_KERNEL_NUM_ARGS>() > 0)
+        (void)kernels[0].getArgInfo<CL_KERNEL_ARG_NAME>(0);
       built = true;
       last_build_source_ = BuildSource::DiskCache;
     } catch (const cl::Error&) {
