@@ -7,7 +7,12 @@
 
 #include <cstdint>
 
-#include "collapse/stages.hpp"
+#include <vector>
+
+#include "collapse/connectivity.hpp"
+#include "collapse/edge_state.hpp"
+#include "collapse/params.hpp"
+#include "collapse/upload.hpp"
 
 namespace tc::collapse_detail {
 

@@ -6,8 +6,8 @@
 #include <cstdlib>
 #include <string>
 
-#include "collapse/launch.hpp"
-#include "collapse/stages.hpp"
+
+#include "collapse/select_atomic_min.hpp"
 #include "tetcollapse/error.hpp"
 
 namespace tc::collapse_detail {

@@ -1,0 +1,21 @@
+// The admissible filter over every marked edge at once (cl/collapse_admissible.cl, admissible),
+// which the atomic-min conflict detection takes, and the quality guard's per-tet qualities.
+#pragma once
+
+#include <cstdint>
+
+#include "collapse/connectivity.hpp"
+#include "collapse/edge_state.hpp"
+#include "collapse/params.hpp"
+#include "collapse/upload.hpp"
+
+namespace tc::collapse_detail {
+
+// Tests every marked edge (adm, dir, reason); returns the number of admissible edges.
+uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p);
+// The quality guard's per-tet qualities of the current mesh (a placeholder when it is off):
+// once per connectivity; after a compaction only the tets that changed (tet_quality_carry).
+const cl::Buffer& tet_qualities(Context& ctx, DeviceMesh& dm, const Connectivity& c, EdgeState& s,
+                                const StageParams& p);
+
+}  // namespace tc::collapse_detail

@@ -1,0 +1,58 @@
+// What the stages are told: the user's options as the kernels take them, and the reasons a
+// test gives for refusing an edge.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "tetcollapse/collapse.hpp"
+
+namespace tc::collapse_detail {
+
+enum Reason : uint8_t {
+  kOk = 0, kNotMarked = 1, kRefusedQ = 2, kRefusedLink = 3, kRefusedVolume = 4, kRefusedQuality = 6,
+  kUntested = 5,  // lazy filter: passed Q, never tested because a cheaper rival won (an edge
+                  // with a refusal carried from the previous iteration keeps that reason)
+  kRefusedSurface = 7,  // the surface guard (guard_surface.hpp)
+  kVolumeOk = 8         // in verdict[] only (TCC_VOLUME_OK): the volume test passed, the link not yet run
+};
+
+struct StageParams {
+  int mode = 1;  // 0 strict, 1 features, 2 free
+  bool paper_rule = false;
+  bool use_labels = true;
+  double eps_f = 0.01, eps_r = 0.1, eps_v = 2e-12;
+  double min_quality = 0;  // quality guard, 0 = off
+  double target = 0;
+  int mask_mode = 0;  // 0 none, 1 both, 2 either
+  std::string cost_source;  // user cost, "" for the edge length
+  // The user's placement and predicate (OpenCL C, "" for none) and the -D options that switch
+  // them on (collapse_common.h): compiled into the kernels that place a survivor or evaluate Q
+  // (stage_kernel).
+  std::string user_source, user_defines;
+  // One work-group for the conflict rounds (no launch and read-back per round): lazy pass 1
+  // once at most loop_tests edges of a turn list are to be tested and loop_turns in all, back
+  // to per-round launches when a list has more than loop_exit_tests to test; pass 2
+  // (conflict_pass2's loop_size) once at most 2048 candidates wait. Results do not depend on
+  // them (tests set them to 0 and to the maximum).
+  uint32_t loop_tests = 128, loop_turns = 4096, loop_exit_tests = 512;
+  // Greedy selection: the priority in steps of target / priority_levels (0: the exact cost),
+  // CollapseOptions::priority_levels; its rounds run in one work-group (greedy_loop) once the
+  // turn list holds at most greedy_loop_size edges, back to per-round kernels when one holds
+  // more than greedy_loop_exit. Results do not depend on the last two. With the waiting lists a
+  // turn list holds only edges to decide (~3 us of a core each on W1), so one core is slower
+  // than two plus a round's launches (~0.25 ms) above ~170 of them (bench_selection, matching,
+  // 6-8 alternations, medians: iteration 3 0.077 s against 0.086 s at 512/2048, iteration 6
+  // 0.043 s against 0.048 s, iteration 0 the same).
+  double priority_levels = 64;
+  uint32_t greedy_loop_size = 128, greedy_loop_exit = 512;
+  // Greedy and matching selections: an edge waiting for its blocker waits on the blocker's
+  // vertex and is woken when the blocker decides (tcc_wait_on, cl/collapse_select.h), instead of
+  // going to every turn list until then. Results do not depend on it.
+  bool waiting_lists = true;
+  // Matching selection: a waiting edge's early volume test (cl/collapse_matching.cl, spec).
+  bool match_early_tests = true;
+};
+StageParams params_from(const CollapseOptions& o);
+
+}  // namespace tc::collapse_detail

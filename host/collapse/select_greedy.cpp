@@ -1,0 +1,33 @@
+// The greedy selection (cl/collapse_admissible.cl, greedy_*).
+#include "collapse/select_greedy.hpp"
+
+#include "collapse/select_lazy.hpp"
+
+namespace tc::collapse_detail {
+
+uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                          uint32_t& passed_q, uint32_t& tested) {
+  const std::string A = "collapse_admissible.cl";
+  Kernel decide = stage_kernel(ctx, p, A, "greedy_decide"), loop = stage_kernel(ctx, p, A, "greedy_loop");
+  // the priority first: lazy_init claims the first slots in its order
+  const DeviceBuffer<double>& prio = selection_priority(ctx, c, s, p);
+  lazy_start(ctx, dm, c, s, p, prio, {&decide, &loop});
+  selection_buffers(ctx, dm, c, s);
+  const cl_int W = p.waiting_lists ? 1 : 0;
+  Kernel block = kernel(ctx, A, "greedy_block"), recompute = kernel(ctx, A, "lazy_p1_recompute"),
+             turns = kernel(ctx, A, "lazy_p1_turns");
+  auto one_round = [&](uint32_t nt, int cur, cl_uint round) {
+    decide.set(arg("n", nt), arg("cur", cl_uint(cur)), arg("tlist", s.work[cur]), arg("tnext", s.work[1 - cur]), arg("cnt", s.work_n), arg("edges", c.edges), arg("prio", prio), arg("slot", s.slot[0]), arg("blocker", s.blocker), arg("queued", s.queued), arg("round", round), arg("inlist", s.inlist), arg("vstamp", s.vstamp), arg("dlist", s.dlist), arg("state", s.state), arg("vaff", s.vaff), arg("waiting", W), arg("whead", s.whead), arg("wnext", s.wnext));
+    decide.launch(ctx, nt);
+    block.set(arg("inlist", s.inlist), arg("cnt", s.work_n), arg("edges", c.edges), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("slot", s.slot[0]), arg("vstamp", s.vstamp), arg("round", round), arg("dlist", s.dlist), arg("state", s.state));
+    block.launch(ctx, nt);  // over the round's taken edges (cnt[4] <= nt)
+    vertex_part(ctx, s, c, recompute, turns, prio, cur, round, nullptr, p.waiting_lists);
+  };
+  auto in_one_group = [&](uint32_t nt, int cur, cl_uint round) {
+    loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.work[0]), arg("t1", s.work[1]), arg("cnt", s.work_n), arg("edges", c.edges), arg("prio", prio), arg("slot", s.slot[0]), arg("blocker", s.blocker), arg("queued", s.queued), arg("inlist", s.inlist), arg("vstamp", s.vstamp), arg("dlist", s.dlist), arg("state", s.state), arg("vaff", s.vaff), arg("max_n", p.greedy_loop_exit), arg("resume", s.resume), arg("waiting", W), arg("whead", s.whead), arg("wnext", s.wnext));
+    loop.launch_one_group(ctx);
+  };
+  return selection_rounds(ctx, c, s, p, "greedy_round", one_round, in_one_group, passed_q, tested);
+}
+
+}  // namespace tc::collapse_detail

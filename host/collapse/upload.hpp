@@ -1,0 +1,45 @@
+// The current mesh on the device, and how it gets there and back.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "collapse/launch.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/mesh.hpp"
+
+namespace tc::collapse_detail {
+
+// The current mesh on the device.
+struct DeviceMesh {
+  uint32_t nv = 0, nt = 0;
+  DeviceBuffer<double> points;        // 3 per vertex
+  DeviceBuffer<int32_t> tets;         // 4 per tet
+  bool has_labels = false;            // primary labels drive material interfaces
+  std::vector<DeviceBuffer<int32_t>> labels;  // every label array of the mesh, 1 per tet
+  uint32_t vfield_comps = 0, tfield_comps = 0;  // all fields packed per entity
+  DeviceBuffer<double> vfields, tfields;
+  bool has_mask = false;
+  DeviceBuffer<uint8_t> vmask;
+  // ring(v) of every vertex (ascending), filled on the host by upload_mesh with
+  // Context::cpu_tuning (a CPU device);
+  // the first build_connectivity takes them (has_rings then false)
+  bool has_rings = false;
+  DeviceBuffer<uint32_t> vt_off;  // nv + 1
+  DeviceBuffer<int32_t> vt;       // 4 nt
+  const cl::Buffer& primary_labels() const { return labels[0].buffer(); }
+};
+
+// The refusals both methods share (tc::InputError): array lengths, sizes beyond 32-bit indices
+// (12 nt scratch slots must fit), tet vertex indices out of range or repeated, label arrays of
+// the wrong length.
+void check_collapse_input(const Mesh& mesh);
+
+// With vertex_new, the device mesh is renumbered in spatial order (spatial_order.hpp) and
+// *vertex_new receives the map input vertex -> device vertex; else it keeps the input's order.
+void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm,
+                 std::vector<int32_t>* vertex_new = nullptr);
+
+void download_mesh(const DeviceMesh& dm, Mesh& mesh);
+
+}  // namespace tc::collapse_detail
