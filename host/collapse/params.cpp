@@ -1,6 +1,11 @@
 // StageParams from the user's options.
 #include "collapse/params.hpp"
 
+#include <cmath>
+#include <stdexcept>
+
+#include "tetcollapse/error.hpp"
+
 namespace tc::collapse_detail {
 
 StageParams params_from(const CollapseOptions& o) {
@@ -25,6 +30,23 @@ StageParams params_from(const CollapseOptions& o) {
     p.user_defines += " -DTCC_USER_PREDICATE";
   }
   return p;
+}
+
+void check_options(const CollapseOptions& o, const Context& ctx) {
+  if (o.max_iterations < 0) throw std::invalid_argument("max_iterations must be >= 0");
+  if (o.selection_rounds < 1) throw std::invalid_argument("selection_rounds must be >= 1");
+  if (o.selection_rounds > 1 && o.conflicts != CollapseOptions::TwoPass)
+    throw std::invalid_argument("selection_rounds > 1 needs the two-pass conflict detection");
+  if (!(o.priority_levels >= 0) || !std::isfinite(o.priority_levels))
+    throw std::invalid_argument("priority_levels must be finite and >= 0");
+  if (!o.cost_cl_source.empty() && !(o.target_length > 0))
+    throw std::invalid_argument("a user cost (cost_cl_source) needs an explicit target_length > 0");
+  if (!(o.target_length > 0) && !(o.target_factor > 0))
+    throw std::invalid_argument("target_factor must be > 0 when target_length is not given");
+  if (o.conflicts == CollapseOptions::AtomicMin && !ctx.info().int64_atomics_extended)
+    throw DeviceError("device '" + ctx.info().name +
+                      "' lacks cl_khr_int64_extended_atomics (64-bit atomic min), which --conflicts atomic-min needs; "
+                      "use --conflicts two-pass");
 }
 
 }  // namespace tc::collapse_detail

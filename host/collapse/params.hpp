@@ -6,6 +6,7 @@
 #include <string>
 
 #include "tetcollapse/collapse.hpp"
+#include "tetcollapse/device.hpp"
 
 namespace tc::collapse_detail {
 
@@ -54,5 +55,8 @@ struct StageParams {
   bool match_early_tests = true;
 };
 StageParams params_from(const CollapseOptions& o);
+// The options the parallel method refuses (std::invalid_argument), or this device cannot run
+// (tc::DeviceError).
+void check_options(const CollapseOptions& o, const Context& ctx);
 
 }  // namespace tc::collapse_detail

@@ -1,13 +1,13 @@
 // Atomic-min conflict detection (CollapseOptions::AtomicMin): the method of Gautron and Kenzel
 // 2023 as the paper's Sec. 4 describes it, over the admissible edges of admissible(). Kernels,
 // descriptor layout and why the result is conflict-free: cl/collapse_atomic_min.cl.
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
+#include "collapse/select_atomic_min.hpp"
+
+#include <memory>
 #include <string>
 
-
-#include "collapse/select_atomic_min.hpp"
+#include "collapse/admissible.hpp"
+#include "collapse/selection.hpp"
 #include "tetcollapse/error.hpp"
 
 namespace tc::collapse_detail {
@@ -48,5 +48,24 @@ uint32_t conflicts_atomic_min(Context& ctx, DeviceMesh& dm, Connectivity& c, Edg
   s.counters.download(&n, 1, 3);
   return n;
 }
+
+
+namespace {
+
+// Every marked edge tested (admissible()), then the atomic minima.
+class AtomicMinSelection final : public Selection {
+  Chosen choose(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                const IterationStats& stats) override {
+    Chosen r;
+    r.admissible = admissible(ctx, dm, c, s, p);
+    r.tested = uint32_t(stats.marked);
+    r.after_pass1 = r.after_pass2 = conflicts_atomic_min(ctx, dm, c, s);
+    return r;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Selection> make_atomic_min_selection() { return std::make_unique<AtomicMinSelection>(); }
 
 }  // namespace tc::collapse_detail

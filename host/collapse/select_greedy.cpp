@@ -1,6 +1,10 @@
 // The greedy selection (cl/collapse_admissible.cl, greedy_*).
 #include "collapse/select_greedy.hpp"
 
+#include <memory>
+
+#include "collapse/selection.hpp"
+
 #include "collapse/select_lazy.hpp"
 
 namespace tc::collapse_detail {
@@ -29,5 +33,21 @@ uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
   };
   return selection_rounds(ctx, c, s, p, "greedy_round", one_round, in_one_group, passed_q, tested);
 }
+
+
+namespace {
+
+class GreedySelection final : public Selection {
+  Chosen choose(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                const IterationStats&) override {
+    Chosen r;
+    r.admissible = r.after_pass1 = r.after_pass2 = greedy_selection(ctx, dm, c, s, p, r.passed_q, r.tested);
+    return r;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Selection> make_greedy_selection() { return std::make_unique<GreedySelection>(); }
 
 }  // namespace tc::collapse_detail

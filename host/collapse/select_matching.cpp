@@ -1,6 +1,10 @@
 // The matching selection and its undo (cl/collapse_matching.cl).
 #include "collapse/select_matching.hpp"
 
+#include <memory>
+
+#include "collapse/selection.hpp"
+
 #include <algorithm>
 #include <numeric>
 
@@ -118,5 +122,38 @@ uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   run(ctx, M, "match_undo", 1, arg("n", n), arg("order", s.work[1]), arg("refused", s.refused), arg("edges", c.edges), arg("edge_dir", s.dir), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("tdead", s.tdead), arg("tkill", s.tkill), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("pts0", s.points0), arg("vfield0", s.vfields0), arg("vaff", s.vaff), arg("state", s.state), arg("fin", s.fin), arg("reason", s.reason));
   return n;
 }
+
+
+namespace {
+
+// The matching selection applies its collapses as it takes them: the mesh is kept as it was
+// (begin), and the collapses the surface guard refuses are undone with those that saw them,
+// then the result is tested again; the selection does not run again.
+class MatchingSelection final : public Selection {
+  void begin(Context& ctx, DeviceMesh& dm, EdgeState& s) override { matching_backup(ctx, dm, s); }
+  Chosen choose(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                const IterationStats&) override {
+    Chosen r;
+    r.admissible = r.after_pass1 = r.after_pass2 = matching_selection(ctx, dm, c, s, p, r.passed_q, r.tested);
+    return r;
+  }
+  uint32_t guard(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                 uint32_t& chosen) override {
+    uint32_t refused = 0, n = 0;
+    while ((n = guard_.run_applied(ctx, dm, c, s, p, chosen)) > 0) {
+      refused += n;
+      chosen -= matching_undo(ctx, dm, c, s, guard_);
+    }
+    return refused;
+  }
+  bool guard_leaves_final() const override { return true; }
+  void count(const Chosen&, uint32_t after_guard, IterationStats& stats) const override {
+    stats.admissible = stats.after_pass1 = stats.after_pass2 = after_guard;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Selection> make_matching_selection() { return std::make_unique<MatchingSelection>(); }
 
 }  // namespace tc::collapse_detail

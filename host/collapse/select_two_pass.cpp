@@ -2,6 +2,10 @@
 // pass 2, further selection rounds (cl/collapse_conflict.cl, cl/collapse_admissible.cl lazy_p1_*).
 #include "collapse/select_two_pass.hpp"
 
+#include <memory>
+
+#include "collapse/selection.hpp"
+
 #include <chrono>
 #include <cstdio>
 
@@ -210,5 +214,35 @@ uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, Edg
   run(ctx, "collapse_verdicts.cl", "merge_rounds_vertices", dm.nv, arg("nv", dm.nv), arg("vaff1", s.vaff1), arg("vaff", s.vaff));
   return total;
 }
+
+
+namespace {
+
+// The paper's selection, with `rounds` selection rounds per iteration (next_selection_round).
+class TwoPassSelection final : public Selection {
+ public:
+  explicit TwoPassSelection(int rounds) : rounds_(rounds) {}
+
+ private:
+  Chosen choose(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                const IterationStats&) override {
+    Chosen r;
+    r.admissible = r.after_pass1 = lazy_admissible_pass1(ctx, dm, c, s, p, r.passed_q, r.tested);
+    r.after_pass2 = conflict_pass2(ctx, dm, c, s);
+    for (int round = 1; round < rounds_ && r.after_pass2 > 0; ++round) {
+      uint32_t tested = 0;
+      const uint32_t total = next_selection_round(ctx, dm, c, s, p, tested);
+      r.tested += tested;
+      if (total == r.after_pass2) break;  // nothing more
+      r.after_pass2 = total;
+    }
+    return r;
+  }
+  int rounds_;
+};
+
+}  // namespace
+
+std::unique_ptr<Selection> make_two_pass_selection(int rounds) { return std::make_unique<TwoPassSelection>(rounds); }
 
 }  // namespace tc::collapse_detail

@@ -2,6 +2,7 @@
 #include "collapse/upload.hpp"
 
 #include <exception>
+#include <numeric>
 #include <limits>
 #include <stdexcept>
 #include <system_error>
@@ -158,6 +159,54 @@ void download_mesh(const DeviceMesh& dm, Mesh& mesh) {
   };
   unpack(mesh.vertex_fields, dm.vfields, dm.vfield_comps, dm.nv);
   unpack(mesh.tet_fields, dm.tfields, dm.tfield_comps, dm.nt);
+}
+
+DeviceBuffer<int32_t> upload_with_origin(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm) {
+  std::vector<int32_t> origin;
+  upload_mesh(ctx, mesh, o, dm, o.spatial_order ? &origin : nullptr);
+  if (!o.spatial_order) {
+    origin.resize(dm.nv);
+    std::iota(origin.begin(), origin.end(), 0);
+  }
+  return DeviceBuffer<int32_t>(ctx, origin);
+}
+
+namespace {
+
+// The elements (triangles or edges) through the vertex map `origin`; degenerate ones dropped.
+void remap_elements(std::vector<int32_t>& elems, std::vector<int32_t>& tags, int arity,
+                    const std::vector<int32_t>& origin) {
+  const size_t n = elems.size() / arity;
+  std::vector<int32_t> out, out_tags;
+  out.reserve(elems.size());
+  for (size_t i = 0; i < n; ++i) {
+    int32_t v[3];
+    bool ok = true;
+    for (int k = 0; k < arity; ++k) {
+      int32_t x = elems[i * arity + k];
+      if (x < 0 || size_t(x) >= origin.size()) {
+        ok = false;
+        break;
+      }
+      v[k] = origin[x];
+      for (int j = 0; j < k; ++j) ok = ok && v[j] != v[k];
+    }
+    if (!ok) continue;
+    out.insert(out.end(), v, v + arity);
+    if (i < tags.size()) out_tags.push_back(tags[i]);
+  }
+  elems.swap(out);
+  if (!tags.empty()) tags.swap(out_tags);
+}
+
+}  // namespace
+
+void download_result(const DeviceMesh& dm, const DeviceBuffer<int32_t>& origin, Mesh& mesh) {
+  download_mesh(dm, mesh);
+  if (mesh.tris.empty() && mesh.edges.empty()) return;
+  const std::vector<int32_t> org = origin.download();
+  remap_elements(mesh.tris, mesh.tri_tags, 3, org);
+  remap_elements(mesh.edges, mesh.edge_tags, 2, org);
 }
 
 }  // namespace tc::collapse_detail

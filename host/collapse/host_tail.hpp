@@ -1,0 +1,40 @@
+// The host tail (CollapseOptions::host_tail): once the iterations on the device collapse few
+// edges each and would go on for many more, the rest runs on the host with the sequential
+// method, greedily, from the device's connectivity (a TailSeed).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "collapse/connectivity.hpp"
+#include "collapse/edge_state.hpp"
+#include "collapse/params.hpp"
+#include "collapse/sequential_run.hpp"
+#include "collapse/upload.hpp"
+#include "tetcollapse/collapse.hpp"
+
+namespace tc::collapse_detail {
+
+class HostTail {
+ public:
+  HostTail(const CollapseOptions& options, const Context& ctx);
+  // After an iteration and the next connectivity: does the rest run on the host? When the last
+  // iteration collapsed fewer than the fraction x its tets, and the collapses shrink slowly.
+  bool due(const std::vector<IterationStats>& iterations) const;
+  // Takes over the current mesh's connectivity (built and, with reuse, its verdicts carried) and
+  // the vertex mask, before the mesh is downloaded.
+  void seed(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
+  // Runs the rest on the downloaded mesh (current numbering; its triangles and edges remapped);
+  // its iterations continue the report's.
+  void finish(Mesh& mesh, const StageParams& p, CollapseReport& report);
+  bool seeded() const { return seeded_; }
+
+ private:
+  const CollapseOptions& o_;
+  double fraction_ = 0;
+  bool seeded_ = false;
+  sequential_detail::TailSeed seed_;
+  std::vector<uint8_t> mask_;
+};
+
+}  // namespace tc::collapse_detail

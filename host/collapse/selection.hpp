@@ -1,0 +1,64 @@
+// The selection of an iteration (paper, Algorithm 1, lines "admissible" and "conflicts"): which
+// marked edges collapse. Four implementations, one per conflict detection, each in the file of
+// its kernels' host side:
+//   TwoPass    the paper's: the lazy admissible filter with conflict pass 1 over edges, then
+//              pass 2 over tets (select_two_pass.cpp)
+//   Greedy     one priority-ordered pass under both passes' conflicts (select_greedy.cpp)
+//   Matching   priority order, each edge tested on the mesh with the earlier collapses applied;
+//              only edges sharing an end point conflict (select_matching.cpp)
+//   AtomicMin  every admissible edge, then Gautron and Kenzel's 64-bit atomic minima
+//              (select_atomic_min.cpp)
+// The surface guard then tests the chosen collapses; the refused edges are unmarked and the
+// selection runs again (the matching selection undoes them instead), until none is refused.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "collapse/connectivity.hpp"
+#include "collapse/edge_state.hpp"
+#include "collapse/guard_surface.hpp"
+#include "collapse/params.hpp"
+#include "collapse/upload.hpp"
+#include "tetcollapse/collapse.hpp"
+
+namespace tc::collapse_detail {
+
+class Selection {
+ public:
+  virtual ~Selection() = default;
+  // This iteration's collapses in s.fin, s.dir and s.vaff, tested by the surface guard; returns
+  // how many. Fills the selection's counts and seconds of `stats`.
+  uint32_t select(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                  IterationStats& stats);
+
+ protected:
+  // What one run of the selection chose and counted.
+  struct Chosen {
+    uint32_t admissible = 0, after_pass1 = 0, after_pass2 = 0;
+    uint32_t passed_q = 0, tested = 0;
+  };
+  // Before the first selection of an iteration.
+  virtual void begin(Context&, DeviceMesh&, EdgeState&) {}
+  // The admissible filter and the conflict detection.
+  virtual Chosen choose(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                        const IterationStats& stats) = 0;
+  // The surface guard on the `chosen` collapses: returns how many it refused; `chosen` becomes
+  // how many are left. Unless guard_leaves_final(), a refusal has the selection run again.
+  virtual uint32_t guard(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
+                         uint32_t& chosen);
+  virtual bool guard_leaves_final() const { return false; }
+  // The counts of the selection whose collapses stand, after its guard ran.
+  virtual void count(const Chosen& c, uint32_t after_guard, IterationStats& stats) const;
+
+  SurfaceGuard guard_;
+};
+
+std::unique_ptr<Selection> make_two_pass_selection(int rounds);
+std::unique_ptr<Selection> make_greedy_selection();
+std::unique_ptr<Selection> make_matching_selection();
+std::unique_ptr<Selection> make_atomic_min_selection();
+// The selection options.conflicts names.
+std::unique_ptr<Selection> make_selection(const CollapseOptions& options);
+
+}  // namespace tc::collapse_detail
