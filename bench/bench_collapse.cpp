@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
   size_t wg = 0;
   int max_iterations = 1000;
   int rounds = CollapseOptions{}.selection_rounds;
-  double host_tail = CollapseOptions{}.host_tail;
+  double host_tail = CollapseTuning{}.host_tail;
   std::vector<double> eps_cs = {0, 700}, qualities = {0, CollapseOptions{}.min_quality};
   std::vector<std::string> conflicts = {"matching"};  // the library's default
   for (int i = 1; i < argc; ++i) {
@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
         o.eps_c = eps_c;
         o.min_quality = q;
         o.selection_rounds = rounds;
-        o.host_tail = host_tail;
+        o.tuning.host_tail = host_tail;
         o.max_iterations = max_iterations;
         conflicts_from(conflicts[k], o.conflicts);
         auto t = std::chrono::steady_clock::now();

@@ -5,7 +5,7 @@
 //   --runs N             timed repetitions (default 7; not bench_conflict_rule, which counts)
 //   --target-factor F    target edge length = F x the median edge length (default 2, W1's)
 //   --min-quality Q      the quality guard (default 0, W1's)
-//   --priority-levels L  CollapseOptions::priority_levels (default the library's)
+//   --priority-levels L  CollapseTuning::priority_levels (default the library's)
 #pragma once
 
 #include <algorithm>
@@ -46,7 +46,7 @@ inline int parse_stage_args(const char* prog, int argc, char** argv, StageBenchA
     if (!std::strcmp(argv[i], "--runs") && has_value && timed) a.runs = std::max(1, std::atoi(argv[++i]));
     else if (!std::strcmp(argv[i], "--target-factor") && has_value) a.options.target_factor = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--min-quality") && has_value) a.options.min_quality = std::atof(argv[++i]);
-    else if (!std::strcmp(argv[i], "--priority-levels") && has_value) a.options.priority_levels = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--priority-levels") && has_value) a.options.tuning.priority_levels = std::atof(argv[++i]);
     else if (argv[i][0] == '-') {
       std::fprintf(stderr, "%s: unknown option or missing value: %s\n", prog, argv[i]);
       return 2;
@@ -79,7 +79,7 @@ inline bool load_stage_bench(const char* prog, const StageBenchArgs& a, StageBen
   }
   b.p = collapse_detail::params_from(a.options);
   b.p.target = a.options.target_factor * median_edge_length(b.mesh);
-  collapse_detail::upload_mesh(b.ctx, b.mesh, a.options, b.dm, a.options.spatial_order ? &b.vertex_new : nullptr);
+  collapse_detail::upload_mesh(b.ctx, b.mesh, a.options, b.dm, a.options.tuning.spatial_order ? &b.vertex_new : nullptr);
   collapse_detail::build_connectivity(b.ctx, b.dm, b.c, b.p);
   return true;
 }

@@ -117,7 +117,7 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, double sec
       .field("boundary", c.boundary)
       .field("method", c.method)
       .field("conflicts", c.conflicts)
-      .field("spatial_order", c.opt.spatial_order)
+      .field("spatial_order", c.opt.tuning.spatial_order)
       .field("seconds_total", seconds_total)
       .field("seconds_collapse", r.seconds_total)
       .field("seconds_upload", r.seconds_upload)
@@ -248,7 +248,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
                "Parallel method: keep the input's numbering on the device (default: vertices along a\n"
                "Morton curve, tets by their smallest vertex, for memory locality; the output then\n"
                "follows that order)");
-  app.add_option("--host-tail", c->opt.host_tail,
+  app.add_option("--host-tail", c->opt.tuning.host_tail,
                  "Parallel method with --eps-c 0 or 1: once an iteration collapses fewer than F x its\n"
                  "tets (and the counts shrink slowly: a long tail), finish on the host with the\n"
                  "sequential method's checks, greedily (the last iterations collapse a few edges each\n"
@@ -282,7 +282,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
                    : c->boundary == "free" ? CollapseOptions::Free
                                            : CollapseOptions::Features;
     opt.use_labels = !c->no_labels;
-    opt.spatial_order = !c->no_spatial_order;
+    opt.tuning.spatial_order = !c->no_spatial_order;
     opt.method = c->method == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
     opt.conflicts = c->conflicts == "atomic-min" ? CollapseOptions::AtomicMin
                     : c->conflicts == "two-pass" ? CollapseOptions::TwoPass
@@ -293,7 +293,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
           (opt.conflicts != CollapseOptions::Greedy && opt.conflicts != CollapseOptions::Matching))
         throw CLI::ValidationError("--priority-levels",
                                    "applies to the greedy and matching conflict detections only (--conflicts greedy|matching)");
-      opt.priority_levels = c->priority_levels;
+      opt.tuning.priority_levels = c->priority_levels;
     }
     if (opt.method == CollapseOptions::Sequential && !c->device.empty())
       throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");

@@ -36,7 +36,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   CollapseReport report = report_for(mesh, ctx);
   StageParams p = params_from(options);
   p.eps_v = report.eps_v = volume_threshold(mesh, options);
-  const bool carry = options.reuse_across_iterations;  // verdicts and connectivity carried
+  const bool carry = options.tuning.reuse_across_iterations;  // verdicts and connectivity carried
   Stopwatch clock;
   DeviceMesh dm, next;
   DeviceBuffer<int32_t> origin = upload_with_origin(ctx, mesh, options, dm);  // input vertex -> current

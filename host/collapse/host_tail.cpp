@@ -12,18 +12,18 @@ namespace tc::collapse_detail {
 
 namespace {
 
-// CollapseOptions::host_tail on this device (negative: automatic).
+// CollapseTuning::host_tail on this device (negative: automatic).
 double host_tail_fraction(const CollapseOptions& o, const Context& ctx) {
-  if (o.host_tail >= 0) return o.host_tail;
+  if (o.tuning.host_tail >= 0) return o.tuning.host_tail;
   if (!ctx.cpu_tuning()) return 0.0;
-  return o.conflicts == CollapseOptions::Matching ? CollapseOptions::kHostTailCpuMatching : CollapseOptions::kHostTailCpu;
+  return o.conflicts == CollapseOptions::Matching ? CollapseTuning::kHostTailCpuMatching : CollapseTuning::kHostTailCpu;
 }
 
-// CollapseOptions::host_tail_min_iterations (negative: automatic).
+// CollapseTuning::host_tail_min_iterations (negative: automatic).
 double host_tail_iterations(const CollapseOptions& o) {
-  if (o.host_tail_min_iterations >= 0) return o.host_tail_min_iterations;
-  return o.conflicts == CollapseOptions::Matching ? CollapseOptions::kHostTailIterationsMatching
-                                                  : CollapseOptions::kHostTailIterations;
+  if (o.tuning.host_tail_min_iterations >= 0) return o.tuning.host_tail_min_iterations;
+  return o.conflicts == CollapseOptions::Matching ? CollapseTuning::kHostTailIterationsMatching
+                                                  : CollapseTuning::kHostTailIterations;
 }
 
 // TETCOLLAPSE_HOST_TAIL_SEED=0 hands the host tail the mesh alone (a switch for the tests, which
@@ -63,7 +63,7 @@ void HostTail::seed(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s)
   seed_.vclass = c.vclass.download_range(0, dm.nv);
   seed_.tet_nbr = c.tet_nbr.download_range(0, 4 * size_t(dm.nt));
   seed_.edges = c.edges.download_range(0, 2 * size_t(c.ne));
-  if (o_.reuse_across_iterations &&
+  if (o_.tuning.reuse_across_iterations &&
       (o_.conflicts == CollapseOptions::Greedy || o_.conflicts == CollapseOptions::Matching))
     seed_.touched = tail_touched(ctx, dm, c, s);
   else

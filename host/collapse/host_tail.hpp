@@ -1,4 +1,4 @@
-// The host tail (CollapseOptions::host_tail): once the iterations on the device collapse few
+// The host tail (CollapseTuning::host_tail): once the iterations on the device collapse few
 // edges each and would go on for many more, the rest runs on the host with the sequential
 // method, greedily, from the device's connectivity (a TailSeed).
 #pragma once

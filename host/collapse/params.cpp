@@ -17,7 +17,7 @@ StageParams params_from(const CollapseOptions& o) {
   p.eps_r = o.eps_r;
   p.eps_v = o.eps_v;
   p.min_quality = o.min_quality;
-  p.priority_levels = o.priority_levels;
+  p.priority_levels = o.tuning.priority_levels;
   p.mask_mode = o.vertex_mask.empty() ? 0 : o.mask_either ? 2 : 1;
   p.cost_source = o.cost_cl_source;
   // (#line: the compiler's messages give the line in the user's source, under its option's name)
@@ -37,7 +37,7 @@ void check_options(const CollapseOptions& o, const Context& ctx) {
   if (o.selection_rounds < 1) throw std::invalid_argument("selection_rounds must be >= 1");
   if (o.selection_rounds > 1 && o.conflicts != CollapseOptions::TwoPass)
     throw std::invalid_argument("selection_rounds > 1 needs the two-pass conflict detection");
-  if (!(o.priority_levels >= 0) || !std::isfinite(o.priority_levels))
+  if (!(o.tuning.priority_levels >= 0) || !std::isfinite(o.tuning.priority_levels))
     throw std::invalid_argument("priority_levels must be finite and >= 0");
   if (!o.cost_cl_source.empty() && !(o.target_length > 0))
     throw std::invalid_argument("a user cost (cost_cl_source) needs an explicit target_length > 0");

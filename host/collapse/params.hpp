@@ -38,7 +38,7 @@ struct StageParams {
   // them (tests set them to 0 and to the maximum).
   uint32_t loop_tests = 128, loop_turns = 4096, loop_exit_tests = 512;
   // Greedy selection: the priority in steps of target / priority_levels (0: the exact cost),
-  // CollapseOptions::priority_levels; its rounds run in one work-group (greedy_loop) once the
+  // CollapseTuning::priority_levels; its rounds run in one work-group (greedy_loop) once the
   // turn list holds at most greedy_loop_size edges, back to per-round kernels when one holds
   // more than greedy_loop_exit. Results do not depend on the last two. With the waiting lists a
   // turn list holds only edges to decide (~3 us of a core each on W1), so one core is slower

@@ -105,7 +105,7 @@ SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const T
     for (size_t i = 0; i < origin_.size(); ++i) origin_[i] = int32_t(i);
   }
   touched_.assign(size_t(sm_.num_vertices()), 0);  // 0: touched "in the iteration before the first"
-  if (seed && o_.reuse_across_iterations) {
+  if (seed && o_.tuning.reuse_across_iterations) {
     if (seed->touched.size() != touched_.size())
       throw std::invalid_argument("SequentialRun: the seed's touched flags need one entry per vertex");
     // untouched: a value no iteration's prev or cur (it_, it_ + 1) takes
@@ -180,7 +180,7 @@ bool SequentialRun::step() {
   }
   if (it_ == 0) sm_.build_guard(target_);
   // marking, Q, link and volume; the admissible edges into the queue
-  const bool reuse = o_.reuse_across_iterations;
+  const bool reuse = o_.tuning.reuse_across_iterations;
   const uint32_t prev = uint32_t(it_);  // touched_ value of the previous iteration (0: the input)
   const int mask_mode = mask_.empty() ? 0 : o_.mask_either ? 2 : 1;
   auto marked = [&](int32_t a, int32_t b, double cost) {

@@ -33,7 +33,7 @@
 // list, seconds_admissible: marking, checks and queue, seconds_collapse: popping, checking
 // again, collapsing and the compaction (seconds_cost, _pass1, _pass2 are 0).
 //
-// Reuse (CollapseOptions::reuse_across_iterations, default on; the result is the same either
+// Reuse (CollapseTuning::reuse_across_iterations, default on; the result is the same either
 // way and a test compares both): an edge neither of whose end points was touched in the
 // previous iteration has the star, cost and verdict it had then; it was not admissible then
 // (an admissible edge either collapsed or was overtaken by a collapse that touched it), so step

@@ -163,8 +163,8 @@ void download_mesh(const DeviceMesh& dm, Mesh& mesh) {
 
 DeviceBuffer<int32_t> upload_with_origin(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm) {
   std::vector<int32_t> origin;
-  upload_mesh(ctx, mesh, o, dm, o.spatial_order ? &origin : nullptr);
-  if (!o.spatial_order) {
+  upload_mesh(ctx, mesh, o, dm, o.tuning.spatial_order ? &origin : nullptr);
+  if (!o.tuning.spatial_order) {
     origin.resize(dm.nv);
     std::iota(origin.begin(), origin.end(), 0);
   }

@@ -41,7 +41,7 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
                  std::vector<int32_t>* vertex_new = nullptr);
 
 void download_mesh(const DeviceMesh& dm, Mesh& mesh);
-// upload_mesh, in spatial order with CollapseOptions::spatial_order; returns the map input
+// upload_mesh, in spatial order with CollapseTuning::spatial_order; returns the map input
 // vertex -> device vertex, which collapse_and_compact keeps current.
 DeviceBuffer<int32_t> upload_with_origin(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm);
 // download_mesh, and the input's triangles and edges remapped through origin (degenerate ones

@@ -5,13 +5,25 @@
 //   opt.target_factor = 2;
 //   tc::CollapseReport r = tc::collapse(mesh, opt, ctx);   // mesh is replaced by the result
 //
-// One iteration = connectivity of the current mesh (carried through the compaction for the
-// vertices no collapse touched, rebuilt on the device for the others), cost and marking, the
-// admissible filter (predicate Q, link condition, volumes) and the conflict detection (by
-// default together: the matching selection, which also applies the collapses; the paper's
-// conflict pass 1 over edges and pass 2 over tets with Conflicts::TwoPass), the surface guard,
-// compaction. Iterations stop when one collapses fewer than max(eps_c, 1) edges or after
-// max_iterations.
+// The algorithm (the paper's Algorithm 1, with the choices beyond it named):
+//
+//   upload the mesh, renumbered along a Morton curve (tuning.spatial_order)
+//   build the connectivity: rings, neighbours N(v), edges, tet neighbours, the feature surface S
+//     and the class of every vertex (interior, face, ridge, corner)
+//   target = target_length, or target_factor x the median edge length
+//   repeat
+//     cost and marking: an edge is marked when its cost (its length) is below the target
+//     selection: among the marked edges, those that pass the admissible filter (the predicate
+//       Q of the boundary mode, the link condition, the volume test eps_v, the quality guard)
+//       and do not conflict with each other (Conflicts: Matching, Greedy, TwoPass, AtomicMin)
+//     surface guard: a collapse whose new S triangles would cross S is refused; the selection
+//       runs again without it (Matching: the collapse is undone)
+//     collapse: survivors placed, removed vertices and degenerate tets dropped, mesh compacted
+//     stop when fewer than max(eps_c, 1) edges collapsed, or after max_iterations
+//     build the connectivity again, carried for the vertices no collapse touched
+//     host tail: once the collapses per iteration are few and shrink slowly, the rest runs on
+//       the host, greedily (tuning.host_tail)
+//   download the mesh
 //
 // Boundary and material interfaces. The feature surface S is the outer boundary plus, when the
 // mesh has labels, every face between tets of different primary labels (tet_labels[0]).
@@ -78,7 +90,7 @@ struct IterationStats {
   // pass 2 (or the atomic-min conflicts), the further selection rounds and the surface guard.
   double seconds_connectivity = 0, seconds_cost = 0, seconds_admissible = 0, seconds_pass1 = 0,
          seconds_pass2 = 0, seconds_collapse = 0, seconds_total = 0;
-  // An iteration of the host tail (CollapseOptions::host_tail): the sequential method's, greedy;
+  // An iteration of the host tail (CollapseTuning::host_tail): the sequential method's, greedy;
   // its stats are those of the sequential method (no conflict passes), whose marked, tested
   // and admissible count its first tests only: the edges queued again after each collapse
   // are not counted, so collapsed may exceed admissible.
@@ -94,6 +106,49 @@ struct CollapseReport {
   double target_length = 0;   // the threshold actually used
   double median_edge_length = 0;  // of the input (computed when target_length <= 0)
   double eps_v = 0;           // the volume threshold actually used
+};
+
+// How the parallel method goes about its work: choices of speed and memory that a user rarely
+// sets. reuse_across_iterations never changes the result; the others change which of the
+// equally valid collapses are taken, or the output's numbering.
+struct CollapseTuning {
+  // Matching and Greedy: the order is the cost in steps of target_length / priority_levels and,
+  // within a step, a fixed pseudo-random order of the edges (a bijective hash of the edge
+  // index). The exact cost order (0) makes the parallel rounds follow chains of slowly growing
+  // cost: many more rounds per iteration for few more collapses.
+  double priority_levels = 64;
+  // Reuse work across iterations: verdicts of the link and volume tests of edges whose rings
+  // did not change, and the connectivity of the vertices no collapse touched. Same result either
+  // way (a test compares both); false recomputes everything.
+  bool reuse_across_iterations = true;
+  // Renumber vertices along a Morton curve and tets by their smallest new vertex before the run,
+  // for the memory locality of the stages. The output's vertices and tets follow that order
+  // instead of the input's.
+  bool spatial_order = true;
+  // Host tail. Parallel method (any conflict detection but AtomicMin), run until nothing
+  // collapses (eps_c <= 1), without user functions (has_user_functions): once an iteration
+  // collapses fewer than host_tail x (its tets) edges and the counts shrink slowly enough to
+  // promise many more iterations (at the ratio of the last two, at least
+  // host_tail_min_iterations until none), the rest runs on the host with the sequential
+  // method's checks, greedily (after each collapse the marked edges around it are queued at
+  // once, so one iteration leaves nothing admissible; another runs only when the surface guard
+  // refused an edge, since it looks beyond the star). The last iterations of the parallel
+  // method collapse a few edges each (a cascade: a collapse makes a neighbour admissible) at
+  // the price of passes over the whole mesh, which on a CPU device cost more than collapsing
+  // them one by one; on a GPU those passes are cheap. Negative (default): with
+  // Context::cpu_tuning (default: a CPU device) kHostTailCpu (kHostTailCpuMatching with the
+  // matching selection, whose tail iterations are each a pass over the mesh for fewer
+  // collapses), else 0; 0: every iteration on the device. Decided by counts only: the output
+  // stays deterministic.
+  static constexpr double kHostTailCpu = 0.002, kHostTailCpuMatching = 0.005;
+  double host_tail = -1;
+  // The host's fixed cost (its dynamic mesh, the edge list, the first tests of the marked edges
+  // the last device iteration touched, the final compaction) is worth about this many device
+  // iterations of the same mesh on a CPU device: a tail that dies out faster stays on the
+  // device. Negative (default): kHostTailIterations, or kHostTailIterationsMatching with the
+  // matching selection (its tail iterations cost more, and its tail shrinks faster).
+  static constexpr double kHostTailIterations = 24, kHostTailIterationsMatching = 6;
+  double host_tail_min_iterations = -1;
 };
 
 struct CollapseOptions {
@@ -115,14 +170,14 @@ struct CollapseOptions {
   //   four times as many as Greedy's and a run needs about a third of the iterations
   //   (cl/collapse_matching.cl). A waiting edge gets one early volume test, and a refusal there is
   //   final for the iteration. The surface guard tests the result; the collapses it refuses are
-  //   undone with those taken after them within reach. W1 (bench/README.md): 9 iterations
-  //   against 30, 1.36-1.41x the speed of Greedy on a 2-core CPU, 2% more tets at the end.
+  //   undone with those taken after them within reach. Fewer iterations and a faster run than
+  //   Greedy, for slightly more tets at the end (bench/README.md).
   // Greedy: one selection under the conflicts of both of the paper's passes: the
   //   edges that taking the marked edges one after another in cost order would take, skipping
   //   each that fails the tests or touches a tet of an edge taken before. Like the two passes it
   //   never takes two edges that share a vertex or touch a common tet, but it chooses among all
   //   candidates where pass 2 chooses among pass 1's winners only, and it tests only the edges
-  //   whose turn comes: W1 (bench/README.md) 30 iterations instead of 33, 1.2x the speed.
+  //   whose turn comes: fewer iterations than TwoPass, and faster (bench/README.md).
   // TwoPass: the paper's two passes (pass 1 over edges, pass 2 over tets), each the greedy
   //   independent set of its candidates in (cost, index) order.
   // AtomicMin: Gautron and Kenzel 2023, every admissible edge propagates a 64-bit descriptor
@@ -130,11 +185,6 @@ struct CollapseOptions {
   //   collapses when it holds the minimum in all of them; needs cl_khr_int64_extended_atomics.
   enum Conflicts { TwoPass, AtomicMin, Greedy, Matching };
   Conflicts conflicts = Matching;
-  // Matching and Greedy: the order is the cost in steps of target_length / priority_levels and,
-  // within a step, a fixed pseudo-random order of the edges (a bijective hash of the edge
-  // index). The exact cost order (0) makes the parallel rounds follow chains of slowly growing
-  // cost: W1's first iteration then takes ~200 rounds instead of ~25, for 2% more collapses.
-  double priority_levels = 64;
 
   // Edges with a cost below target_length are marked. <= 0: target_factor x the input's median
   // edge length.
@@ -159,45 +209,12 @@ struct CollapseOptions {
   // 1 regular, -> 0 sliver) of the tets it reshapes would fall below min(their worst quality
   // before, min_quality). 0 turns it off (the paper's behaviour: only eps_v is checked).
   double min_quality = 0.1;
-  // Reuse work across iterations: verdicts of the link and volume tests of edges whose rings
-  // did not change. Same result either way (a test compares both); false recomputes everything.
-  bool reuse_across_iterations = true;
   // Selection rounds per iteration (two-pass conflicts only; the greedy selection leaves no such
   // edge): after the conflict passes, edges whose stars are disjoint from those of the
   // collapses chosen so far are selected again in the same connectivity (same rules). 1 is the
-  // paper's algorithm and the default: on W1 (bench/README.md) a second round collapses ~9% more
-  // per early iteration but needs more iterations in all (72 vs 68).
+  // paper's algorithm and the default: a second round collapses more per early iteration but
+  // needs more iterations in all (bench/README.md).
   int selection_rounds = 1;
-  // Parallel method: renumber vertices along a Morton curve and tets by their smallest new vertex
-  // before the run (memory locality of the stages: W1 about 20% faster with TetGen's numbering).
-  // The output's vertices and tets follow that order instead of the input's.
-  bool spatial_order = true;
-  // Host tail. Parallel method (any conflict detection but AtomicMin), run until nothing
-  // collapses (eps_c <= 1), without user functions (has_user_functions): once an iteration
-  // collapses fewer than host_tail x (its tets) edges and the counts shrink slowly enough to
-  // promise many more iterations (at the ratio of the last two, at least
-  // host_tail_min_iterations until none), the rest runs on the host with the sequential
-  // method's checks, greedily (after each collapse the marked edges around it are queued at
-  // once, so one iteration leaves nothing admissible; another runs only when the surface guard
-  // refused an edge, since it looks beyond the star). The last iterations of the parallel
-  // method collapse a few edges each (a cascade: a collapse makes a neighbour admissible) at
-  // the price of passes over the whole mesh, which on a CPU device cost more than collapsing
-  // them one by one: W1 (bench/README.md) saves ~0.2 s of ~3 s. On a
-  // GPU those passes are cheap. Negative (default): with Context::cpu_tuning (default: a CPU
-  // device) kHostTailCpu (kHostTailCpuMatching with the matching selection, whose tail
-  // iterations are each a pass over the mesh for fewer collapses: W1 5% faster, 1% fewer
-  // tets), else 0; 0: every
-  // iteration on the device. Decided by counts only: the output stays deterministic.
-  static constexpr double kHostTailCpu = 0.002, kHostTailCpuMatching = 0.005;
-  double host_tail = -1;
-  // The host's fixed cost (its dynamic mesh, the edge list, the first tests of the marked edges
-  // the last device iteration touched, the final compaction) is worth about this many device
-  // iterations of the same mesh on a CPU device: a tail that dies out faster stays on the device
-  // (e.g. the shared Block 250k in strict mode). Negative (default): kHostTailIterations, or
-  // kHostTailIterationsMatching with the matching selection (its tail iterations cost more, and
-  // its tail shrinks by about half per iteration).
-  static constexpr double kHostTailIterations = 24, kHostTailIterationsMatching = 6;
-  double host_tail_min_iterations = -1;
 
   // Adaptive marking: with a non-empty mask (one byte per input vertex, non-zero = selected),
   // only edges whose both end points are selected are marked, or either end point with
@@ -234,6 +251,9 @@ struct CollapseOptions {
   bool has_user_functions() const {
     return !cost_cl_source.empty() || !placement_cl_source.empty() || !predicate_cl_source.empty();
   }
+
+  // How the parallel method goes about it (not what it computes).
+  CollapseTuning tuning;
 
   // Called after every iteration (e.g. for a progress line).
   std::function<void(const IterationStats&)> progress;

@@ -309,7 +309,7 @@ TEST(CollapseAtomicMin, FullRunsStayValidAndDeterministic) {
     collapse(b, o, ctx);
     EXPECT_EQ(a.points, b.points);
     EXPECT_EQ(a.tets, b.tets);
-    o.reuse_across_iterations = false;
+    o.tuning.reuse_across_iterations = false;
     Mesh d = in;
     collapse(d, o, ctx);
     EXPECT_EQ(a.points, d.points);

@@ -247,7 +247,7 @@ TEST(CollapseGreedy, WholeRunsValidAndNeedFewerIterationsThanTwoPass) {
   const Mesh in = read_mesh(test::project_mesh("bracket.msh"));
   CollapseOptions o;
   o.target_factor = 2;
-  o.host_tail = 0;  // every iteration on the device: the counts compare the detections
+  o.tuning.host_tail = 0;  // every iteration on the device: the counts compare the detections
   o.conflicts = CollapseOptions::Greedy;
   Mesh g = in, again = in, t = in;
   const CollapseReport rg = collapse(g, o, ctx);
@@ -274,10 +274,10 @@ TEST(CollapseGreedy, WholeRunsValidAndNeedFewerIterationsThanTwoPass) {
   EXPECT_GT(rg.iterations[0].collapsed, rt.iterations[0].collapsed);
   for (const IterationStats& s : rg.iterations) EXPECT_EQ(s.after_pass1, s.after_pass2);
   o.conflicts = CollapseOptions::Greedy;
-  o.priority_levels = -1;
+  o.tuning.priority_levels = -1;
   Mesh bad = in;
   EXPECT_THROW(collapse(bad, o, ctx), std::invalid_argument);
-  o.priority_levels = NAN;
+  o.tuning.priority_levels = NAN;
   EXPECT_THROW(collapse(bad, o, ctx), std::invalid_argument);
 }
 

@@ -1,4 +1,4 @@
-// The host tail (CollapseOptions::host_tail): once an iteration of the parallel method collapses
+// The host tail (CollapseTuning::host_tail): once an iteration of the parallel method collapses
 // few edges, the rest runs on the host with the sequential method's checks, greedily.
 #include <gtest/gtest.h>
 
@@ -57,8 +57,8 @@ Mesh bracket_with_attributes() {
 CollapseOptions tail_early() {
   CollapseOptions o;
   o.target_factor = 2;
-  o.host_tail = 0.05;  // from the first iteration collapsing fewer than 5% of its tets
-  o.host_tail_min_iterations = 0;  // however fast the counts shrink
+  o.tuning.host_tail = 0.05;  // from the first iteration collapsing fewer than 5% of its tets
+  o.tuning.host_tail_min_iterations = 0;  // however fast the counts shrink
   return o;
 }
 
@@ -110,7 +110,7 @@ TEST(CollapseHostTail, FinishesOnTheHostWithNothingLeft) {
   Mesh again = m;
   CollapseOptions o2 = tail_early();
   o2.target_length = r.target_length;
-  o2.host_tail = 0;
+  o2.tuning.host_tail = 0;
   o2.max_iterations = 1;
   const CollapseReport r2 = collapse(again, o2, ctx);
   ASSERT_EQ(r2.iterations.size(), 1u);
@@ -155,7 +155,7 @@ TEST(CollapseHostTail, OnlyWhenRunningUntilNothingCollapses) {
   Context ctx;
   const Mesh in = bracket_with_attributes();
   CollapseOptions off = tail_early();
-  off.host_tail = 0;
+  off.tuning.host_tail = 0;
   CollapseOptions eps = tail_early();
   eps.eps_c = 50;  // stops by itself: no tail
   CollapseOptions user = tail_early();
@@ -169,7 +169,7 @@ TEST(CollapseHostTail, OnlyWhenRunningUntilNothingCollapses) {
   }
   // a tail that would die out within host_tail_min_iterations stays on the device
   CollapseOptions slow = tail_early();
-  slow.host_tail_min_iterations = 1e9;
+  slow.tuning.host_tail_min_iterations = 1e9;
   {
     Mesh m = in;
     EXPECT_EQ(count_on_host(collapse(m, slow, ctx)), 0);
@@ -178,14 +178,14 @@ TEST(CollapseHostTail, OnlyWhenRunningUntilNothingCollapses) {
   // otherwise) from 0.2% on, else never (the context decides, not the run)
   CollapseOptions d;
   d.target_factor = 2;
-  EXPECT_LT(d.host_tail, 0);
-  d.host_tail_min_iterations = 0;  // the bracket's tail dies out fast
+  EXPECT_LT(d.tuning.host_tail, 0);
+  d.tuning.host_tail_min_iterations = 0;  // the bracket's tail dies out fast
   Mesh m = in;
   const CollapseReport r = collapse(m, d, ctx);
   if (ctx.cpu_tuning()) {
     ASSERT_GE(count_on_host(r), 1);
     const IterationStats& last_device = r.iterations[r.iterations.size() - count_on_host(r) - 1];
-    EXPECT_LT(double(last_device.collapsed), CollapseOptions::kHostTailCpuMatching * double(last_device.tets));
+    EXPECT_LT(double(last_device.collapsed), CollapseTuning::kHostTailCpuMatching * double(last_device.tets));
   } else {
     EXPECT_EQ(count_on_host(r), 0);
   }

@@ -42,7 +42,7 @@ struct Input {
 std::vector<Input> inputs() {
   std::vector<Input> in;
   CollapseOptions o;
-  o.spatial_order = false;
+  o.tuning.spatial_order = false;
   const Mesh bracket = read_mesh(test::project_mesh("bracket.msh"));
   for (auto mode : {CollapseOptions::Features, CollapseOptions::Strict, CollapseOptions::Free})
     for (double q : {0.0, 0.1}) {
@@ -360,7 +360,7 @@ TEST(CollapseMatching, LinkConditionPerKindOfSurface) {
   CollapseOptions o;
   o.boundary = CollapseOptions::Free;
   o.min_quality = 0;
-  o.spatial_order = false;
+  o.tuning.spatial_order = false;
   StageParams p = params_from(o);
   DeviceMesh dm;
   Connectivity c;
@@ -423,7 +423,7 @@ TEST(CollapseMatching, WholeRunsValidDeterministicAndInFewerIterations) {
     for (int variant = 0; variant < 2; ++variant) {
       CollapseOptions o = in.options;
       if (variant == 0) ctx.set_work_group_size(8);
-      else o.reuse_across_iterations = false;
+      else o.tuning.reuse_across_iterations = false;
       Mesh again = in.mesh;
       const CollapseReport r2 = collapse(again, o, ctx);
       ctx.set_work_group_size(0);

@@ -166,7 +166,7 @@ TEST(CollapsePipeline, MaskKeepsUnselectedVertices) {
   o.vertex_mask = test::mask_x_below(in, 0.5, &outside);
   for (bool order : {true, false}) {
     SCOPED_TRACE(order);
-    o.spatial_order = order;
+    o.tuning.spatial_order = order;
     Mesh m = in;
     CollapseReport r = collapse(m, o, ctx);
     EXPECT_LT(r.tets_out, r.tets_in);
@@ -272,9 +272,9 @@ TEST(CollapsePipeline, ReuseAcrossIterationsGivesTheSameResult) {
         o.boundary = mode;
         o.min_quality = q;
         Mesh a = in, b = in;
-        o.reuse_across_iterations = true;
+        o.tuning.reuse_across_iterations = true;
         CollapseReport ra = collapse(a, o, ctx);
-        o.reuse_across_iterations = false;
+        o.tuning.reuse_across_iterations = false;
         CollapseReport rb = collapse(b, o, ctx);
         EXPECT_EQ(a.points, b.points);
         EXPECT_EQ(a.tets, b.tets);
@@ -364,7 +364,7 @@ TEST(CollapsePipeline, GpuTuningGivesTheCpuTuningsResult) {
           o.conflicts = conflicts;
           o.boundary = mode;
           o.target_factor = 2;
-          o.host_tail = tail;
+          o.tuning.host_tail = tail;
           Mesh a = in, b = in;
           const CollapseReport ra = collapse(a, o, cpu), rb = collapse(b, o, gpu);
           if (tail < 0) {
@@ -396,7 +396,7 @@ TEST(CollapsePipeline, GpuTuningGivesTheCpuTuningsResult) {
       CollapseOptions o;
       o.conflicts = conflicts;
       o.target_factor = 2;
-      o.host_tail = 0;
+      o.tuning.host_tail = 0;
       Mesh a = inputs[0].second, b = inputs[0].second;
       collapse(a, o, cpu);
       gpu.set_work_group_size(wg);

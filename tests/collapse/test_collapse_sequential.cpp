@@ -519,7 +519,7 @@ TEST(SequentialCollapse, DeterministicAndTheSameWithoutReuse) {
   Mesh a = in, b = in, c = in;
   CollapseReport ra = collapse_sequential(a, o);
   CollapseReport rb = collapse_sequential(b, o);
-  o.reuse_across_iterations = false;  // every marked edge tested, every popped edge checked again
+  o.tuning.reuse_across_iterations = false;  // every marked edge tested, every popped edge checked again
   CollapseReport rc = collapse_sequential(c, o);
   EXPECT_EQ(a.points, b.points);
   EXPECT_EQ(a.tets, b.tets);
@@ -534,7 +534,7 @@ TEST(SequentialCollapse, DeterministicAndTheSameWithoutReuse) {
   // tc::collapse dispatches to the same method
   Context ctx;
   Mesh d = in;
-  o.reuse_across_iterations = true;
+  o.tuning.reuse_across_iterations = true;
   o.method = CollapseOptions::Sequential;
   CollapseReport rd = collapse(d, o, ctx);
   EXPECT_EQ(rd.device, "cpu-sequential");

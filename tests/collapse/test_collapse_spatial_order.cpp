@@ -1,4 +1,4 @@
-// The spatial order of the device run (host/collapse/spatial_order.*, CollapseOptions::spatial_order):
+// The spatial order of the device run (host/collapse/spatial_order.*, CollapseTuning::spatial_order):
 // a permutation that brings the ends of edges close in index, and with it the result no longer
 // depends on how the input happens to be numbered.
 #include <gtest/gtest.h>
@@ -140,7 +140,7 @@ TEST(SpatialOrder, OffKeepsTheInputNumberingAndStaysValid) {
   o.boundary = CollapseOptions::Strict;  // boundary vertices never move: many survive unmoved
   Mesh on = in, off = in;
   CollapseReport r_on = collapse(on, o, ctx);
-  o.spatial_order = false;
+  o.tuning.spatial_order = false;
   CollapseReport r_off = collapse(off, o, ctx);
   CheckOptions co;
   co.quality = false;
