@@ -155,17 +155,17 @@ int main(int argc, char** argv) {
   for (size_t w = 0; w < results.size(); ++w) {
     const Result& r = results[w];
     const CollapseReport& rep = r.report;
-    double st[6] = {0, 0, 0, 0, 0, 0};
+    constexpr int kStages = 5;
+    double st[kStages] = {0, 0, 0, 0, 0};
     for (const auto& s : rep.iterations) {
       st[0] += s.seconds_connectivity;
       st[1] += s.seconds_cost;
-      st[2] += s.seconds_admissible;
-      st[3] += s.seconds_pass1;
-      st[4] += s.seconds_pass2;
-      st[5] += s.seconds_collapse;
+      st[2] += s.seconds_select;
+      st[3] += s.seconds_guard;
+      st[4] += s.seconds_collapse;
     }
-    const char* names[6] = {"connectivity", "cost", "admissible", "pass1", "pass2", "collapse"};
-    int dom = int(std::max_element(st, st + 6) - st);
+    const char* names[kStages] = {"connectivity", "cost", "select", "guard", "collapse"};
+    int dom = int(std::max_element(st, st + kStages) - st);
     double median = r.walls[r.walls.size() / 2];
     std::printf("\n== eps_c = %lld, min_quality %g, conflicts %s: target %.6g (2 x median %.6g)\n",
                 (long long)r.eps_c, r.min_quality, r.conflicts.c_str(), rep.target_length, rep.median_edge_length);
@@ -173,18 +173,21 @@ int main(int argc, char** argv) {
                 median, r.walls.front(), r.walls.back(), runs, rep.seconds_upload, rep.seconds_download);
     std::printf("tets %lld -> %lld, vertices %lld -> %lld, %zu iterations\n", (long long)rep.tets_in,
                 (long long)rep.tets_out, (long long)rep.vertices_in, (long long)rep.vertices_out, rep.iterations.size());
-    std::printf("%4s %9s %9s %9s %9s %9s %9s %9s | %7s %7s %7s %7s %7s %7s %7s\n", "it", "tets", "marked", "passedQ",
-                "tested", "pass1", "pass2", "collapsed", "conn", "cost", "adm+p1", "p1", "p2", "coll", "total");
+    std::printf("%4s %9s %9s %9s %9s %9s %9s %9s | %7s %7s %7s %7s %7s %7s\n", "it", "tets", "marked", "cand",
+                "tested", "selected", "refused", "collapsed", "conn", "cost", "select", "guard", "coll", "total");
     for (const auto& s : rep.iterations)
-      std::printf("%4d %9lld %9lld %9lld %9lld %9lld %9lld %9lld | %7.4f %7.4f %7.4f %7.4f %7.4f %7.4f %7.4f\n",
-                  s.iteration, (long long)s.tets, (long long)s.marked, (long long)s.passed_q, (long long)s.tested,
-                  (long long)s.after_pass1,
-                  (long long)s.after_pass2, (long long)s.collapsed, s.seconds_connectivity, s.seconds_cost,
-                  s.seconds_admissible, s.seconds_pass1, s.seconds_pass2, s.seconds_collapse, s.seconds_total);
+      std::printf("%4d %9lld %9lld %9lld %9lld %9lld %9lld %9lld | %7.4f %7.4f %7.4f %7.4f %7.4f %7.4f\n",
+                  s.iteration, (long long)s.tets, (long long)s.marked, (long long)s.candidates, (long long)s.tested,
+                  (long long)s.selected, (long long)s.refused_by_guard, (long long)s.collapsed,
+                  s.seconds_connectivity, s.seconds_cost, s.seconds_select, s.seconds_guard, s.seconds_collapse,
+                  s.seconds_total);
     std::printf("stage totals:");
-    for (int k = 0; k < 6; ++k) std::printf(" %s %.3f s", names[k], st[k]);
-    std::printf("\ndominant stage: %s (%.0f%% of the iterations' time)\n", names[dom],
-                100 * st[dom] / std::max(1e-12, st[0] + st[1] + st[2] + st[3] + st[4] + st[5]));
+    double sum = 0;
+    for (int k = 0; k < kStages; ++k) {
+      std::printf(" %s %.3f s", names[k], st[k]);
+      sum += st[k];
+    }
+    std::printf("\ndominant stage: %s (%.0f%% of the iterations' time)\n", names[dom], 100 * st[dom] / std::max(1e-12, sum));
 
     js << (w ? ", " : "") << "{\"eps_c\": " << r.eps_c << ", \"min_quality\": " << r.min_quality << ", \"conflicts\": \"" << r.conflicts << "\", \"seconds_median\": " << median << ", \"seconds_runs\": [";
     for (size_t i = 0; i < r.walls.size(); ++i) js << (i ? ", " : "") << r.walls[i];
@@ -193,7 +196,7 @@ int main(int argc, char** argv) {
        << ", \"collapses_per_iteration\": [";
     for (size_t i = 0; i < rep.iterations.size(); ++i) js << (i ? ", " : "") << rep.iterations[i].collapsed;
     js << "], \"stage_seconds\": {";
-    for (int k = 0; k < 6; ++k) js << (k ? ", " : "") << "\"" << names[k] << "\": " << st[k];
+    for (int k = 0; k < kStages; ++k) js << (k ? ", " : "") << "\"" << names[k] << "\": " << st[k];
     js << "}, \"dominant_stage\": \"" << names[dom] << "\"}";
   }
   js << "]}";

@@ -66,6 +66,7 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
     reason[e] = TCC_REFUSED_Q;
     return;
   }
+  atomic_inc(&counters[5]);  /* passed Q: IterationStats::candidates */
   uchar r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts,
                                 vfield, vfield_stride, vflags, eflags, eps_v, q_min, tet_quality);
   reason[e] = r;

@@ -129,26 +129,24 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, double sec
   for (const auto& it : r.iterations) {
     w.begin_object()
         .field("iteration", it.iteration)
+        .field("on_host", it.on_host)
         .field("vertices", it.vertices)
         .field("tets", it.tets)
         .field("edges", it.edges)
         .field("marked", it.marked)
-        .field("passed_q", it.passed_q)
+        .field("candidates", it.candidates)
         .field("tested", it.tested)
-        .field("admissible", it.admissible)
-        .field("after_pass1", it.after_pass1)
-        .field("after_pass2", it.after_pass2)
+        .field("selected", it.selected)
+        .field("refused_by_guard", it.refused_by_guard)
         .field("collapsed", it.collapsed)
         .field("tets_after", it.tets_after)
         .field("vertices_after", it.vertices_after)
         .field("seconds_connectivity", it.seconds_connectivity)
         .field("seconds_cost", it.seconds_cost)
-        .field("seconds_admissible", it.seconds_admissible)
-        .field("seconds_pass1", it.seconds_pass1)
-        .field("seconds_pass2", it.seconds_pass2)
+        .field("seconds_select", it.seconds_select)
+        .field("seconds_guard", it.seconds_guard)
         .field("seconds_collapse", it.seconds_collapse)
         .field("seconds_total", it.seconds_total)
-        .field("on_host", it.on_host)
         .end_object();
   }
   w.end_array().end_object();
@@ -337,10 +335,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
     if (!c->quiet)
       opt.progress = [](const IterationStats& it) {
         std::fprintf(stderr,
-                     "iteration %3d: marked %9lld  admissible %9lld  pass1 %8lld  pass2 %8lld  collapsed %8lld  "
+                     "iteration %3d: marked %9lld  tested %9lld  selected %8lld  refused %6lld  collapsed %8lld  "
                      "tets %9lld  %.3f s%s\n",
-                     it.iteration + 1, (long long)it.marked, (long long)it.admissible, (long long)it.after_pass1,
-                     (long long)it.after_pass2, (long long)it.collapsed, (long long)it.tets_after, it.seconds_total,
+                     it.iteration + 1, (long long)it.marked, (long long)it.tested, (long long)it.selected,
+                     (long long)it.refused_by_guard, (long long)it.collapsed, (long long)it.tets_after, it.seconds_total,
                      it.on_host ? "  (host tail)" : "");
       };
 
@@ -377,23 +375,22 @@ void register_collapse(CLI::App& app, int& exit_code) {
     double seconds_write = seconds_since(tw);
     double seconds_total = seconds_since(t0);
     if (!c->quiet) {
-      double stage[6] = {0, 0, 0, 0, 0, 0};
+      double stage[5] = {0, 0, 0, 0, 0};
       for (const auto& it : r.iterations) {
         stage[0] += it.seconds_connectivity;
         stage[1] += it.seconds_cost;
-        stage[2] += it.seconds_admissible;
-        stage[3] += it.seconds_pass1;
-        stage[4] += it.seconds_pass2;
-        stage[5] += it.seconds_collapse;
+        stage[2] += it.seconds_select;
+        stage[3] += it.seconds_guard;
+        stage[4] += it.seconds_collapse;
       }
       std::fprintf(stderr,
                    "%s -> %s\n  vertices %lld -> %lld, tets %lld -> %lld (%.1f%% fewer), %zu iterations, "
-                   "target length %.6g\n  collapse %.3f s (connectivity %.3f, cost %.3f, admissible %.3f, "
-                   "pass1 %.3f, pass2 %.3f, collapse %.3f), read %.3f s, write %.3f s, total %.3f s\n",
+                   "target length %.6g\n  collapse %.3f s (connectivity %.3f, cost %.3f, select %.3f, "
+                   "guard %.3f, collapse %.3f), read %.3f s, write %.3f s, total %.3f s\n",
                    c->in.c_str(), c->out.c_str(), (long long)r.vertices_in, (long long)r.vertices_out,
                    (long long)r.tets_in, (long long)r.tets_out,
                    r.tets_in ? 100.0 * (1.0 - double(r.tets_out) / double(r.tets_in)) : 0.0, r.iterations.size(),
-                   r.target_length, r.seconds_total, stage[0], stage[1], stage[2], stage[3], stage[4], stage[5],
+                   r.target_length, r.seconds_total, stage[0], stage[1], stage[2], stage[3], stage[4],
                    seconds_read, seconds_write, seconds_total);
     }
     if (!c->stats.empty()) write_report(c->stats, stats_json(*c, r, seconds_total, seconds_read, seconds_write, verdict));

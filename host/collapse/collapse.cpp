@@ -75,7 +75,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     clock.lap();
     if (s.collapsed > 0) collapse_and_carry();
     s.seconds_collapse = clock.lap();
-    s.seconds_total = s.seconds_connectivity + s.seconds_cost + s.seconds_admissible + s.seconds_pass2 + s.seconds_collapse;
+    s.seconds_total = s.seconds_connectivity + s.seconds_cost + s.seconds_select + s.seconds_guard + s.seconds_collapse;
     s.vertices_after = dm.nv;
     s.tets_after = dm.nt;
     report.iterations.push_back(s);

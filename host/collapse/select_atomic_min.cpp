@@ -55,11 +55,12 @@ namespace {
 // Every marked edge tested (admissible()), then the atomic minima.
 class AtomicMinSelection final : public Selection {
   Chosen choose(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
-                const IterationStats& stats) override {
+                const IterationStats&) override {
     Chosen r;
-    r.admissible = admissible(ctx, dm, c, s, p);
-    r.tested = uint32_t(stats.marked);
-    r.after_pass1 = r.after_pass2 = conflicts_atomic_min(ctx, dm, c, s);
+    admissible(ctx, dm, c, s, p);
+    r.candidates = read_counter(s, 5);
+    r.tested = r.candidates;
+    r.selected = conflicts_atomic_min(ctx, dm, c, s);
     return r;
   }
 };

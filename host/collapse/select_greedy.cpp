@@ -41,7 +41,7 @@ class GreedySelection final : public Selection {
   Chosen choose(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                 const IterationStats&) override {
     Chosen r;
-    r.admissible = r.after_pass1 = r.after_pass2 = greedy_selection(ctx, dm, c, s, p, r.passed_q, r.tested);
+    r.selected = greedy_selection(ctx, dm, c, s, p, r.candidates, r.tested);
     return r;
   }
 };

@@ -134,7 +134,7 @@ class MatchingSelection final : public Selection {
   Chosen choose(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                 const IterationStats&) override {
     Chosen r;
-    r.admissible = r.after_pass1 = r.after_pass2 = matching_selection(ctx, dm, c, s, p, r.passed_q, r.tested);
+    r.selected = matching_selection(ctx, dm, c, s, p, r.candidates, r.tested);
     return r;
   }
   uint32_t guard(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
@@ -147,9 +147,6 @@ class MatchingSelection final : public Selection {
     return refused;
   }
   bool guard_leaves_final() const override { return true; }
-  void count(const Chosen&, uint32_t after_guard, IterationStats& stats) const override {
-    stats.admissible = stats.after_pass1 = stats.after_pass2 = after_guard;
-  }
 };
 
 }  // namespace

@@ -227,14 +227,14 @@ class TwoPassSelection final : public Selection {
   Chosen choose(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                 const IterationStats&) override {
     Chosen r;
-    r.admissible = r.after_pass1 = lazy_admissible_pass1(ctx, dm, c, s, p, r.passed_q, r.tested);
-    r.after_pass2 = conflict_pass2(ctx, dm, c, s);
-    for (int round = 1; round < rounds_ && r.after_pass2 > 0; ++round) {
+    lazy_admissible_pass1(ctx, dm, c, s, p, r.candidates, r.tested);
+    r.selected = conflict_pass2(ctx, dm, c, s);
+    for (int round = 1; round < rounds_ && r.selected > 0; ++round) {
       uint32_t tested = 0;
       const uint32_t total = next_selection_round(ctx, dm, c, s, p, tested);
       r.tested += tested;
-      if (total == r.after_pass2) break;  // nothing more
-      r.after_pass2 = total;
+      if (total == r.selected) break;  // nothing more
+      r.selected = total;
     }
     return r;
   }

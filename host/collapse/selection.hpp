@@ -28,15 +28,16 @@ class Selection {
  public:
   virtual ~Selection() = default;
   // This iteration's collapses in s.fin, s.dir and s.vaff, tested by the surface guard; returns
-  // how many. Fills the selection's counts and seconds of `stats`.
+  // how many. Fills stats' candidates, tested, selected, refused_by_guard, seconds_select and
+  // seconds_guard.
   uint32_t select(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                   IterationStats& stats);
 
  protected:
-  // What one run of the selection chose and counted.
+  // What one run of the selection chose and counted: the collapses, the marked edges passing
+  // Q, the tests run.
   struct Chosen {
-    uint32_t admissible = 0, after_pass1 = 0, after_pass2 = 0;
-    uint32_t passed_q = 0, tested = 0;
+    uint32_t selected = 0, candidates = 0, tested = 0;
   };
   // Before the first selection of an iteration.
   virtual void begin(Context&, DeviceMesh&, EdgeState&) {}
@@ -48,8 +49,6 @@ class Selection {
   virtual uint32_t guard(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                          uint32_t& chosen);
   virtual bool guard_leaves_final() const { return false; }
-  // The counts of the selection whose collapses stand, after its guard ran.
-  virtual void count(const Chosen& c, uint32_t after_guard, IterationStats& stats) const;
 
   SurfaceGuard guard_;
 };

@@ -194,14 +194,14 @@ bool SequentialRun::step() {
     uint8_t fe = 0;
     const int dir = sm_.predicate(e.a, e.b, fe);
     if (dir < 0) continue;
-    ++s.passed_q;
+    ++s.candidates;
     if (reuse && touched_[e.a] != prev && touched_[e.b] != prev) continue;  // refused then, refused now
     ++s.tested;
     if (!sm_.admissible(e.a, e.b, fe, dir)) continue;
     heap_.push_back({e.cost, e.a, e.b, uint8_t(dir)});
     if (greedy_) queued_.insert(key(e.a, e.b));
   }
-  s.admissible = int64_t(heap_.size());
+  s.selected = int64_t(heap_.size());
   auto later = [](const QueueEntry& x, const QueueEntry& y) { return after(x.cost, x.a, x.b, y.cost, y.a, y.b); };
   std::make_heap(heap_.begin(), heap_.end(), later);
   const double t2 = seconds_since(t0);
@@ -241,6 +241,7 @@ bool SequentialRun::step() {
       // touched, so the edge is tested again next iteration (S nearby may have moved away)
       touched_[e.a] = touched_[e.b] = cur;
       ++guard_refusals;
+      ++s.refused_by_guard;
       if (greedy_) refused_.insert(refused_.end(), {e.a, e.b});
       continue;
     }
@@ -269,7 +270,6 @@ bool SequentialRun::step() {
       }
     }
   }
-  s.after_pass1 = s.after_pass2 = s.collapsed;  // no conflict passes: every collapse is applied
 
   // 3. compaction
   if (s.collapsed > 0) {
@@ -296,7 +296,7 @@ bool SequentialRun::step() {
   const double t4 = seconds_since(t0);
   s.seconds_connectivity = t1;
   s.seconds_cost = 0;  // the lengths come with the edge list
-  s.seconds_admissible = t2 - t1;
+  s.seconds_select = t2 - t1;
   s.seconds_collapse = t4 - t2;
   s.seconds_total = t4;
   s.vertices_after = sm_.alive_vertices();

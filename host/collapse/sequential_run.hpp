@@ -22,16 +22,17 @@
 // edge once), and the run stops after an iteration in which the surface guard refused nothing.
 // Then every marked edge was tested after the last change of its star and refused, except those
 // the guard refused, so a later greedy iteration lists only those edges (its edges, marked,
-// passed_q and tested count them alone).
+// candidates and tested count them alone).
 // The options of the parallel method's conflict detection (conflicts, selection_rounds) do not
 // apply; a user cost (cost_cl_source) is refused.
 //
 // IterationStats of an iteration: marked (all marked edges; in a greedy iteration after the
-// first, of the listed edges only, as edges), passed_q (of those, passing Q at
-// the start), tested (link and volume tests at the start), admissible (pushed into the queue),
-// after_pass1 = after_pass2 = collapsed (no conflict passes); seconds_connectivity: the edge
-// list, seconds_admissible: marking, checks and queue, seconds_collapse: popping, checking
-// again, collapsing and the compaction (seconds_cost, _pass1, _pass2 are 0).
+// first, of the listed edges only, as edges), candidates (of those, passing Q at the start),
+// tested (link and volume tests at the start), selected (pushed into the queue),
+// refused_by_guard (popped edges the surface guard refused); seconds_connectivity: the edge
+// list, seconds_select: marking, checks and queue, seconds_collapse: popping, checking
+// again, the surface guard, collapsing and the compaction (seconds_cost and seconds_guard are
+// 0).
 //
 // Reuse (CollapseTuning::reuse_across_iterations, default on; the result is the same either
 // way and a test compares both): an edge neither of whose end points was touched in the

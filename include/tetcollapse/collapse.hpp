@@ -58,43 +58,33 @@
 
 namespace tc {
 
+// What one iteration did; the same meaning under every conflict detection and on the host.
 struct IterationStats {
   int iteration = 0;              // 0-based
-  // of the mesh this iteration started from; edges, marked, passed_q and tested of a host-tail
-  // iteration after its first (on_host) count only the edges it lists: those the surface guard
-  // refused in the iteration before (every other edge was refused after its star last changed)
+  bool on_host = false;           // an iteration of the host tail (CollapseTuning::host_tail)
+  // Of the mesh the iteration started from. A host-tail iteration after its first lists only
+  // the edges the surface guard refused in the iteration before (every other edge was refused
+  // after its star last changed): edges, marked, candidates and tested count those alone.
   int64_t vertices = 0, tets = 0, edges = 0;
-  int64_t marked = 0;             // cost < target (and in the mask)
-  // The admissible filter is lazy (it runs inside conflict pass 1, or inside the greedy
-  // selection): Q is evaluated on every marked edge, but the link condition and the volume test
-  // only on the edges whose cheaper rivals are all decided, which gives the same result as
-  // testing every edge.
-  int64_t passed_q = 0;           // marked edges passing the predicate Q
-  // Of those, the edges tested: link condition and volume test evaluated (greedy selection: the
-  // volume test, which most of them end with; with the atomic-min conflicts: every marked
-  // edge; matching selection: the tests run, up to two per edge: an early volume test while it
-  // waits, and the full test when its turn comes, on the mesh as it is then). When the surface
-  // guard refuses a collapse, the edges are selected again (the lazy filter then tests only
-  // edges not tested before): marked and passed_q are counted before
-  // the first selection, tested adds up over the selections and selection rounds, and
-  // admissible, after_pass1 and after_pass2 are the last selection's.
+  int64_t marked = 0;             // cost below the target (and in the vertex mask)
+  int64_t candidates = 0;         // marked and passing the predicate Q (and the user predicate)
+  // Tests run of the link condition and the volume test (and the quality guard). The selections
+  // test lazily, an edge only when no cheaper rival can still take it, and only edges no earlier
+  // selection of the iteration tested; the matching selection may test an edge twice (early
+  // while it waits, and on the mesh as it is when its turn comes); the atomic-min conflicts test
+  // every marked edge.
   int64_t tested = 0;
-  int64_t admissible = 0;         // tested and passed (= after_pass1 with the lazy filter)
-  int64_t after_pass1 = 0;        // survived conflict pass 1 (edges); greedy: = after_pass2
-  int64_t after_pass2 = 0;        // survived conflict pass 2 (tets) = collapsed
+  int64_t selected = 0;           // chosen by the first selection, before the surface guard
+  // Chosen collapses the surface guard refused, over all its runs (the selection then runs
+  // again, or with the matching selection the collapse and those that saw it are undone).
+  int64_t refused_by_guard = 0;
   int64_t collapsed = 0;
   int64_t tets_after = 0, vertices_after = 0;
-  // Seconds per stage (wall time, the queue finished after each stage), summed over the
-  // iteration's selections. seconds_admissible holds the lazy filter together with conflict
-  // pass 1 (greedy: the whole selection); seconds_pass1 is then 0. seconds_pass2 holds conflict
-  // pass 2 (or the atomic-min conflicts), the further selection rounds and the surface guard.
-  double seconds_connectivity = 0, seconds_cost = 0, seconds_admissible = 0, seconds_pass1 = 0,
-         seconds_pass2 = 0, seconds_collapse = 0, seconds_total = 0;
-  // An iteration of the host tail (CollapseTuning::host_tail): the sequential method's, greedy;
-  // its stats are those of the sequential method (no conflict passes), whose marked, tested
-  // and admissible count its first tests only: the edges queued again after each collapse
-  // are not counted, so collapsed may exceed admissible.
-  bool on_host = false;
+  // Seconds per stage (wall time, the queue finished after each stage): the connectivity, the
+  // cost and marking, the selections (filter and conflicts), the surface guard (with the
+  // undo), the collapse and compaction.
+  double seconds_connectivity = 0, seconds_cost = 0, seconds_select = 0, seconds_guard = 0, seconds_collapse = 0,
+         seconds_total = 0;
 };
 
 struct CollapseReport {

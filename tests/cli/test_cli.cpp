@@ -172,7 +172,7 @@ TEST(Cli, CoarsenWritesAValidMeshAndStats) {
   std::string s = tc::test::read_text(stats);
   for (const char* key : {"\"tets_in\":23925", "\"vertices_in\":5580", "\"tets_out\":", "\"vertices_out\":",
                           "\"device\":", "\"seconds_total\":", "\"seconds_collapse\":", "\"iterations\":[{",
-                          "\"collapsed\":", "\"seconds_admissible\":", "\"check\":\"valid\""})
+                          "\"collapsed\":", "\"seconds_select\":", "\"refused_by_guard\":", "\"check\":\"valid\""})
     EXPECT_NE(s.find(key), std::string::npos) << key << " not in " << s;
   ASSERT_EQ(run_command(cli() + " check -q " + q(result), &out), 0) << out;
   EXPECT_NE(s.find("\"spatial_order\":true"), std::string::npos) << s;

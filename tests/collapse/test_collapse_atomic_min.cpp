@@ -297,8 +297,10 @@ TEST(CollapseAtomicMin, FullRunsStayValidAndDeterministic) {
     EXPECT_FALSE(c.reference.topology_changed);
     int64_t collapsed = 0;
     for (const IterationStats& s : r.iterations) {
-      EXPECT_LE(s.collapsed, s.admissible);
-      EXPECT_LE(s.admissible, s.marked);
+      EXPECT_LE(s.collapsed, s.selected);
+      EXPECT_LE(s.selected, s.tested);
+      EXPECT_EQ(s.tested, s.candidates);  // every candidate tested
+      EXPECT_LE(s.candidates, s.marked);
       EXPECT_EQ(s.vertices - s.vertices_after, s.collapsed);
       collapsed += s.collapsed;
     }

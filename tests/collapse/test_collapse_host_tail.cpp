@@ -253,7 +253,7 @@ TEST(CollapseHostTail, SeedFromTheDeviceChangesNothing) {
       for (size_t i = 0; i < rs.iterations.size(); ++i) EXPECT_EQ(rs.iterations[i].collapsed, ra.iterations[i].collapsed);
       EXPECT_EQ(rs.iterations[first_host].edges, ra.iterations[first_host].edges);  // the device's list, gathered
       EXPECT_EQ(rs.iterations[first_host].marked, ra.iterations[first_host].marked);
-      EXPECT_EQ(rs.iterations[first_host].passed_q, ra.iterations[first_host].passed_q);
+      EXPECT_EQ(rs.iterations[first_host].candidates, ra.iterations[first_host].candidates);
       if (conflicts != CollapseOptions::TwoPass)
         EXPECT_LT(rs.iterations[first_host].tested, ra.iterations[first_host].tested);
       else

@@ -163,10 +163,10 @@ CollapseReport expect_valid_run(const Mesh& in, Mesh& m, const CollapseOptions& 
   // the report adds up
   int64_t collapsed = 0;
   for (const IterationStats& s : r.iterations) {
-    EXPECT_LE(s.passed_q, s.marked);
-    EXPECT_LE(s.tested, s.passed_q);
-    EXPECT_LE(s.admissible, s.tested);
-    EXPECT_LE(s.collapsed, s.admissible);
+    EXPECT_LE(s.candidates, s.marked);
+    EXPECT_LE(s.tested, s.candidates);
+    EXPECT_LE(s.selected, s.tested);
+    EXPECT_LE(s.collapsed, s.selected);
     EXPECT_EQ(s.vertices - s.vertices_after, s.collapsed);
     collapsed += s.collapsed;
   }
@@ -528,7 +528,7 @@ TEST(SequentialCollapse, DeterministicAndTheSameWithoutReuse) {
   ASSERT_EQ(ra.iterations.size(), rc.iterations.size());
   for (size_t i = 0; i < ra.iterations.size(); ++i) {
     EXPECT_EQ(ra.iterations[i].collapsed, rc.iterations[i].collapsed);
-    EXPECT_EQ(ra.iterations[i].admissible, rc.iterations[i].admissible);
+    EXPECT_EQ(ra.iterations[i].selected, rc.iterations[i].selected);
     EXPECT_LE(ra.iterations[i].tested, rc.iterations[i].tested);
   }
   // tc::collapse dispatches to the same method
@@ -904,7 +904,7 @@ TEST(SequentialCollapse, CornersAreNeverRemoved) {
   EXPECT_EQ(m.num_vertices(), 8);
   ASSERT_EQ(r.iterations.size(), 1u);
   EXPECT_EQ(r.iterations[0].marked, 19);
-  EXPECT_EQ(r.iterations[0].passed_q, 0);
+  EXPECT_EQ(r.iterations[0].candidates, 0);
 }
 
 TEST(SequentialCollapse, RefusesWhatItCannotDo) {
