@@ -11,7 +11,7 @@
 
 namespace tc::collapse_detail {
 
-// Tests every marked edge (adm, dir, reason); returns the number of admissible edges.
+// Tests every marked edge (edges_are_admissible, edges2dir, edges2reason); returns the number of admissible edges.
 uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p);
 // The quality guard's per-tet qualities of the current mesh (a placeholder when it is off):
 // once per connectivity; after a compaction only the tets that changed (tet_quality_carry).

@@ -42,12 +42,12 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   const bool cy = carry && carry->has_prev;
   const cl_int ci = cy ? 1 : 0;
   // carried data when cy (collapse_verdicts.cl), placeholders otherwise
-  const cl::Buffer& nd = cy ? carry->ndirty.buffer() : c.count.buffer();
-  const cl::Buffer& vo = cy ? carry->vold.buffer() : c.count.buffer();
-  const cl::Buffer& vm = cy ? carry->vmap.buffer() : c.count.buffer();
+  const cl::Buffer& nd = cy ? carry->verts_are_dirty.buffer() : c.count.buffer();
+  const cl::Buffer& vo = cy ? carry->verts2prev.buffer() : c.count.buffer();
+  const cl::Buffer& vm = cy ? carry->prev_verts2new.buffer() : c.count.buffer();
   const cl::Buffer& pno = cy ? carry->prev_nb_off.buffer() : c.count.buffer();
   const cl::Buffer& pnb = cy ? carry->prev_nb.buffer() : c.count.buffer();
-  run(ctx, F, "conn_ring_sort_and_gather", nv, arg("tets", dm.tets), arg("nv", nv), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("scratch", c.scratch), arg("nb_count", c.count), arg("up_count", c.up_count), arg("sort", cl_int(sorted ? 0 : 1)), arg("carry", ci), arg("ndirty", nd), arg("vold", vo), arg("vmap", vm), arg("prev_nb_off", pno), arg("prev_nb", pnb), arg("rename", cl_int(updated ? 1 : 0)), arg("prev_vaff", updated ? carry->vaff.buffer() : c.count.buffer()));
+  run(ctx, F, "conn_ring_sort_and_gather", nv, arg("tets", dm.tets), arg("nv", nv), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("scratch", c.scratch), arg("nb_count", c.count), arg("up_count", c.up_count), arg("sort", cl_int(sorted ? 0 : 1)), arg("carry", ci), arg("ndirty", nd), arg("vold", vo), arg("vmap", vm), arg("prev_nb_off", pno), arg("prev_nb", pnb), arg("rename", cl_int(updated ? 1 : 0)), arg("prev_vaff", updated ? carry->verts2collapse.buffer() : c.count.buffer()));
   uint32_t nnb = scan_offsets(ctx, c.count, c.nb_off, nv);
   c.ne = scan_offsets(ctx, c.up_count, c.edge_off, nv);
   ensure(c.nb, ctx, nnb);
@@ -61,8 +61,8 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   ensure(c.tet_nbr, ctx, size_t(nt) * 4);
   // carried boundary data
-  const cl::Buffer& to = cy ? carry->told.buffer() : c.vt.buffer();
-  const cl::Buffer& tn = cy ? carry->tnew.buffer() : c.vt_off.buffer();
+  const cl::Buffer& to = cy ? carry->tets2prev.buffer() : c.vt.buffer();
+  const cl::Buffer& tn = cy ? carry->prev_tets2new.buffer() : c.vt_off.buffer();
   const cl::Buffer& pt = cy ? carry->prev_tet_nbr.buffer() : c.vt.buffer();
   const cl::Buffer& pvc = cy ? carry->prev_vclass.buffer() : c.vflags.buffer();
   const cl::Buffer& pef = cy ? carry->prev_eflags.buffer() : c.vflags.buffer();
@@ -73,7 +73,7 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
     run(ctx, F, "conn_tet_neighbours_carry", nt, arg("nt", nt), arg("tets", dm.tets), arg("tet_nbr", c.tet_nbr), arg("ndirty", nd), arg("told", to), arg("tnew", tn), arg("prev_tet_nbr", pt));
     // the full matching only for the dirty vertices
     ensure(c.dirty_list, ctx, nv);
-    const uint32_t nd_count = dev::compact_indices(ctx, carry->dirty_flags, c.dirty_list, nv);
+    const uint32_t nd_count = dev::compact_indices(ctx, carry->verts_are_dirty_words, c.dirty_list, nv);
     run(ctx, F, "conn_tet_neighbours", nd_count, arg("n", nd_count), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("use_list", cl_int(1)), arg("list", c.dirty_list));
   } else {
     run(ctx, F, "conn_tet_neighbours", nv, arg("n", nv), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("use_list", cl_int(0)), arg("list", c.vt_off));

@@ -7,63 +7,81 @@
 
 namespace tc::collapse_detail {
 
-// Per-edge and per-vertex state of the later stages.
+// Per-edge, per-vertex and per-tet state of the stages after the connectivity, named for what
+// each buffer maps (edges2x: a value per edge; edges_are_x: a 0/1 flag per edge; verts2x, tets2x
+// likewise). Grouped by the stage that writes it; later stages read the selection's result.
 struct EdgeState {
-  DeviceBuffer<double> cost;
-  DeviceBuffer<uint32_t> marked, adm, p1, fin;
-  DeviceBuffer<uint8_t> state;      // conflict passes: 0 undecided, 1 in, 2 out
-  DeviceBuffer<double> tet_quality; // quality guard: tc_tet_quality per tet (collapse_admissible.cl)
-  DeviceBuffer<double> tet_quality_next;
-  uint64_t quality_generation = 0;  // tet_quality is complete for the connectivity of this generation
-  bool quality_carried = false;     // tet_quality holds the carried values (-1: to compute) of the mesh
-  DeviceBuffer<uint32_t> cand;      // lazy filter: marked and passing Q
-  // Conflict rounds (collapse_conflict.cl): candidate edges, worklists of their slots, the
-  // length of the next worklist, stored rivals per slot (pass 2) and their count.
-  DeviceBuffer<uint32_t> cand_edges, work[2], work_n, rivals, rcount;
-  DeviceBuffer<int32_t> slot[2];    // pass 1: per-vertex claims (collapse_conflict.cl)
-  DeviceBuffer<uint32_t> queued, dlist, resume;  // lazy pass 1: turn-list stamps, vertex list, loop exit
-  DeviceBuffer<uint8_t> dir, reason;
-  DeviceBuffer<int32_t> vaff;       // per vertex
-  // greedy selection (greedy_selection): the priority (levels > 0), per edge the edge it waits
-  // for, per vertex the round it was last listed, the edges taken in a round
-  DeviceBuffer<double> prio, slotp;  // slotp: the priority of each vertex's slot (matching)
-  DeviceBuffer<int32_t> blocker;
-  DeviceBuffer<int32_t> whead, wnext;  // the selections' waiting lists: per vertex, per edge
-  DeviceBuffer<uint32_t> vstamp, inlist;
-  // matching selection (matching_selection): per edge whether its early test ran and the round
-  // it was taken in, per tet whether a collapse removed it and which; the positions and fields
-  // of the iteration's start (matching_backup), for undoing collapses the surface guard refuses
-  // (matching_undo: per edge refused / undone, per vertex the first round reaching it); in_place:
-  // the collapses are applied (collapse_and_compact only compacts)
-  DeviceBuffer<uint8_t> spec, tdead, refused, undo;
-  DeviceBuffer<uint32_t> dround, reachmin;
-  DeviceBuffer<int32_t> tkill;
-  DeviceBuffer<double> points0, vfields0;
-  bool in_place = false;
-  // marked, admissible, pass1, pass2, tested (lazy), passed Q (lazy)
+  // Cost and marking (cost.cpp); counters: marked, admissible, pass 1, pass 2, tested, passed Q.
+  DeviceBuffer<double> edges2cost;
+  DeviceBuffer<uint32_t> edges_are_marked;
   DeviceBuffer<uint32_t> counters;
-  // Verdicts of the link and volume tests kept across iterations (collapse_verdicts.cl):
-  // verdict[e] is the reason of a test of e (TCC_OK or a refusal), kVolumeOk (the greedy
-  // selection's volume test passed, the link condition not yet run) or TCC_VERDICT_UNKNOWN.
-  // Carried to the next iteration for the edges whose end points' rings did not change.
-  DeviceBuffer<uint8_t> verdict;
+
+  // The selection's result, read by the surface guard and the compaction: the edges to
+  // collapse, the direction of each (which end point survives, where it goes), per vertex the
+  // collapse that moves or removes it (-1: none), and why a tested edge was refused (Reason).
+  DeviceBuffer<uint32_t> edges_are_final;
+  DeviceBuffer<uint8_t> edges2dir, edges2reason;
+  DeviceBuffer<int32_t> verts2collapse;
+  DeviceBuffer<uint8_t> edges2state;  // conflict passes: 0 undecided, 1 in, 2 out
+  // admissible() over every marked edge (the atomic-min conflicts), and conflict pass 1's winners
+  DeviceBuffer<uint32_t> edges_are_admissible, edges_pass1;
+
+  // The quality guard: tc_tet_quality per tet (collapse_admissible.cl), complete for the
+  // connectivity of quality_generation, or carried through the compaction (-1: to compute).
+  DeviceBuffer<double> tets2quality, tets2quality_next;
+  uint64_t quality_generation = 0;
+  bool quality_carried = false;
+
+  // The lazy filter and the selections' rounds (select_lazy.cpp, select_two_pass.cpp): the
+  // candidates (marked and passing Q) as flags and as a list, the turn lists of the rounds and
+  // their lengths, each vertex's claim (its slot: the first undecided candidate at it), pass 2's
+  // rivals per slot, the round an edge was last queued, the vertices listed in a round, where a
+  // one-work-group loop stopped.
+  DeviceBuffer<uint32_t> edges_are_candidates, candidate_list, turn_lists[2], list_counts;
+  DeviceBuffer<uint32_t> slots2rivals, slots2rival_count;
+  DeviceBuffer<int32_t> verts2slot[2];
+  DeviceBuffer<uint32_t> edges2queued, vertex_list, loop_resume;
+  // The greedy and matching selections: the priority (CollapseTuning::priority_levels), per edge
+  // the edge it waits for, per vertex the round it was last listed, the edges taken in a round,
+  // the waiting lists (per vertex its first waiting edge, per edge the next).
+  DeviceBuffer<double> edges2priority;
+  DeviceBuffer<int32_t> edges2blocker, verts2waiting, edges2next_waiting;
+  DeviceBuffer<uint32_t> verts2listed, round_taken;
+  // The matching selection (select_matching.cpp): each slot's priority, per edge whether its
+  // early test ran and the round it was taken in, per tet whether a collapse removed it and
+  // which; the positions and fields of the iteration's start (matching_backup), for undoing what
+  // the surface guard refuses (matching_undo: per edge refused / to undo, per vertex the first
+  // round reaching it). in_place: the collapses are applied (collapse_and_compact only compacts).
+  DeviceBuffer<double> verts2slot_priority;
+  DeviceBuffer<uint8_t> edges_early_tested, tets_are_dead, edges_are_refused, edges_to_undo;
+  DeviceBuffer<uint32_t> edges2round, verts2first_round;
+  DeviceBuffer<int32_t> tets2killer;
+  DeviceBuffer<double> points_before, vfields_before;
+  bool in_place = false;
+
+  // Verdicts of the link and volume tests kept across iterations (verdict_carry.cpp):
+  // edges2verdict[e] is the reason of a test of e (TCC_OK or a refusal), kVolumeOk (the greedy
+  // selection's volume test passed, the link condition not yet run) or TCC_VERDICT_UNKNOWN;
+  // carried to the next iteration for the edges whose end points' rings did not change.
+  DeviceBuffer<uint8_t> edges2verdict;
   bool verdict_ready = false;
-  // later selection rounds (next_selection_round): the previous rounds' results, and the flag
-  // that restricts lazy_admissible_pass1's candidates to edges with clean end points (vdirty)
-  DeviceBuffer<uint32_t> fin1;
-  DeviceBuffer<uint8_t> dir1;
-  DeviceBuffer<int32_t> vaff1;
-  bool restrict_clean = false;  // verdict holds carried values (else lazy_admissible_pass1 clears it)
-  // what carry_verdicts needs from the previous iteration
+  // Later selection rounds (next_selection_round): the earlier rounds' results, and the flag that
+  // restricts the candidates to edges with clean end points (prev_verts_are_dirty).
+  DeviceBuffer<uint32_t> rounds_final;
+  DeviceBuffer<uint8_t> rounds_dir;
+  DeviceBuffer<int32_t> rounds_verts2collapse;
+  bool restrict_clean = false;
+  // What carry_verdicts needs of the previous iteration: its connectivity and verdicts, which of
+  // its vertices a collapse touched (dirty: an end point of a collapse or a neighbour of one), and
+  // the maps between its vertices and tets and the current ones.
   bool has_prev = false;
   uint32_t prev_nv = 0, prev_nt = 0;
-  DeviceBuffer<uint8_t> prev_verdict, vdirty;  // vdirty per previous vertex
-  DeviceBuffer<uint8_t> ndirty;                // per current vertex: vdirty of its previous self
-  DeviceBuffer<uint32_t> dirty_flags;          // the same as 0/1 words (for compact_indices)
-  DeviceBuffer<int32_t> vold;                  // current vertex -> previous vertex
-  DeviceBuffer<int32_t> vmap;                  // previous vertex -> current (collapse_and_compact)
-  DeviceBuffer<int32_t> told;                  // current tet -> previous tet
-  DeviceBuffer<uint32_t> tkeep, tnew;          // previous tet: kept, new index (collapse_and_compact)
+  DeviceBuffer<uint8_t> prev_edges2verdict, prev_verts_are_dirty;
+  DeviceBuffer<uint8_t> verts_are_dirty;          // per current vertex: its previous self's
+  DeviceBuffer<uint32_t> verts_are_dirty_words;   // the same as 0/1 words (for compact_indices)
+  DeviceBuffer<int32_t> verts2prev, tets2prev;    // current -> previous
+  DeviceBuffer<int32_t> prev_verts2new;           // previous vertex -> current (collapse_and_compact)
+  DeviceBuffer<uint32_t> prev_tets_are_kept, prev_tets2new;  // (collapse_and_compact)
   DeviceBuffer<uint32_t> prev_nb_off, prev_edge_off;
   DeviceBuffer<int32_t> prev_nb, prev_nb_edge, prev_tet_nbr;
   DeviceBuffer<uint8_t> prev_vclass, prev_eflags;

@@ -44,8 +44,8 @@ struct SurfaceGuard {
   bool each_pair_once = true;
   bool last_run_each_pair_once = false;
 
-  // Tests the `chosen` collapses of s.fin / s.dir; returns how many were refused (their edges
-  // are unmarked in s.marked).
+  // Tests the `chosen` collapses of s.edges_are_final / s.edges2dir; returns how many were refused (their edges
+  // are unmarked in s.edges_are_marked).
   uint32_t run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p, uint32_t chosen);
   // The same for the matching selection, whose collapses are applied to dm and c.tet_nbr
   // (EdgeState::in_place): on the result (cl/collapse_guard.cl, sguard_applied_*).

@@ -21,14 +21,14 @@ uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
   Kernel block = kernel(ctx, A, "greedy_block"), recompute = kernel(ctx, A, "lazy_p1_recompute"),
              turns = kernel(ctx, A, "lazy_p1_turns");
   auto one_round = [&](uint32_t nt, int cur, cl_uint round) {
-    decide.set(arg("n", nt), arg("cur", cl_uint(cur)), arg("tlist", s.work[cur]), arg("tnext", s.work[1 - cur]), arg("cnt", s.work_n), arg("edges", c.edges), arg("prio", prio), arg("slot", s.slot[0]), arg("blocker", s.blocker), arg("queued", s.queued), arg("round", round), arg("inlist", s.inlist), arg("vstamp", s.vstamp), arg("dlist", s.dlist), arg("state", s.state), arg("vaff", s.vaff), arg("waiting", W), arg("whead", s.whead), arg("wnext", s.wnext));
+    decide.set(arg("n", nt), arg("cur", cl_uint(cur)), arg("tlist", s.turn_lists[cur]), arg("tnext", s.turn_lists[1 - cur]), arg("cnt", s.list_counts), arg("edges", c.edges), arg("prio", prio), arg("slot", s.verts2slot[0]), arg("blocker", s.edges2blocker), arg("queued", s.edges2queued), arg("round", round), arg("inlist", s.round_taken), arg("vstamp", s.verts2listed), arg("dlist", s.vertex_list), arg("state", s.edges2state), arg("vaff", s.verts2collapse), arg("waiting", W), arg("whead", s.verts2waiting), arg("wnext", s.edges2next_waiting));
     decide.launch(ctx, nt);
-    block.set(arg("inlist", s.inlist), arg("cnt", s.work_n), arg("edges", c.edges), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("slot", s.slot[0]), arg("vstamp", s.vstamp), arg("round", round), arg("dlist", s.dlist), arg("state", s.state));
+    block.set(arg("inlist", s.round_taken), arg("cnt", s.list_counts), arg("edges", c.edges), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("slot", s.verts2slot[0]), arg("vstamp", s.verts2listed), arg("round", round), arg("dlist", s.vertex_list), arg("state", s.edges2state));
     block.launch(ctx, nt);  // over the round's taken edges (cnt[4] <= nt)
     vertex_part(ctx, s, c, recompute, turns, prio, cur, round, nullptr, p.waiting_lists);
   };
   auto in_one_group = [&](uint32_t nt, int cur, cl_uint round) {
-    loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.work[0]), arg("t1", s.work[1]), arg("cnt", s.work_n), arg("edges", c.edges), arg("prio", prio), arg("slot", s.slot[0]), arg("blocker", s.blocker), arg("queued", s.queued), arg("inlist", s.inlist), arg("vstamp", s.vstamp), arg("dlist", s.dlist), arg("state", s.state), arg("vaff", s.vaff), arg("max_n", p.greedy_loop_exit), arg("resume", s.resume), arg("waiting", W), arg("whead", s.whead), arg("wnext", s.wnext));
+    loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.turn_lists[0]), arg("t1", s.turn_lists[1]), arg("cnt", s.list_counts), arg("edges", c.edges), arg("prio", prio), arg("slot", s.verts2slot[0]), arg("blocker", s.edges2blocker), arg("queued", s.edges2queued), arg("inlist", s.round_taken), arg("vstamp", s.verts2listed), arg("dlist", s.vertex_list), arg("state", s.edges2state), arg("vaff", s.verts2collapse), arg("max_n", p.greedy_loop_exit), arg("resume", s.loop_resume), arg("waiting", W), arg("whead", s.verts2waiting), arg("wnext", s.edges2next_waiting));
     loop.launch_one_group(ctx);
   };
   return selection_rounds(ctx, c, s, p, "greedy_round", one_round, in_one_group, passed_q, tested);

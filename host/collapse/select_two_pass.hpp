@@ -11,9 +11,9 @@
 
 namespace tc::collapse_detail {
 
-// Conflict pass 1 over the admissible edges (s.adm); returns the number kept.
+// Conflict pass 1 over the admissible edges (s.edges_are_admissible); returns the number kept.
 uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
-// admissible() followed by conflict_pass1() with the same result (p1, vaff, dir of the kept
+// admissible() followed by conflict_pass1() with the same result (edges_pass1, verts2collapse, edges2dir of the kept
 // edges), testing only the edges whose turn comes (cl/collapse_admissible.cl). Returns the
 // number kept; passed_q and tested receive the number of marked edges passing Q and tested.
 uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
@@ -22,8 +22,8 @@ uint32_t conflict_pass2(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
 // A further selection round in the same connectivity after conflict_pass2: edges whose end
 // points are neither end points of the collapses chosen so far nor their neighbours (their
 // stars are disjoint from those collapses, which change nothing the edges' tests look at) go
-// through the lazy filter and both conflict passes again; the result is merged (fin, dir,
-// vaff). Returns the total number of collapses chosen; tested receives the round's tests.
+// through the lazy filter and both conflict passes again; the result is merged
+// (edges_are_final, edges2dir, verts2collapse). Returns the total number of collapses chosen; tested receives the round's tests.
 uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                               uint32_t& tested);
 

@@ -27,7 +27,7 @@ namespace tc::collapse_detail {
 class Selection {
  public:
   virtual ~Selection() = default;
-  // This iteration's collapses in s.fin, s.dir and s.vaff, tested by the surface guard; returns
+  // This iteration's collapses in s.edges_are_final, s.edges2dir and s.verts2collapse, tested by the surface guard; returns
   // how many. Fills stats' candidates, tested, selected, refused_by_guard, seconds_select and
   // seconds_guard.
   uint32_t select(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,

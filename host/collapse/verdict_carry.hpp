@@ -14,7 +14,7 @@ namespace tc::collapse_detail {
 // Verdict carrying around collapse_and_compact: remember_for_carry() before it (dirty vertices:
 // the end points of the final edges and their neighbours), note_compaction() right after it
 // (previous connectivity and verdicts kept, current -> previous vertex map), carry_verdicts()
-// after the next build_connectivity (fills s.verdict for the next lazy_admissible_pass1).
+// after the next build_connectivity (fills s.edges2verdict for the next lazy_admissible_pass1).
 void remember_for_carry(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
 void note_compaction(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
 void carry_verdicts(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);

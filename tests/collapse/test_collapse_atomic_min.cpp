@@ -59,11 +59,11 @@ struct AtomicStage {
     n = conflicts_atomic_min(ctx, dm, c, s);
     ne = c.ne;
     edges = c.edges.download_range(0, 2 * size_t(ne));
-    adm = s.adm.download_range(0, ne);
-    fin = s.fin.download_range(0, ne);
-    cost = s.cost.download_range(0, ne);
-    dir = s.dir.download_range(0, ne);
-    vaff = s.vaff.download_range(0, dm.nv);
+    adm = s.edges_are_admissible.download_range(0, ne);
+    fin = s.edges_are_final.download_range(0, ne);
+    cost = s.edges2cost.download_range(0, ne);
+    dir = s.edges2dir.download_range(0, ne);
+    vaff = s.verts2collapse.download_range(0, dm.nv);
     tets = m.tets;
     ring.assign(m.num_vertices(), {});
     for (size_t t = 0; t < tets.size() / 4; ++t)
@@ -229,7 +229,7 @@ TEST(CollapseAtomicMin, SelectedEdgesAreLocalMinimaAndASubsetOfTwoPass) {
     const std::vector<uint32_t> atomic_fin = st.fin;
     conflict_pass1(ctx, st.dm, st.c, st.s);
     const uint32_t n2 = conflict_pass2(ctx, st.dm, st.c, st.s);
-    const std::vector<uint32_t> two = st.s.fin.download_range(0, st.ne);
+    const std::vector<uint32_t> two = st.s.edges_are_final.download_range(0, st.ne);
     uint32_t outside = 0;
     for (uint32_t e = 0; e < st.ne; ++e) outside += atomic_fin[e] && !two[e];
     std::printf("%s: atomic-min %u, two-pass %u, atomic edges not in two-pass %u, resolution ties %d\n",

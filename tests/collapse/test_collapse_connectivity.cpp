@@ -257,7 +257,7 @@ TEST(CollapseConnectivity, CarriedAfterCollapsesEqualsFreshBuild) {
       StageParams q = p;
       q.target = 1e300;  // every edge marked: cost = length
       cost_and_mark(ctx, dm, c, s, q);
-      return s.cost.download_range(0, c.ne);
+      return s.edges2cost.download_range(0, c.ne);
     }();
     std::nth_element(len.begin(), len.begin() + len.size() / 2, len.end());
     p.target = 2 * len[len.size() / 2];
@@ -289,7 +289,7 @@ TEST(CollapseConnectivity, CarriedAfterCollapsesEqualsFreshBuild) {
       EXPECT_EQ(c.vclass.download_range(0, dm.nv), fresh.vclass.download_range(0, dm.nv));
       EXPECT_EQ(c.eflags.download_range(0, c.ne), fresh.eflags.download_range(0, c.ne));
       // some vertices were carried, not recomputed (else this test would test nothing)
-      std::vector<uint8_t> nd = s.ndirty.download_range(0, dm.nv);
+      std::vector<uint8_t> nd = s.verts_are_dirty.download_range(0, dm.nv);
       EXPECT_GT(std::count(nd.begin(), nd.end(), uint8_t(0)), 0) << "iteration " << it;
       ++carried_iterations;
     }

@@ -107,16 +107,16 @@ struct MatchStage {
     cost_and_mark(ctx, dm, c, s, p);
     ne = c.ne;
     edges = c.edges.download_range(0, 2 * size_t(ne));
-    marked = s.marked.download_range(0, ne);
+    marked = s.edges_are_marked.download_range(0, ne);
     matching_backup(ctx, dm, s);
     uint32_t passed_q = 0;
     s.verdict_ready = false;
     taken = matching_selection(ctx, dm, c, s, p, passed_q, tested);
-    fin = s.fin.download_range(0, ne);
-    dround = s.dround.download_range(0, ne);
-    dir = s.dir.download_range(0, ne);
-    reason = s.reason.download_range(0, ne);
-    prio = s.prio.download_range(0, ne);
+    fin = s.edges_are_final.download_range(0, ne);
+    dround = s.edges2round.download_range(0, ne);
+    dir = s.edges2dir.download_range(0, ne);
+    reason = s.edges2reason.download_range(0, ne);
+    prio = s.edges2priority.download_range(0, ne);
   }
   // The mesh as the collapses left it, compacted.
   Mesh result(Context& ctx, const Mesh& input) {
@@ -276,8 +276,8 @@ TEST(CollapseMatching, UndoLeavesTheOtherCollapses) {
       if (st.fin[e]) taken.push_back(e);
     for (size_t i = 0; i < taken.size(); i += 3) refused.push_back(taken[i]);
     const uint32_t undone = matching_undo(ctx, st.dm, st.c, st.s, refused);
-    const std::vector<uint32_t> fin = st.s.fin.download_range(0, st.ne);
-    const std::vector<uint8_t> reason = st.s.reason.download_range(0, st.ne);
+    const std::vector<uint32_t> fin = st.s.edges_are_final.download_range(0, st.ne);
+    const std::vector<uint8_t> reason = st.s.edges2reason.download_range(0, st.ne);
     // the closure on the host
     std::vector<std::vector<int32_t>> nbr(size_t(in.mesh.num_vertices()));
     for (uint32_t e = 0; e < st.ne; ++e) {
@@ -367,7 +367,7 @@ TEST(CollapseMatching, LinkConditionPerKindOfSurface) {
   EdgeState s;
   test::run_to_admissible(ctx, m, p, 10, dm, c, s);
   const std::vector<int32_t> edges = c.edges.download_range(0, 2 * size_t(c.ne));
-  const std::vector<uint8_t> reason = s.reason.download_range(0, c.ne), eflags = c.eflags.download_range(0, c.ne);
+  const std::vector<uint8_t> reason = s.edges2reason.download_range(0, c.ne), eflags = c.eflags.download_range(0, c.ne);
   int32_t e = -1;
   for (uint32_t i = 0; i < c.ne; ++i)
     if (edges[2 * i] == std::min(a, b) && edges[2 * i + 1] == std::max(a, b)) e = int32_t(i);
@@ -512,11 +512,11 @@ TEST(CollapseMatching, GuardAfterUndoTestsWhatTheUndoChanged) {
         full.each_pair_once = false;
         const uint32_t full_refused = full.run_applied(ctx, dm, c, s, p, chosen);
         full_queries += int(full.last_queries);
-        const std::vector<uint32_t> marked = s.marked.download_range(0, c.ne);
+        const std::vector<uint32_t> marked = s.edges_are_marked.download_range(0, c.ne);
         const uint32_t refused = guard.run_applied(ctx, dm, c, s, p, chosen);
         restricted_queries += int(guard.last_queries);
         EXPECT_EQ(refused, full_refused) << "iteration " << it;
-        EXPECT_EQ(s.marked.download_range(0, c.ne), marked) << "iteration " << it;  // the same ones unmarked
+        EXPECT_EQ(s.edges_are_marked.download_range(0, c.ne), marked) << "iteration " << it;  // the same ones unmarked
         if (refused == 0) break;
         chosen -= matching_undo(ctx, dm, c, s, guard);
       }

@@ -47,9 +47,9 @@ DeviceVerdicts device_verdicts(Context& ctx, const Mesh& m, const CollapseOption
   admissible(ctx, dm, c, s, p);
   DeviceVerdicts d;
   d.edges = c.edges.download_range(0, 2 * size_t(c.ne));
-  d.marked = s.marked.download_range(0, c.ne);
-  d.reason = s.reason.download_range(0, c.ne);
-  d.dir = s.dir.download_range(0, c.ne);
+  d.marked = s.edges_are_marked.download_range(0, c.ne);
+  d.reason = s.edges2reason.download_range(0, c.ne);
+  d.dir = s.edges2dir.download_range(0, c.ne);
   d.vflags = c.vflags.download_range(0, dm.nv);
   d.vclass = c.vclass.download_range(0, dm.nv);
   d.eflags = c.eflags.download_range(0, c.ne);
