@@ -2,9 +2,8 @@
 // open addressing, linear probing, erase by backward shift, at most half full.
 //
 // Why our own: the greedy host tail (SequentialRun, sequential.cpp) inserts and erases an edge
-// for every queue entry, ~52,000 on W1's tail and several times that when it starts earlier;
-// std::unordered_set allocates and frees a node for each (~11% of the tail's time in a perf
-// profile of a long tail). The standard library has no flat hash set, and one header is less
+// for every queue entry; std::unordered_set allocates and frees a node for each, a visible share
+// of the tail's time in a profile (bench/README.md). The standard library has no flat hash set, and one header is less
 // than a new dependency (Boost's unordered_flat_set) for the same thing.
 #pragma once
 

@@ -20,7 +20,7 @@ namespace tc::collapse_detail {
 
 namespace {
 
-// ensure (stages.hpp) with at least one element: no zero-sized OpenCL buffers.
+// ensure (launch.hpp) with at least one element: no zero-sized OpenCL buffers.
 template <class T>
 void ensure_nonempty(DeviceBuffer<T>& b, Context& ctx, size_t n) {
   ensure(b, ctx, std::max<size_t>(n, 1));

@@ -41,10 +41,9 @@ struct StageParams {
   // CollapseTuning::priority_levels; its rounds run in one work-group (greedy_loop) once the
   // turn list holds at most greedy_loop_size edges, back to per-round kernels when one holds
   // more than greedy_loop_exit. Results do not depend on the last two. With the waiting lists a
-  // turn list holds only edges to decide (~3 us of a core each on W1), so one core is slower
-  // than two plus a round's launches (~0.25 ms) above ~170 of them (bench_selection, matching,
-  // 6-8 alternations, medians: iteration 3 0.077 s against 0.086 s at 512/2048, iteration 6
-  // 0.043 s against 0.048 s, iteration 0 the same).
+  // turn list holds only edges to decide, each a test of some microseconds, so past a small
+  // list one core is slower than two cores plus a round's launches (the sizes measured with
+  // bench_selection; bench/README.md).
   double priority_levels = 64;
   uint32_t greedy_loop_size = 128, greedy_loop_exit = 512;
   // Greedy and matching selections: an edge waiting for its blocker waits on the blocker's

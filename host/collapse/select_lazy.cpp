@@ -27,7 +27,7 @@ void vertex_part(Context& ctx, EdgeState& s, const Connectivity& c, Kernel& reco
 
 // The start shared by the lazy filter and the greedy selection: buffers, the verdicts, lazy_init
 // (candidates, Q, carried refusals, the first claims in s.verts2slot[0] in the order of `order`), and
-// the test's arguments of each kernel of `tests` (from the given argument index on).
+// the test's arguments of each kernel of `tests`, by name.
 void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                 const DeviceBuffer<double>& order, std::initializer_list<Kernel*> tests,
                 bool keep_refused) {

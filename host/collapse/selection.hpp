@@ -1,5 +1,5 @@
-// The selection of an iteration (paper, Algorithm 1, lines "admissible" and "conflicts"): which
-// marked edges collapse. Four implementations, one per conflict detection, each in the file of
+// The selection of an iteration (the paper's Sections 3.2 and 3.3, within collapseEdges of
+// Algorithm 1): which marked edges collapse. Four implementations, one per conflict detection, each in the file of
 // its kernels' host side:
 //   TwoPass    the paper's: the lazy admissible filter with conflict pass 1 over edges, then
 //              pass 2 over tets (select_two_pass.cpp)

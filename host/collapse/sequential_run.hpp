@@ -67,8 +67,8 @@ struct TailSeed {
   std::vector<uint8_t> vflags, vclass, touched;
   std::vector<int32_t> tet_nbr;  // 4 per tet (collapse_common.h), the device's
   // The edges of the mesh (a, b), a < b, 2 per edge, the device's (Connectivity::edges): the
-  // first iteration's edge list, instead of gathering N(v) of every vertex again (W1: ~15 ms of
-  // a ~0.15 s tail). Empty: gathered. Any order: the queue orders by (cost, a, b).
+  // first iteration's edge list, instead of gathering N(v) of every vertex again (a visible share
+  // of a short tail). Empty: gathered. Any order: the queue orders by (cost, a, b).
   std::vector<int32_t> edges;
 };
 

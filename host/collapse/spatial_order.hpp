@@ -1,7 +1,7 @@
 // A locality-improving renumbering of a mesh for the device run: vertices along a Morton
 // (Z-order) curve of their positions, tets by their smallest new vertex index. The stages
 // gather rings, neighbours and points of nearby vertices; in file order (e.g. TetGen's, where
-// the two ends of an edge are ~17,000 indices apart on the robot mesh) nearly every such
+// the two ends of an edge are often thousands of indices apart) nearly every such
 // access misses the cache. The collapse keeps relative order, so the locality lasts the run.
 // Ties (points closer than 2^-21 of the extent share a code; tets with the same smallest
 // vertex) keep the input's order.

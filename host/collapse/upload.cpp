@@ -40,10 +40,10 @@ void check_collapse_input(const Mesh& mesh) {
 namespace {
 
 // ring(v) for every vertex: counted, then filled in tet order, so each ring is ascending. Why
-// on the host for a CPU device (Context::cpu_tuning): one sequential pass over the tets (W1: a
-// few ms on one core) against the device's atomic count and scatter and a sort of every ring
-// (conn_count, conn_scatter, conn_ring_sort_and_gather's sort), ~0.025 s on both cores; the
-// tets are in spatial order, so the writes are near each other. A GPU does its own.
+// on the host for a CPU device (Context::cpu_tuning): one sequential pass over the tets is
+// cheaper than the device's atomic count and scatter and a sort of every ring (conn_count,
+// conn_scatter, conn_ring_sort_and_gather's sort) on the same cores; the tets are in spatial
+// order, so the writes are near each other. A GPU does its own.
 void host_rings(const std::vector<int32_t>& tets, uint32_t nv, std::vector<uint32_t>& off, std::vector<int32_t>& vt) {
   off.assign(size_t(nv) + 1, 0);
   for (int32_t v : tets) ++off[size_t(v) + 1];
@@ -78,8 +78,8 @@ void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, Devic
   dm.nt = uint32_t(nt);
   const std::vector<int32_t>& tets = order ? spatial.tets : mesh.tets;
   // The rings (Context::cpu_tuning: a CPU device) on a second thread while this one gathers and
-  // uploads the rest: the device's threads are idle during the upload (W1: the rings ~0.02 s,
-  // the rest ~0.015 s).
+  // uploads the rest: the device's threads are idle during the upload, and the two take
+  // about as long.
   dm.has_rings = ctx.cpu_tuning();
   std::vector<uint32_t> ring_off;
   std::vector<int32_t> ring_vt;

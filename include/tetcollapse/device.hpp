@@ -83,8 +83,9 @@ class Context {
   // kernels that prefetch for their next work items, the rings built on the host, the
   // primitives' CPU variants (tc::dev::Tuning; a process-wide dev::set_tuning_override comes
   // first), at least 4 work-groups per compute unit per launch (with work_group_size() 0), and
-  // the automatic host tail (CollapseOptions::host_tail). Otherwise the GPU choices. Results
-  // never depend on it: tests set it to false to run the GPU code paths on PoCL. The environment
+  // the automatic host tail (CollapseTuning::host_tail). Otherwise the GPU choices. Results
+  // depend on it only through the automatic host tail (a CPU device runs one, a GPU none; with
+  // host_tail set, never): tests set it to false to run the GPU code paths on PoCL. The environment
   // variable TETCOLLAPSE_TUNING=gpu|cpu sets it for every new context (DeviceError for another
   // value). It may change at any time; the next program of a variant not built yet in this
   // context is compiled (or read from the disk cache) then.
