@@ -11,7 +11,6 @@
 // Prints a table (median of N runs of collapse(), iterations, collapses per iteration, time per
 // stage summed over the iterations of the median run, tets in/out) and the same as JSON.
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -19,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "stopwatch.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/io.hpp"
 
@@ -34,9 +34,6 @@ struct Result {
   CollapseReport report;  // of the median run
 };
 
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 std::vector<double> parse_list(const char* s) {
   std::vector<double> out;
@@ -95,14 +92,14 @@ int main(int argc, char** argv) {
     }
   }
   Mesh input;
-  auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch read_clock;
   try {
     input = read_mesh(path);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_collapse: cannot read %s: %s\n", path.c_str(), e.what());
     return 1;
   }
-  const double read_s = seconds_since(t0);
+  const double read_s = read_clock.peek();
   Context ctx;
   ctx.set_work_group_size(wg);
   std::printf("mesh %s: %lld vertices, %lld tets (read in %.3f s)\ndevice %s\n", path.c_str(),
@@ -131,9 +128,9 @@ int main(int argc, char** argv) {
         o.tuning.host_tail = host_tail;
         o.max_iterations = max_iterations;
         conflicts_from(conflicts[k], o.conflicts);
-        auto t = std::chrono::steady_clock::now();
+        const Stopwatch clock;
         CollapseReport rep = collapse(m, o, ctx);
-        double wall = seconds_since(t);
+        double wall = clock.peek();
         rs[k].walls.push_back(wall);
         all[k].emplace_back(wall, rep);
       }

@@ -1,5 +1,4 @@
 // The main job: tetcollapse IN OUT [options] coarsens a mesh by parallel edge collapse.
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -9,6 +8,7 @@
 #include "cli/common.hpp"
 #include "io/io_util.hpp"
 #include "json.hpp"
+#include "stopwatch.hpp"
 #include "tetcollapse/collapse.hpp"
 #ifdef TETCOLLAPSE_HAVE_CHECK
 #include "tetcollapse/check.hpp"
@@ -164,9 +164,6 @@ std::string cl_file(const std::string& path) {
   return "#line 1 \"" + quoted + "\"\n" + io::load_file(path);
 }
 
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 }  // namespace
 
@@ -269,9 +266,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
       throw CLI::RequiredError("IN and OUT (or a subcommand; see --help)");
     check_output_path(c->out, &c->output);
     check_output_path(c->stats, nullptr);
-    auto t0 = std::chrono::steady_clock::now();
+    const Stopwatch total;
+    Stopwatch stage;
     Mesh mesh = read_input(c->in, c->input, c->quiet);
-    double seconds_read = seconds_since(t0);
+    double seconds_read = stage.lap();
     Mesh input;
     if (c->check) input = mesh;
 
@@ -370,10 +368,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
       throw CLI::ValidationError("--check", "this build has no checker (CGAL)");
 #endif
     }
-    auto tw = std::chrono::steady_clock::now();
+    stage.lap();
     if (exit_code != kCheckFailed) write_mesh(c->out, mesh, write_options(c->output));
-    double seconds_write = seconds_since(tw);
-    double seconds_total = seconds_since(t0);
+    double seconds_write = stage.lap();
+    double seconds_total = total.peek();
     if (!c->quiet) {
       double stage[5] = {0, 0, 0, 0, 0};
       for (const auto& it : r.iterations) {
