@@ -26,9 +26,16 @@ void ensure_nonempty(DeviceBuffer<T>& b, Context& ctx, size_t n) {
   ensure(b, ctx, std::max<size_t>(n, 1));
 }
 
+// The kernels of the matching selection's guard live in collapse_guard_applied.cl.
+bool applied_kernel(const std::string& name) {
+  return name.rfind("sguard_applied_", 0) == 0 || name == "sguard_undone_boxes" || name == "sguard_requery" ||
+         name == "sguard_refused_list";
+}
+
 template <class... T>
 void launch(Context& ctx, const StageParams& p, const char* name, size_t n, const Arg<T>&... args) {
-  run_stage(ctx, p, "collapse_guard.cl", name, n, args...);  // the placement may be the user's
+  // the placement may be the user's
+  run_stage(ctx, p, applied_kernel(name) ? "collapse_guard_applied.cl" : "collapse_guard.cl", name, n, args...);
 }
 
 // The cell of coordinate v on one axis (ih = 1 / the cell size); the same arithmetic as

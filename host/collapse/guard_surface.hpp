@@ -48,12 +48,12 @@ struct SurfaceGuard {
   // are unmarked in s.edges_are_marked).
   uint32_t run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p, uint32_t chosen);
   // The same for the matching selection, whose collapses are applied to dm and c.tet_nbr
-  // (EdgeState::in_place): on the result (cl/collapse_guard.cl, sguard_applied_*).
+  // (EdgeState::in_place): on the result (cl/collapse_guard_applied.cl).
   uint32_t run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                        uint32_t chosen);
   // After the matching selection undid the collapses of `undone` (after a run_applied that
   // refused some): the next run_applied tests only the queries that the undo may concern
-  // (cl/collapse_guard.cl, sguard_undone_boxes).
+  // (cl/collapse_guard_applied.cl, sguard_undone_boxes).
   void restrict_to_undone(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
                           const std::vector<uint32_t>& undone);
   // After a run that refused collapses: their edges flagged in flag (1) and listed in list (from
