@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Plots and markdown tables of a bench/run_suite.py result (issue 6).
 
-    bench/plot_suite.py [RESULT.json] [--out-dir DIR] [--markdown FILE] [--no-plots]
+    bench/plot_suite.py [RESULT.json] [--out-dir DIR] [--markdown FILE] [--no-plots] [--parts fig7,fig8,table2,fig9]
 
 RESULT.json defaults to bench/results/suite.json. Writes, with Debian's matplotlib (python3-matplotlib):
   DIR/fig7_<mesh>.png   collapses per iteration, every method (paper Fig. 7)
@@ -10,7 +10,9 @@ RESULT.json defaults to bench/results/suite.json. Writes, with Debian's matplotl
   DIR/fig9.png          run time and tets left against eps_c, ours (paper Fig. 9)
 DIR defaults to bench/plots, or bench/plots/smoke for a result labelled "smoke".
 Prints markdown tables (Fig. 7 iterations and the goals of issue 6, Fig. 8, Table 2, Fig. 9,
-failures) on stdout, and into --markdown FILE when given, for bench/README.md.
+failures) on stdout, and into --markdown FILE when given. --parts limits both to those parts (e.g. to
+redraw only fig8 from a result whose other parts newer files supersede). The tables of bench/README.md
+are written by bench/make_tables.py, which takes each part from the newest result holding it.
 """
 import argparse
 import json
@@ -199,17 +201,22 @@ def plot_fig9(plt, r, out_dir, tag):
 
 # ---- markdown ---------------------------------------------------------------------------------
 
-def markdown(r):
+def part_markdown(r, part, heading=True, notes=True):
+    """The markdown lines of one part ("fig7", "fig8", "table2", "fig9") of result r, with its
+    heading unless heading=False and the Fig. 7 goals and the notes under Table 2 unless
+    notes=False ([] when r does not hold the part). bench/make_tables.py puts these into
+    bench/README.md."""
     md = multi_device(r)
-    out = header_lines(r)
-    out.append("")
     parts = r.get("parts", {})
-
-    if "fig7" in parts:
-        out += ["#### Fig. 7: iterations below the median edge length (eps_c 0)", "",
-                "One run per method and mesh (the sequence of collapses is deterministic; more runs of the same "
-                "configuration, e.g. from fig8, are checked to give the same counts).", "",
-                "| mesh | tets in | method | iterations | tets out | collapses per iteration (first 8) |",
+    if part not in parts:
+        return []
+    out = []
+    if part == "fig7":
+        if heading:
+            out += ["#### Fig. 7: iterations below the median edge length (eps_c 0)", "",
+                    "One run per method and mesh (the sequence of collapses is deterministic; more runs of the same "
+                    "configuration, e.g. from fig8, are checked to give the same counts).", ""]
+        out += ["| mesh | tets in | method | iterations | tets out | collapses per iteration (first 8) |",
                 "|---|---:|---|---:|---:|---|"]
         goals = []
         for m in parts["fig7"]["data"]:
@@ -226,7 +233,10 @@ def markdown(r):
                     out.append(f"| {m['mesh']} | {m['info']['tets']:,} | {label_of(e, md)} | "
                                f"{e['iterations_collapsing']} | {e['tets_out']:,} | {first}, ... |")
             goals += [(m["mesh"], g) for g in m.get("goals", [])]
-        out += ["", "Goals of issue 6 (iterations that collapse at least one edge):", "",
+        if not notes:
+            out.append("")
+            return out
+        out += ["", "Goals (iterations that collapse at least one edge):", "",
                 "| mesh | goal | verdict | detail |", "|---|---|---|---|"]
         for mesh, g in goals:
             out.append(f"| {mesh} | {g['goal']}{g.get('device_tag', '')} | **{g['verdict']}** | {g['detail']} |")
@@ -234,22 +244,22 @@ def markdown(r):
             out.append("| - | - | not evaluated | no Fig. 7 mesh ran |")
         out.append("")
 
-    if "fig8" in parts:
-        out += ["#### Fig. 8: run time against the threshold (eps_c 0), median seconds: overall / collapsing", ""]
+    if part == "fig8":
+        if heading:
+            out += ["#### Fig. 8: run time against the threshold (eps_c 0), median seconds: overall / collapsing", ""]
+        cols = []
         for m in parts["fig8"]["data"]:
-            if m.get("status") != "ok":
-                out += [f"{m['mesh']}: skipped ({m.get('message')})", ""]
-                continue
-            cols = []
-            for p in m["points"]:
+            for p in m.get("points", []):
                 for e in p["results"]:
                     lab = label_of(e, md)
                     if lab not in cols:
                         cols.append(lab)
-            out.append(f"{m['mesh']} ({m['info']['tets']:,} tets):")
-            out.append("")
-            out.append("| threshold | " + " | ".join(cols) + " | tets out (ours) |")
-            out.append("|---:|" + "---:|" * len(cols) + "---:|")
+        out.append("| mesh (tets) | threshold (fraction of the median) | " + " | ".join(cols) + " | tets out (ours) |")
+        out.append("|---|---:|" + "---:|" * len(cols) + "---:|")
+        for m in parts["fig8"]["data"]:
+            if m.get("status") != "ok":
+                out.append(f"| {m['mesh']} | skipped ({m.get('message')}) |" + " |" * (len(cols) + 1))
+                continue
             for p in m["points"]:
                 cells = {}
                 tets = "-"
@@ -261,13 +271,14 @@ def markdown(r):
                             tets = f"{e['tets_out']:,}"
                     else:
                         cells[lab] = "failed"
-                out.append(f"| {p['threshold']:.4g} ({p['fraction']:.2f}) | " + " | ".join(cells.get(c, "-") for c in cols)
-                           + f" | {tets} |")
-            out.append("")
+                out.append(f"| {m['mesh']} ({m['info']['tets']:,}) | {p['threshold']:.4g} ({p['fraction']:.2f}) | "
+                           + " | ".join(cells.get(c, "-") for c in cols) + f" | {tets} |")
+        out.append("")
 
-    if "table2" in parts:
+    if part == "table2":
         t = parts["table2"]["data"]
-        out += [f"#### Table 2: {t['mesh']} to 2 x median edge length, eps_c 0", ""]
+        if heading:
+            out += [f"#### Table 2: {t['mesh']} to 2 x median edge length, eps_c 0", ""]
         if t.get("status") != "ok":
             out += [f"skipped ({t.get('message')})", ""]
         else:
@@ -291,15 +302,17 @@ def markdown(r):
             if pe and pe.get("status") != "ok":
                 out.append(f"\nPeers: {pe.get('status')} ({pe.get('message')}).")
             out.append("")
-            out.append("Run time = `seconds_collapse` (collapse() with the connectivity rebuilds, without file I/O); "
-                       "speedup of ours = run time of the row / run time of ours in the same run. Peers: their own "
-                       "algorithm time where they report one; the whole-process column compares their wall clock "
-                       "with ours' whole CLI process (file I/O included).")
-            out.append("")
+            if notes:
+                out.append("Run time = `seconds_collapse` (collapse() with the connectivity rebuilds, without file I/O); "
+                           "speedup of ours = run time of the row / run time of ours in the same run. Peers: their own "
+                           "algorithm time where they report one; the whole-process column compares their wall clock "
+                           "with ours' whole CLI process (file I/O included).")
+                out.append("")
 
-    if "fig9" in parts:
+    if part == "fig9":
         m = parts["fig9"]["data"]
-        out += [f"#### Fig. 9: {m['mesh']} to 2 x median edge length, eps_c swept (ours)", ""]
+        if heading:
+            out += [f"#### Fig. 9: {m['mesh']} to 2 x median edge length, eps_c swept (ours)", ""]
         if m.get("status") != "ok":
             out += [f"skipped ({m.get('message')})", ""]
         else:
@@ -313,6 +326,17 @@ def markdown(r):
                         out.append(f"| {p['eps_c']} | {dev} | {fmt(e['median']['seconds_collapse'])} | "
                                    f"{e['iterations_collapsing']} | {e['tets_out']:,} | {e['vertices_out']:,} |")
             out.append("")
+    return out
+
+
+PARTS = ("fig7", "fig8", "table2", "fig9")
+
+
+def markdown(r, parts=PARTS):
+    out = header_lines(r)
+    out.append("")
+    for part in parts:
+        out += part_markdown(r, part)
 
     fails = r.get("failures", [])
     if fails:
@@ -333,12 +357,17 @@ def main():
     ap.add_argument("--out-dir", default=None)
     ap.add_argument("--markdown", default=None, help="also write the tables to this file")
     ap.add_argument("--no-plots", action="store_true")
+    ap.add_argument("--parts", default=",".join(PARTS), help="comma-separated subset of " + ",".join(PARTS))
     a = ap.parse_args()
+    parts = [p for p in a.parts.split(",") if p]
+    unknown = [p for p in parts if p not in PARTS]
+    if unknown:
+        ap.error(f"unknown part(s) {unknown}; known: {', '.join(PARTS)}")
     with open(a.result) as f:
         r = json.load(f)
     smoke = r.get("label") == "smoke"
     out_dir = a.out_dir or os.path.join(HERE, "plots", "smoke" if smoke else "")
-    text = markdown(r)
+    text = markdown(r, [p for p in PARTS if p in parts])
     print(text)
     if a.markdown:
         with open(a.markdown, "w") as f:
@@ -353,7 +382,8 @@ def main():
         sys.exit("plot_suite.py: matplotlib is missing: apt-get install python3-matplotlib and run with /usr/bin/python3")
     os.makedirs(out_dir, exist_ok=True)
     tag = "SMOKE RUN - " if smoke else ""
-    files = plot_fig7(plt, r, out_dir, tag) + plot_fig8(plt, r, out_dir, tag) + plot_fig9(plt, r, out_dir, tag)
+    plotters = {"fig7": plot_fig7, "fig8": plot_fig8, "fig9": plot_fig9}
+    files = [f for p in parts if p in plotters for f in plotters[p](plt, r, out_dir, tag)]
     for f in files:
         print(f"wrote {os.path.relpath(f)}", file=sys.stderr)
 

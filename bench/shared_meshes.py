@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Every shared mesh coarsened to its median edge length, with --check (issue 5).
+"""Every shared mesh coarsened to its median edge length, with --check.
 
     bench/shared_meshes.py [--tetcollapse PATH] [--meshes DIR] [--modes features,strict]
                            [--only SUBSTRING,...] [--out-json F] [--readme F] [--work-dir DIR]
@@ -13,9 +13,10 @@ surface meshes only and are not read) and every mode, runs
 and then, on the output when one was written, `tetcollapse check OUT.vtu --reference IN --json`
 for the numbers --check does not put in the statistics (boundary Hausdorff distance, topology,
 output quality). Writes one JSON object per (mesh, mode) to --out-json (default
-bench/results/shared_meshes.json) and replaces the section "Every shared mesh at its median
-edge length (issue 5)" of --readme (default bench/README.md) with a table of the results
-(--from-json F: only that, from a results file).
+bench/results/shared_meshes.json) and rewrites the table between <!-- table:shared_meshes -->
+and <!-- /table:shared_meshes --> in --readme (default bench/README.md; '' leaves it alone)
+with the results (--from-json F: only that, from a results file). bench/make_tables.py writes
+the same table from bench/results/shared_meshes.json.
 Expected for every mesh that is valid on input: exit 0, check valid, boundary topology
 unchanged, and in strict mode a Hausdorff distance of 0. Anything else is listed under the table.
 """
@@ -32,7 +33,7 @@ import time
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 EXTS = (".msh", ".mesh", ".meshb", ".vtk", ".vtu", ".node")
-SECTION = "## Every shared mesh at its median edge length (issue 5)"
+TABLE = "shared_meshes"  # the name of the README's table markers
 
 
 def default_tetcollapse():
@@ -131,32 +132,39 @@ def fmt(x, spec):
     return "-" if x is None else format(x, spec)
 
 
-def table(rows, meta):
-    lines = [SECTION, ""]
-    lines.append(f"`bench/shared_meshes.py` ({meta['date']}, commit {meta['commit']}, binary built "
-                 f"{meta.get('binary_built', '?')}, {meta['device']}; load average "
-                 f"{meta['load_min']:.1f}-{meta['load_max']:.1f} during the run). Every volume mesh of "
-                 "`../shared/meshes/`, target = its median edge length (`--target-factor 1`), default options "
-                 "(quality guard 0.1, eps_c 0), one run each: `tetcollapse IN OUT.vtu --target-factor 1 --boundary "
-                 "MODE --check --stats S.json`, then `tetcollapse check OUT.vtu --reference IN` for the boundary "
-                 "Hausdorff distance (relative to the bounding-box diagonal) and the output's smallest dihedral "
-                 "angle. `collapse s` is the pipeline without file I/O (`seconds_collapse`), `total s` the whole "
-                 "command including reading, `--check` and writing (`seconds_total`). Results: "
-                 "`bench/results/shared_meshes.json`.")
-    lines.append("")
-    lines.append("| mesh | tets in | mode | tets out | reduction | iterations | collapse s | total s | --check | "
-                 "Hausdorff rel | min dihedral in -> out |")
-    lines.append("|---|---:|---|---:|---:|---:|---:|---:|---|---:|---:|")
-    for r in rows:
-        check = r.get("check") or (f"exit {r.get('exit_code')}")
-        if r.get("topology_changed"):
-            check += ", topology changed"
-        lines.append("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |".format(
-            r["mesh"], fmt(r.get("tets_in"), ","), r["mode"], fmt(r.get("tets_out"), ","),
-            fmt(None if r.get("tet_reduction") is None else 100 * r["tet_reduction"], ".1f") + "%",
-            fmt(r.get("iterations"), "d"), fmt(r.get("seconds_collapse"), ".2f"), fmt(r.get("seconds_total"), ".2f"),
-            check, fmt(r.get("hausdorff_rel"), ".2g"),
-            fmt(r.get("min_dihedral_in_deg"), ".2f") + " -> " + fmt(r.get("min_dihedral_deg"), ".2f")))
+def table(rows, meta, json_path="bench/results/shared_meshes.json"):
+    """The README's table of a results file: where it was recorded, one row per mesh with a
+    group of columns per boundary mode, then every run that is not the expected result."""
+    modes = list(dict.fromkeys(r["mode"] for r in rows))
+    meshes = list(dict.fromkeys(r["mesh"] for r in rows))
+    by = {(r["mesh"], r["mode"]): r for r in rows}
+    lines = [f"Recorded: `{json_path}`; commit {meta['commit']}, device {meta['device']}, machine "
+             f"{meta.get('machine', '?')}; load average {meta['load_min']:.1f}-{meta['load_max']:.1f} during the run.",
+             ""]
+    head = ["mesh", "tets in"]
+    for m in modes:
+        head += [f"{m}: tets out (reduction)", "it.", "collapse (total) s", "Hausdorff rel", "--check"]
+    head.append("min dihedral in -> " + " / ".join(modes))
+    lines.append("| " + " | ".join(head) + " |")
+    lines.append("|---|---:|" + "---:|---:|---:|---:|---|" * len(modes) + "---:|")
+    for mesh in meshes:
+        rs = [by.get((mesh, m)) for m in modes]
+        first = next(r for r in rs if r)
+        cells = [mesh, fmt(first.get("tets_in"), ",")]
+        for r in rs:
+            if r is None:
+                cells += ["-"] * 5
+                continue
+            check = r.get("check") or (f"exit {r.get('exit_code')}")
+            if r.get("topology_changed"):
+                check += ", topology changed"
+            red = fmt(None if r.get("tet_reduction") is None else 100 * r["tet_reduction"], ".1f")
+            cells += [f"{fmt(r.get('tets_out'), ',')} ({red}%)", fmt(r.get("iterations"), "d"),
+                      f"{fmt(r.get('seconds_collapse'), '.2f')} ({fmt(r.get('seconds_total'), '.2f')})",
+                      fmt(r.get("hausdorff_rel"), ".2g"), check]
+        cells.append(fmt(first.get("min_dihedral_in_deg"), ".2f") + " -> "
+                     + " / ".join(fmt(r.get("min_dihedral_deg") if r else None, ".2f") for r in rs))
+        lines.append("| " + " | ".join(cells) + " |")
     bad = [(r, problems(r)) for r in rows if problems(r)]
     lines.append("")
     if bad:
@@ -168,22 +176,14 @@ def table(rows, meta):
                          f". Command: `{r['command']}`")
     else:
         lines.append("Every run: exit 0, output valid, boundary topology unchanged, strict Hausdorff 0.")
-    lines.append("")
     return "\n".join(lines)
 
 
-def replace_section(readme, text):
-    with open(readme) as f:
-        lines = f.read().split("\n")
-    try:
-        start = lines.index(SECTION)
-    except ValueError:
-        body = "\n".join(lines).rstrip("\n") + "\n\n" + text
-    else:
-        end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")), len(lines))
-        body = "\n".join(lines[:start]) + "\n" + text + ("\n" + "\n".join(lines[end:]) if end < len(lines) else "")
-    with open(readme, "w") as f:
-        f.write(body.rstrip("\n") + "\n")
+def write_readme(readme, rows, meta, json_path):
+    sys.path.insert(0, HERE)
+    import make_tables
+    rel = os.path.relpath(os.path.abspath(json_path), ROOT)
+    make_tables.replace_blocks(readme, {TABLE: table(rows, meta, rel)})
 
 
 def main():
@@ -202,7 +202,7 @@ def main():
     if a.from_json:
         with open(a.from_json) as f:
             res = json.load(f)
-        replace_section(a.readme, table(res["runs"], res["meta"]))
+        write_readme(a.readme, res["runs"], res["meta"], a.from_json)
         return
     tc = a.tetcollapse or default_tetcollapse()
     if not tc or not os.access(tc, os.X_OK):
@@ -249,7 +249,7 @@ def main():
         json.dump({"meta": meta, "runs": rows}, f, indent=1)
         f.write("\n")
     if a.readme:
-        replace_section(a.readme, table(rows, meta))
+        write_readme(a.readme, rows, meta, a.out_json)
     if tmp:
         tmp.cleanup()
 
