@@ -1,6 +1,6 @@
 // Single-threaded construction of the connectivity and the boundary classification.
 // See include/tetcollapse/topology.hpp for the definitions and the order of every array; the
-// device version (cl/connectivity.cl, cl/classify.cl) computes the same arrays the same way.
+// collapse's device connectivity (cl/collapse_connectivity.cl) is checked against it.
 #include "tetcollapse/topology.hpp"
 
 #include <algorithm>

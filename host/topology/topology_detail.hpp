@@ -1,4 +1,4 @@
-// Internals of the CPU topology construction, shared with tests and the device code.
+// Internals of the CPU topology construction, shared with tests.
 #pragma once
 
 #include <cstdint>

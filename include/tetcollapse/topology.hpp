@@ -1,8 +1,9 @@
 // Mesh connectivity and boundary classification (paper, Section 3.1).
 //
-// This is the plain single-threaded construction. It is the reference the device version
-// (host/device/connectivity.cpp) is checked against array by array, and the CPU fallback.
-// Both follow the same steps and define every array's order the same way:
+// This is the plain single-threaded construction. It is the reference the collapse's device
+// connectivity (host/collapse/connectivity.cpp, cl/collapse_connectivity.cl) is checked against,
+// for the arrays that one keeps (tests/collapse/test_collapse_connectivity.cpp), and the CPU
+// fallback. Every array's order is defined here:
 //
 //   edges        sort the 6 keys (v0 << 32 | v1), v0 < v1, of every tet; the distinct keys, in
 //                ascending order, are the edges, so `edges` is sorted lexicographically.
@@ -95,8 +96,7 @@ struct Topology {
   int32_t num_sfaces() const { return static_cast<int32_t>(sface_tet.size()); }
 };
 
-// Wall time of each construction stage in seconds (the device version ends each stage with a
-// queue finish, so its numbers include the kernels).
+// Wall time of each construction stage in seconds.
 struct TopologyTimings {
   double check = 0, edges = 0, vertex_lists = 0, faces = 0, sface_lists = 0, flags = 0, classify = 0;
   double total() const { return check + edges + vertex_lists + faces + sface_lists + flags + classify; }
