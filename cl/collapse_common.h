@@ -91,7 +91,7 @@ inline int tcc_face_others(__global const int* tets, __global const uint* vt_off
  * no other tet (boundary), -2 when in several (invalid input: each side counts as boundary). */
 
 /* At most this many S-faces through a vertex are gathered (conn_surface_flags, the matching
- * selection's live tests); more (never seen in practice) classify it as a corner there and
+ * selection's live tests); more (rare: a fan of thin boundary faces) classify it as a corner there and
  * refuse the edge here. */
 #ifndef TCC_MAX_VERTEX_SFACES
 #define TCC_MAX_VERTEX_SFACES 64

@@ -471,7 +471,7 @@ inline uchar tcc_edge_flags_of(int a, int b, __global const int* tets, __global 
  * S-edge joins two S vertices (most edges are not: 0 at once). The ridge edges at v are those
  * to the vertices of its S-faces (the rule is symmetric: v's work item decides the edges it
  * does not own the same way as their owners do).
- * More than TCC_MAX_VERTEX_SFACES S-faces at a vertex (never seen in practice) classify it as
+ * More than TCC_MAX_VERTEX_SFACES S-faces at a vertex (rare: a fan of thin boundary faces) classify it as
  * corner, which only protects it more, and its edges' flags come from ring scans
  * (tcc_edge_flags_of). With carry, a vertex whose ring is unchanged (ndirty == 0) keeps its
  * class and its edges' flags (found in the previous N(v)). */
