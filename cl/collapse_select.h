@@ -1,6 +1,9 @@
-/* The link and volume tests of an edge collapse and the helpers of the selections' rounds, shared
- * by the selections of cl/collapse_admissible.cl (the lazy filter, the greedy selection) and
- * cl/collapse_matching.cl (the matching selection). The checks are described at the top of
+/* The link and volume tests of an edge collapse on the device and the helpers of the selections'
+ * rounds, shared by the selections of cl/collapse_admissible.cl (the lazy filter, the greedy
+ * selection) and cl/collapse_matching.cl (the matching selection). The tests themselves are
+ * cl/collapse_checks.h, shared with the sequential CPU method; here is what only the device has:
+ * its star (the CSR arrays of the iteration, and the matching selection's live mesh) and its
+ * ways of gathering the common neighbours of an edge. The checks are described at the top of
  * cl/collapse_admissible.cl. */
 #ifndef TETCOLLAPSE_COLLAPSE_SELECT_H
 #define TETCOLLAPSE_COLLAPSE_SELECT_H
@@ -20,40 +23,36 @@
 #define TCC_DEAD(t) (live && tdead[t])
 #define TCC_NO_DEAD ((__global const uchar*)0) /* tdead of the tests that are never live */
 
-#ifndef TCC_MAX_LINK
-#define TCC_MAX_LINK 96
-#endif
-/* Tets per chunk of the volume loop: on CPU devices (TCC_PREFETCH) many, so that the gathers
- * overlap; elsewhere few (private arrays indexed at run time cost GPUs scratch memory). */
-#ifdef TCC_PREFETCH
-#define TCC_VOL_CHUNK 32
-#else
-#define TCC_VOL_CHUNK 4
-#endif
+/* The star the shared tests read (cl/collapse_checks.h): the connectivity of the iteration (ring,
+ * tet_nbr), its S flags (vflags, eflags) and points, and, live, the removed tets. */
+#define TCS_LINK_PARAMS                                                                                   \
+  __global const int *tets, __global const uint *vt_off, __global const int *vt, __global const int *tet_nbr, \
+      __global const int *labels, int use_labels, __global const uchar *vflags, __global const uchar *eflags, \
+      int live, __global const uchar *tdead
+#define TCS_LINK_ARGS tets, vt_off, vt, tet_nbr, labels, use_labels, vflags, eflags, live, tdead
+#define TCS_VOL_PARAMS                                                                                      \
+  __global const int *tets, __global const uint *vt_off, __global const int *vt, __global const double *pts, \
+      __global const double *tet_quality, int live, __global const uchar *tdead
+#define TCS_VOL_ARGS tets, vt_off, vt, pts, tet_quality, live, tdead
+#define TCS_RING_BEGIN(x) vt_off[x]
+#define TCS_RING_END(x) vt_off[(x) + 1]
+#define TCS_RING_TET(i) vt[i]
+#define TCS_DEAD(t) TCC_DEAD(t)
+#define TCS_TET(t) (tets + 4 * (t))
+#define TCS_TETS tets
+#define TCS_ACROSS(t, f) tet_nbr[4 * (t) + (f)]
+#define TCS_USE_LABELS use_labels
+#define TCS_LABEL(t) labels[t]
+/* live, the S-edges from the rings (eflags and vflags are those of the iteration's start);
+ * else from eflags, passing over a c off S */
+#define TCS_SEDGE_SKIP(c) (!live && !(vflags[c] & (TCC_BOUNDARY | TCC_INTERFACE)))
+#define TCS_SEDGE(x, c, e) (live ? tcc_ring_sedge(TCS_LINK_ARGS, (x), (c)) : (uint)eflags[e])
+#define TCS_POINT(v) tc_point(pts, (v))
+/* tet_quality holds the qualities of the iteration's start */
+#define TCS_OLD_QUALITY(t, p0, p1, p2, p3) (live ? tc_tet_quality(p0, p1, p2, p3) : tet_quality[t])
 
-inline int tcc_in(const int* list, int n, int x) {
-  for (int i = 0; i < n; ++i)
-    if (list[i] == x) return 1;
-  return 0;
-}
-
-/* x in v[0..8) (pads of -1 never match a vertex): eight compares, no branch. The link test's
- * small sets are kept so when they fit: a lookup by loop exits at a data-dependent place, and
- * those mispredicted exits were a large part of a passing test (bench_admissible). */
-#define TCC_ANY8(v, x)                                                                                     \
-  (((x) == (v)[0]) | ((x) == (v)[1]) | ((x) == (v)[2]) | ((x) == (v)[3]) | ((x) == (v)[4]) | ((x) == (v)[5]) | \
-   ((x) == (v)[6]) | ((x) == (v)[7]))
-
-/* Does some tet of ring(x) contain y and z (and w when w >= 0)? */
-inline int tcc_ring_has(__global const int* tets, __global const uint* vt_off, __global const int* vt, int x, int y,
-                        int z, int w, int live, __global const uchar* tdead) {
-  for (uint i = vt_off[x]; i < vt_off[x + 1]; ++i) {
-    int t = vt[i];
-    if (TCC_DEAD(t)) continue;
-    if (tcc_has(tets, t, y) && tcc_has(tets, t, z) && (w < 0 || tcc_has(tets, t, w))) return 1;
-  }
-  return 0;
-}
+/* The link condition and the volume test themselves: shared with the sequential CPU method. */
+#include "collapse_checks.h"
 
 /* Predicate Q (tcc_predicate_q): shared with the sequential CPU method. */
 #include "collapse_predicate.h"
@@ -66,84 +65,13 @@ inline uchar tcc_volume_test(int a, int b, int dir, __global const int* tets, __
                              __global const int* vt, __global const double* pts, __global const double* vfield,
                              uint vfield_stride, double eps_v, double q_min, __global const double* tet_quality,
                              int live, __global const uchar* tdead) {
-  /* --- volumes after the tentative collapse (first: cheaper, and it refuses more edges) --- */
   double3 p = tcc_placement(pts, vfield, vfield_stride, a, b, (uint)dir);
 #ifdef TCC_USER_PLACEMENT
   /* a user placement may be no point at all (inf, nan: e.g. a division by a zero field
    * difference) */
   if (!isfinite(p.x) || !isfinite(p.y) || !isfinite(p.z)) return TCC_REFUSED_VOLUME;
 #endif
-  double3 pa = tc_point(pts, a), pb = tc_point(pts, b);
-  /* Quality guard (q_min > 0): the worst mean ratio among the tets that change shape may not
-   * fall below min(its value before the collapse, q_min): a collapse never makes a good
-   * neighbourhood bad, nor a bad one worse. */
-  double q_old = 1.0, q_new = 1.0;
-  for (int side = 0; side < 2; ++side) {
-    int x = side == 0 ? a : b, y = side == 0 ? b : a;
-    double3 px = side == 0 ? pa : pb;
-    if (px.x == p.x && px.y == p.y && px.z == p.z) continue; /* x does not move: its tets keep their shape */
-    /* In chunks, two loops: first the vertices of the tets (independent loads, so that the
-     * processor has many cache misses in flight; branch-free), then their volumes. One loop
-     * doing both waited for each tet's vertices in turn. */
-    for (uint i0 = vt_off[x], iend = vt_off[x + 1]; i0 < iend; i0 += TCC_VOL_CHUNK) {
-      int4 qs[TCC_VOL_CHUNK];
-      int ts[TCC_VOL_CHUNK];
-      uint m = 0, i1 = iend - i0 < TCC_VOL_CHUNK ? iend : i0 + TCC_VOL_CHUNK;
-      for (uint i = i0; i < i1; ++i) {
-        int t = vt[i];
-        int4 q = vload4(t, tets);
-        qs[m] = q;
-        ts[m] = t;
-        m += (any(q == (int4)(y)) | TCC_DEAD(t)) ? 0u : 1u; /* else removed by this collapse or an earlier one */
-      }
-      for (uint j = 0; j < m; ++j) {
-        int4 q = qs[j];
-        double3 c[4];
-        c[0] = q.x == x ? p : tc_point(pts, q.x);
-        c[1] = q.y == x ? p : tc_point(pts, q.y);
-        c[2] = q.z == x ? p : tc_point(pts, q.z);
-        c[3] = q.w == x ? p : tc_point(pts, q.w);
-        double vol = tc_tet_volume(c[0], c[1], c[2], c[3]);
-        if (!(vol >= eps_v)) return TCC_REFUSED_VOLUME;
-#ifdef TCC_USER_PLACEMENT
-        if (!(vol < INFINITY)) return TCC_REFUSED_VOLUME; /* a finite placement far enough overflows */
-#endif
-        if (q_min > 0.0) {
-          double qn = tc_tet_quality_v(c[0], c[1], c[2], c[3], vol);
-          /* tc_tet_quality of the tet now (the tet_quality kernel's at the iteration's start) */
-          double qo = live ? tc_tet_quality(q.x == x ? px : c[0], q.y == x ? px : c[1], q.z == x ? px : c[2],
-                                            q.w == x ? px : c[3])
-                           : tet_quality[ts[j]];
-          q_new = qn < q_new ? qn : q_new;
-          q_old = qo < q_old ? qo : q_old;
-        }
-      }
-    }
-  }
-  if (q_min > 0.0 && q_new < (q_old < q_min ? q_old : q_min)) return TCC_REFUSED_QUALITY;
-  return TCC_OK;
-}
-
-/* Live (see the top): the S kind of the edge (x, c) (0 when it is no S-edge), from the faces
- * through it of the tets of ring(x). */
-inline uint tcc_live_sedge(int x, int c, __global const int* tets, __global const uint* vt_off, __global const int* vt,
-                           __global const int* tet_nbr, __global const int* labels, int use_labels,
-                           __global const uchar* tdead) {
-  uint flags = 0;
-  for (uint i = vt_off[x]; i < vt_off[x + 1]; ++i) {
-    int t = vt[i];
-    if (tdead[t]) continue;
-    int lc = tcc_local(tets, t, c);
-    if (lc < 0) continue;
-    int lx = tcc_local(tets, t, x);
-    for (int f = 0; f < 4; ++f) {
-      if (f == lx || f == lc) continue; /* the two faces through x and c */
-      uint on_s;
-      tcc_owned_sface(tet_nbr, labels, use_labels, t, f, &on_s);
-      flags |= on_s;
-    }
-  }
-  return flags;
+  return (uchar)tcc_volume_verdict(TCS_VOL_ARGS, a, b, p, eps_v, q_min);
 }
 
 /* Live: N(a) n N(b) from the tets of the rings into cn (at most TCC_MAX_LINK); returns its size,
@@ -188,15 +116,8 @@ inline int tcc_live_common(int a, int b, __global const int* tets, __global cons
 #ifndef TCC_LIVE_LINK_RING
 #define TCC_LIVE_LINK_RING 32
 #endif
-/* Is x a vertex of lk(ab)? pc, pd: its np edges; p8, d8: the same padded to 8 with -1 (used when
- * np <= 8, for TCC_ANY8). */
-inline int tcc_in_lk(int x, const int* pc, const int* pd, int np, const int* p8, const int* d8) {
-  return np <= 8 ? (TCC_ANY8(p8, x) | TCC_ANY8(d8, x)) : (tcc_in(pc, np, x) || tcc_in(pd, np, x));
-}
-inline int tcc_live_link_common(int a, int b, const int* pc, const int* pd, int np, const int* p8, const int* d8,
-                                __global const int* tets, __global const uint* vt_off, __global const int* vt,
-                                __global const uchar* tdead, int* cn) {
-  const int live = 1; /* for TCC_DEAD */
+inline int tcc_live_link_common(TCS_LINK_PARAMS, int a, int b, const int* pc, const int* pd, int np, const int* p8,
+                                const int* d8, int* cn) {
   uint bits[8] = {0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u};
   for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
     const int t = vt[i];
@@ -217,7 +138,7 @@ inline int tcc_live_link_common(int a, int b, const int* pc, const int* pd, int 
       const int v = q[k];
       if (v == b || !(bits[(v >> 5) & 7] & (1u << (v & 31)))) continue;
       if (tcc_in_lk(v, pc, pd, np, p8, d8)) continue;
-      if (tcc_ring_has(tets, vt_off, vt, a, v, v, -1, live, tdead)) return -1; /* in N(a), off lk(ab) */
+      if (tcc_ring_has(TCS_LINK_ARGS, a, v, v, -1)) return -1; /* in N(a), off lk(ab) */
     }
   }
   int ncn = 0;
@@ -230,19 +151,21 @@ inline int tcc_live_link_common(int a, int b, const int* pc, const int* pd, int 
   return ncn;
 }
 
-/* The link condition of the edge (a, b), a < b: TCC_OK or TCC_REFUSED_LINK. Live (see the top):
- * N(a), N(b) and the S-edges from the rings; an edge that no tet holds any more is refused. */
+/* The link condition of the edge (a, b), a < b: TCC_OK or TCC_REFUSED_LINK. The common
+ * neighbours are gathered here, the decision is tcc_link_holds (cl/collapse_checks.h). Not live,
+ * by a merge of the sorted N(a) and N(b), which also gives the edges (a, c) and (b, c) whose
+ * eflags (ii) reads; live (see the top), from the rings, and an edge that no tet holds any more
+ * is refused. */
 inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global const int* tets,
                            __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
                            __global const uint* nb_off, __global const int* nb, __global const int* nb_edge,
                            __global const int* labels, int use_labels, __global const uchar* vflags,
                            __global const uchar* eflags, int live, __global const uchar* tdead) {
-  /* --- link condition --- */
   /* cn: the common neighbours of a and b, with the edges (a, cn[k]) and (b, cn[k]) (one more
    * slot: the merge writes at ncn before it knows whether it keeps the entry); (pc, pd): the
    * edges of lk(ab), one per tet of the edge */
   int cn[TCC_MAX_LINK + 1], cea[TCC_MAX_LINK + 1], ceb[TCC_MAX_LINK + 1], pc[TCC_MAX_LINK], pd[TCC_MAX_LINK];
-  int ncn = 0, np = 0;
+  int ncn = 0;
   if (!live) {
     /* a merge of the sorted N(a) and N(b) without branches on their values */
     uint i = nb_off[a], ie = nb_off[a + 1], j = nb_off[b], je = nb_off[b + 1];
@@ -257,120 +180,21 @@ inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global con
       j += y <= x;
     }
   }
-  for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
-    int t = vt[i];
-    if (TCC_DEAD(t) || !tcc_has(tets, t, b)) continue;
-    if (np == TCC_MAX_LINK) return TCC_REFUSED_LINK;
-    __global const int* q = tets + 4 * t;
-    int o[2], no = 0;
-    for (int k = 0; k < 4; ++k)
-      if (q[k] != a && q[k] != b) o[no++] = q[k];
-    pc[np] = o[0];
-    pd[np] = o[1];
-    ++np;
-  }
+  const int np = tcc_link_edges(TCS_LINK_ARGS, a, b, pc, pd);
+  if (np < 0) return TCC_REFUSED_LINK;
   if (live && np == 0) return TCC_REFUSED_LINK; /* earlier collapses removed every tet of the edge */
-  /* pc and pd, then cn, padded to 8 when they fit (the usual case), for TCC_ANY8 */
-  int c8[8], p8[8], d8[8];
-  for (int k = 0; k < 8; ++k) {
-    p8[k] = k < np ? pc[k] : -1;
-    d8[k] = k < np ? pd[k] : -1;
-  }
+  int p8[8], d8[8];
+  tcc_pad8(pc, np, p8);
+  tcc_pad8(pd, np, d8);
   if (live) {
     const uint ring = vt_off[a + 1] - vt_off[a];
     ncn = ring <= TCC_LIVE_LINK_RING && 3 * ring <= TCC_MAX_LINK
-              ? tcc_live_link_common(a, b, pc, pd, np, p8, d8, tets, vt_off, vt, tdead, cn)
+              ? tcc_live_link_common(TCS_LINK_ARGS, a, b, pc, pd, np, p8, d8, cn)
               : tcc_live_common(a, b, tets, vt_off, vt, tdead, cn);
     if (ncn < 0) return TCC_REFUSED_LINK;
   }
-  const int small = ncn <= 8 && np <= 8;
-  for (int k = 0; k < 8; ++k) c8[k] = k < ncn ? cn[k] : -1;
-#define TCC_IN_CN(x) (small ? TCC_ANY8(c8, x) : tcc_in(cn, ncn, (x)))
-  int ok = 1;
-  const uint smask = TCC_BOUNDARY | TCC_INTERFACE;
-  /* (iii) with w, inside the tets (a,b,c,d) of the edge: no S-faces (a,c,d) and (b,c,d) (the
-   * triangle (c,d,w) would be in lk(a) and lk(b) but not in lk(ab); e.g. a lone tet, which the
-   * collapse would flatten away). An S-face has S vertices only. */
-  if ((fa & smask) && (fb & smask))
-    for (uint i = vt_off[a]; i < vt_off[a + 1] && ok; ++i) {
-      int t = vt[i];
-      int la = tcc_local(tets, t, a), lb = tcc_local(tets, t, b);
-      if (lb < 0 || TCC_DEAD(t)) continue;
-      int xa = tet_nbr[4 * t + lb], xb = tet_nbr[4 * t + la]; /* across (a,c,d) and (b,c,d) */
-      int acd = xa < 0 || (use_labels && labels[t] != labels[xa]);
-      int bcd = xb < 0 || (use_labels && labels[t] != labels[xb]);
-      if (acd && bcd) ok = 0;
-    }
-  /* (i) vertices, and w */
-  if (small) {
-    for (int k = 0; k < 8; ++k) ok &= (c8[k] < 0) | TCC_ANY8(p8, c8[k]) | TCC_ANY8(d8, c8[k]);
-  } else {
-    for (int k = 0; k < ncn && ok; ++k)
-      if (!tcc_in_lk(cn[k], pc, pd, np, p8, d8)) ok = 0;
-  }
-  if (ok && !tcc_w_join_ok(fa, fb, fe)) ok = 0;
-  /* (ii) with w: S-edges (a,c) and (b,c) need the S-face (a,b,c), of the kinds they share
-   * (tcc_w_join_ok); an S-edge has both end points on S, so only when a and b are */
-  if ((fa & smask) && (fb & smask))
-    for (int k = 0; k < ncn && ok; ++k) {
-      int c = cn[k];
-      uint fac, fbc;
-      if (live) {
-        fac = tcc_live_sedge(a, c, tets, vt_off, vt, tet_nbr, labels, use_labels, tdead);
-        fbc = tcc_live_sedge(b, c, tets, vt_off, vt, tet_nbr, labels, use_labels, tdead);
-      } else {
-        if (!(vflags[c] & smask)) continue;
-        fac = eflags[cea[k]];
-        fbc = eflags[ceb[k]];
-      }
-      if ((fac & smask) && (fbc & smask) &&
-          !tcc_w_join_ok(fac, fbc, tcc_triangle_kind(tets, vt_off, vt, labels, use_labels, a, b, c, live, tdead)))
-        ok = 0;
-    }
-  /* (ii) triangles and (iii) tets and S-faces, from the tets of ring(a) without b */
-  for (uint i = vt_off[a]; i < vt_off[a + 1] && ok; ++i) {
-    int t = vt[i];
-    const int4 q4 = vload4(t, tets);
-    if ((q4.x == b) | (q4.y == b) | (q4.z == b) | (q4.w == b) || TCC_DEAD(t)) continue;
-    __global const int* q = tets + 4 * t;
-    /* the three vertices other than a, in the tet's order, without branches */
-    const int la = q4.x == a ? 0 : q4.y == a ? 1 : q4.z == a ? 2 : 3;
-    const int o[3] = {la == 0 ? q4.y : q4.x, la <= 1 ? q4.z : q4.y, la <= 2 ? q4.w : q4.z};
-    const int in0 = TCC_IN_CN(o[0]), in1 = TCC_IN_CN(o[1]), in2 = TCC_IN_CN(o[2]);
-    if (in0 + in1 + in2 < 2) continue; /* most tets: nothing below applies (no pair in cn) */
-    if (in0 && in1 && in2 && tcc_ring_has(tets, vt_off, vt, b, o[0], o[1], o[2], live, tdead)) {
-      ok = 0; /* tets (a,c,d,e) and (b,c,d,e) */
-      break;
-    }
-    const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
-    const int inside[3] = {in0, in1, in2};
-    for (int k = 0; k < 3 && ok; ++k) {
-      if (!inside[pairs[k][0]] || !inside[pairs[k][1]]) continue;
-      int c = o[pairs[k][0]], d = o[pairs[k][1]];
-      int in_lk = 0;
-      if (small)
-        for (int m = 0; m < 8; ++m) in_lk |= (p8[m] == c & d8[m] == d) | (p8[m] == d & d8[m] == c);
-      else
-        for (int m = 0; m < np; ++m)
-          if ((pc[m] == c && pd[m] == d) || (pc[m] == d && pd[m] == c)) in_lk = 1;
-      if (!in_lk) {
-        /* (ii) triangles (a,c,d) and (b,c,d) need the tet (a,b,c,d) */
-        if (tcc_ring_has(tets, vt_off, vt, b, c, d, -1, live, tdead)) ok = 0;
-        continue;
-      }
-      /* (c,d) in lk(ab): (b,c,d) is a face of the tet (a,b,c,d). (iii) no S-faces (a,c,d) and
-       * (b,c,d); an S-face has S vertices only. (a,c,d) is the face of t opposite its fourth
-       * vertex: S when no tet or several are across it, or a tet of another label. */
-      if (!(fa & smask) || !(fb & smask)) continue;
-      int z = 0;
-      while (q[z] == a || q[z] == c || q[z] == d) ++z;
-      int across = tet_nbr[4 * t + z];
-      int acd_on_s = across < 0 || (use_labels && labels[t] != labels[across]);
-      if (acd_on_s && tcc_triangle_kind(tets, vt_off, vt, labels, use_labels, b, c, d, live, tdead)) ok = 0;
-    }
-  }
-#undef TCC_IN_CN
-  return ok ? TCC_OK : TCC_REFUSED_LINK;
+  return tcc_link_holds(TCS_LINK_ARGS, a, b, fa, fb, fe, cn, cea, ceb, ncn, pc, pd, np, p8, d8) ? TCC_OK
+                                                                                              : TCC_REFUSED_LINK;
 }
 
 /* The volume test, then the link condition (tcc_volume_test, tcc_link_test); returns TCC_OK or

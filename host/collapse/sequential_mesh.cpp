@@ -9,7 +9,6 @@
 
 #include "collapse/stages.hpp"  // collapse_detail::Reason
 #include "collapse_classify.h"  // the classification rules, the device's own
-#include "collapse_guard_geometry.h"  // tc::geo::tc_sg_tri_tri, the device guard's own test
 #include "collapse_predicate.h"
 #include "tetcollapse/error.hpp"
 
@@ -20,37 +19,15 @@ using geo::tc_d3;
 
 namespace {
 
-// The list limits of the kernels, so that the verdicts agree even where they bite:
-// TCC_MAX_LINK (cl/collapse_admissible.cl) and TCC_MAX_VERTEX_SFACES (collapse_connectivity.cl).
-constexpr size_t kMaxLink = 96;
+// The list limit of the kernels, so that the verdicts agree even where it bites:
+// TCC_MAX_VERTEX_SFACES (collapse_connectivity.cl). (The link test's, TCC_MAX_LINK, is
+// cl/collapse_checks.h's own.)
 constexpr size_t kMaxVertexSFaces = 64;
-constexpr uint8_t kSMask = TCC_BOUNDARY | TCC_INTERFACE;
-
 tc_d3 face_normal(const std::vector<double>& pts, const int32_t* q, int f) {
   tc_d3 p0 = geo::tc_point(pts.data(), q[geo::TC_TET_FACES[f][0]]);
   tc_d3 p1 = geo::tc_point(pts.data(), q[geo::TC_TET_FACES[f][1]]);
   tc_d3 p2 = geo::tc_point(pts.data(), q[geo::TC_TET_FACES[f][2]]);
   return geo::normalize(geo::cross(p1 - p0, p2 - p0));
-}
-
-// Bounding box of a triangle, and whether two are apart (the guard kernels' box test,
-// tcc_sg_tri_box_apart, on the boxes sguard_tris stores).
-// (std::min / max rather than fmin / fmax: they differ only for NaN coordinates)
-void box_of(const tc_d3* p, tc_d3& lo, tc_d3& hi) {
-  lo = hi = p[0];
-  for (int k = 1; k < 3; ++k) {
-    lo = {std::min(lo.x, p[k].x), std::min(lo.y, p[k].y), std::min(lo.z, p[k].z)};
-    hi = {std::max(hi.x, p[k].x), std::max(hi.y, p[k].y), std::max(hi.z, p[k].z)};
-  }
-}
-bool boxes_apart(const tc_d3& alo, const tc_d3& ahi, const tc_d3& blo, const tc_d3& bhi) {
-  return alo.x > bhi.x || alo.y > bhi.y || alo.z > bhi.z || blo.x > ahi.x || blo.y > ahi.y || blo.z > ahi.z;
-}
-bool boxes_apart(const tc_d3* a, const tc_d3* b) {
-  tc_d3 alo, ahi, blo, bhi;
-  box_of(a, alo, ahi);
-  box_of(b, blo, bhi);
-  return boxes_apart(alo, ahi, blo, bhi);
 }
 
 // Does the face of q opposite local vertex f run from x to y (x, y consecutive in its order)?
@@ -82,7 +59,6 @@ SeqMesh::SeqMesh(Mesh& mesh, const SeqParams& params, const std::vector<uint8_t>
   talive_.assign(nt_, 1);
   fwd_.assign(nv_, -1);
   mark_.assign(nv_, 0);
-  lmark_.assign(nv_, 0);
   rebuild_rings();
   if (tet_nbr) {
     if (tet_nbr->size() != 4 * size_t(nt_))
@@ -157,7 +133,6 @@ void SeqMesh::ring_remove(int32_t v, int32_t t) {
 uint32_t SeqMesh::next_stamp() {
   if (++stamp_ == 0) {  // wrapped: forget every old stamp
     std::fill(mark_.begin(), mark_.end(), 0u);
-    std::fill(lmark_.begin(), lmark_.end(), 0u);
     stamp_ = 1;
   }
   return stamp_;
@@ -188,34 +163,6 @@ bool SeqMesh::is_edge(int32_t a, int32_t b) const {
 double SeqMesh::length(int32_t a, int32_t b) const {
   tc_d3 d = point(b) - point(a);
   return geo::sqrt(geo::dot(d, d));
-}
-
-bool SeqMesh::ring_has(int32_t x, int32_t y, int32_t z, int32_t w) const {
-  const int32_t* r = ring(x);
-  for (uint32_t i = 0; i < rlen_[x]; ++i) {
-    const int32_t* q = tet(r[i]);
-    if (has(q, y) && has(q, z) && (w < 0 || has(q, w))) return true;
-  }
-  return false;
-}
-
-// tcc_triangle_kind: is (x, y, z) an S-face?
-uint8_t SeqMesh::triangle_kind(int32_t x, int32_t y, int32_t z) const {
-  int n = 0;
-  int32_t t0 = -1, t1 = -1;
-  const int32_t* r = ring(x);
-  for (uint32_t i = 0; i < rlen_[x]; ++i) {
-    const int32_t* q = tet(r[i]);
-    if (has(q, y) && has(q, z)) {
-      if (n == 0) t0 = r[i];
-      else if (n == 1) t1 = r[i];
-      ++n;
-    }
-  }
-  if (n == 0) return 0;
-  if (n != 2) return TCC_BOUNDARY;
-  if (labels_ && label(t0) != label(t1)) return TCC_INTERFACE;
-  return 0;
 }
 
 // --- flags and classes (conn_vertex_flags*, conn_surface_flags) ---
@@ -305,155 +252,6 @@ int64_t SeqMesh::verify_classes() {
     if (f != vflags_[v] || c != vclass_[v]) ++bad;
   }
   return bad;
-}
-
-// --- the admissible checks ---
-
-int SeqMesh::predicate(int32_t a, int32_t b, uint8_t& fe) {
-  fe = edge_flags(a, b);
-  return rules::tcc_predicate_q(a, b, vflags_[a], vflags_[b], fe, vclass_[a], vclass_[b], p_.mode,
-                                p_.paper_rule ? 1 : 0);
-}
-
-Verdict SeqMesh::check(int32_t a, int32_t b) {
-  if (a > b) std::swap(a, b);
-  Verdict v;
-  uint8_t fe = 0;
-  const int dir = predicate(a, b, fe);
-  if (dir < 0) {
-    v.reason = kRefusedQ;
-    return v;
-  }
-  v.reason = link_and_volume(a, b, fe, dir);
-  if (v.reason == kOk) v.dir = uint8_t(dir);
-  return v;
-}
-
-tc_d3 SeqMesh::placement(int32_t a, int32_t b, unsigned dir) const {
-  tc_d3 p0 = point(a), p1 = point(b);
-  if (dir & TCC_DIR_MIDPOINT) return (p0 + p1) * 0.5;
-  return (dir & TCC_DIR_REMOVE_V1) ? p0 : p1;
-}
-
-// tcc_link_and_volume, over the current rings (a < b): the volume and quality test first.
-uint8_t SeqMesh::link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir) {
-  const uint8_t r = volume_and_quality(a, b, dir);
-  if (r != kOk) return r;
-  return link_ok(a, b, fe) ? kOk : kRefusedLink;
-}
-
-bool SeqMesh::admissible(int32_t a, int32_t b, uint8_t fe, int dir) { return link_and_volume(a, b, fe, dir) == kOk; }
-
-// The link condition of tcc_link_and_volume (a < b): true when it holds.
-bool SeqMesh::link_ok(int32_t a, int32_t b, uint8_t fe) {
-  const uint8_t fa = vflags_[a], fb = vflags_[b];
-  // N(a) marked sA; the common neighbours cn = N(a) n N(b) re-marked sC
-  const uint32_t sA = next_stamp(), sC = next_stamp();
-  const int32_t* ra = ring(a);
-  const int32_t* rb = ring(b);
-  for (uint32_t i = 0; i < rlen_[a]; ++i) {
-    const int32_t* q = tet(ra[i]);
-    for (int k = 0; k < 4; ++k)
-      if (q[k] != a) mark_[q[k]] = sA;
-  }
-  cn_.clear();
-  for (uint32_t i = 0; i < rlen_[b]; ++i) {
-    const int32_t* q = tet(rb[i]);
-    for (int k = 0; k < 4; ++k) {
-      int32_t u = q[k];
-      if (u != b && mark_[u] == sA) {
-        mark_[u] = sC;
-        cn_.push_back(u);
-      }
-    }
-  }
-  if (cn_.size() > kMaxLink) return false;
-  // lk(ab): the pairs (c, d) of the tets around the edge, their vertices marked sL
-  const uint32_t sL = next_stamp();
-  pc_.clear();
-  pd_.clear();
-  for (uint32_t i = 0; i < rlen_[a]; ++i) {
-    const int32_t* q = tet(ra[i]);
-    if (!has(q, b)) continue;
-    int32_t o[2];
-    int no = 0;
-    for (int k = 0; k < 4; ++k)
-      if (q[k] != a && q[k] != b) o[no++] = q[k];
-    pc_.push_back(o[0]);
-    pd_.push_back(o[1]);
-    lmark_[o[0]] = lmark_[o[1]] = sL;
-  }
-  if (pc_.size() > kMaxLink) return false;
-  // (iii) with w, inside the tets (a,b,c,d) of the edge: no S-faces (a,c,d) and (b,c,d)
-  if ((fa & kSMask) && (fb & kSMask))
-    for (size_t m = 0; m < pc_.size(); ++m)
-      if (triangle_kind(a, pc_[m], pd_[m]) && triangle_kind(b, pc_[m], pd_[m])) return false;
-  // (i) every common neighbour is a vertex of lk(ab); and w: a, b both on S needs an S-edge
-  for (int32_t c : cn_)
-    if (lmark_[c] != sL) return false;
-  if (!rules::tcc_w_join_ok(fa, fb, fe)) return false;
-  // (ii) with w: S-edges (a,c) and (b,c) need the S-face (a,b,c), of the kinds they share
-  for (int32_t c : cn_) {
-    if (!(vflags_[c] & kSMask)) continue;
-    const uint8_t fac = edge_flags(a, c, false), fbc = edge_flags(b, c, false);
-    if ((fac & kSMask) && (fbc & kSMask) && !rules::tcc_w_join_ok(fac, fbc, triangle_kind(a, b, c))) return false;
-  }
-  // (ii) triangles and (iii) tets and S-faces, from the tets of ring(a) without b
-  for (uint32_t i = 0; i < rlen_[a]; ++i) {
-    const int32_t* q = tet(ra[i]);
-    if (has(q, b)) continue;
-    int32_t o[3];
-    int no = 0;
-    for (int k = 0; k < 4; ++k)
-      if (q[k] != a) o[no++] = q[k];
-    const bool in[3] = {mark_[o[0]] == sC, mark_[o[1]] == sC, mark_[o[2]] == sC};
-    if (in[0] && in[1] && in[2] && ring_has(b, o[0], o[1], o[2])) return false;  // tets (a,c,d,e), (b,c,d,e)
-    static constexpr int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
-    for (const auto& pr : pairs) {
-      if (!in[pr[0]] || !in[pr[1]]) continue;
-      const int32_t c = o[pr[0]], d = o[pr[1]];
-      // triangles (a,c,d) and (b,c,d) need the tet (a,b,c,d), i.e. (c, d) in lk(ab); when it is,
-      // (b,c,d) is a triangle (of that tet), so the kernel's order of tests gives the same answer
-      bool in_lk = false;
-      for (size_t m = 0; m < pc_.size() && !in_lk; ++m)
-        in_lk = (pc_[m] == c && pd_[m] == d) || (pc_[m] == d && pd_[m] == c);
-      if (!in_lk) {
-        if (ring_has(b, c, d, -1)) return false;
-        continue;  // (b,c,d) is no triangle
-      }
-      // S-faces (a,c,d) and (b,c,d); an S-face through a needs a on S (and b likewise)
-      if ((fa & kSMask) && (fb & kSMask) && triangle_kind(a, c, d) && triangle_kind(b, c, d)) return false;
-    }
-  }
-  return true;
-}
-
-// The volumes (and the quality guard) after the tentative collapse.
-uint8_t SeqMesh::volume_and_quality(int32_t a, int32_t b, int dir) const {
-  const tc_d3 p = placement(a, b, unsigned(dir));
-  double q_old = 1.0, q_new = 1.0;
-  const double q_min = p_.min_quality;
-  for (int side = 0; side < 2; ++side) {
-    const int32_t x = side == 0 ? a : b, y = side == 0 ? b : a;
-    const tc_d3 px = point(x);
-    if (px.x == p.x && px.y == p.y && px.z == p.z) continue;  // x does not move: its tets keep their shape
-    const int32_t* rx = ring(x);
-    for (uint32_t i = 0; i < rlen_[x]; ++i) {
-      const int32_t* q = tet(rx[i]);
-      if (has(q, y)) continue;  // removed by the collapse
-      tc_d3 c[4];
-      for (int k = 0; k < 4; ++k) c[k] = q[k] == x ? p : point(q[k]);
-      if (!(geo::tc_tet_volume(c[0], c[1], c[2], c[3]) >= p_.eps_v)) return kRefusedVolume;
-      if (q_min > 0.0) {
-        double qn = geo::tc_tet_quality(c[0], c[1], c[2], c[3]);
-        double qo = geo::tc_tet_quality(point(q[0]), point(q[1]), point(q[2]), point(q[3]));
-        q_new = qn < q_new ? qn : q_new;
-        q_old = qo < q_old ? qo : q_old;
-      }
-    }
-  }
-  if (q_min > 0.0 && q_new < (q_old < q_min ? q_old : q_min)) return kRefusedQuality;
-  return kOk;
 }
 
 // --- collapse and compaction ---
@@ -639,12 +437,11 @@ void SeqMesh::compact(std::vector<int32_t>& vmap, std::vector<int32_t>& kept) {
   vflags_.resize(n);
   vclass_.resize(n);
   mark_.resize(n);  // stale stamps are all older than the next one
-  lmark_.resize(n);
   rebuild_rings();
   if (rebuild_guard) build_guard(guard_h_req_);
 }
 
-// --- surface guard ---
+// --- tet neighbours and S-faces ---
 
 int32_t SeqMesh::scan_across(int32_t t, int f) const {
   const int32_t* q = tet(t);
@@ -703,45 +500,6 @@ int64_t SeqMesh::verify_nbr() const {
   return bad;
 }
 
-int64_t SeqMesh::verify_guard() {
-  if (!guard_on_) return 0;
-  int64_t missing = 0;
-  for (int32_t t = 0; t < nt_; ++t) {
-    if (!talive_[t]) continue;
-    for (int f = 0; f < 4; ++f) {
-      if (!owned_sface(t, f)) continue;
-      tc_d3 p[3];
-      face_points(t, f, p);
-      tc_d3 lo, hi;
-      box_of(p, lo, hi);
-      each_guard_cell(p, [&](size_t cell) {
-        // an entry of the face whose box holds the face's box now
-        auto holds = [&](int32_t e, const GuardBox& b) {
-          return e == 4 * t + f && b.lo[0] <= lo.x && b.lo[1] <= lo.y && b.lo[2] <= lo.z && hi.x <= b.hi[0] &&
-                 hi.y <= b.hi[1] && hi.z <= b.hi[2];
-        };
-        missing += any_live_guard_face(cell, lo, hi, holds, false) ? 0 : 1;
-      });
-    }
-  }
-  // no face twice in a cell among the live entries (a registration makes the earlier ones stale)
-  const tc_d3 all_lo{-INFINITY, -INFINITY, -INFINITY}, all_hi{INFINITY, INFINITY, INFINITY};
-  std::vector<int32_t> ids;
-  for (size_t cell = 0; cell + 1 < gcell_off_.size(); ++cell) {
-    ids.clear();
-    any_live_guard_face(
-        cell, all_lo, all_hi,
-        [&](int32_t e, const GuardBox&) {
-          ids.push_back(e);
-          return false;
-        },
-        false);
-    std::sort(ids.begin(), ids.end());
-    missing += int64_t(ids.size()) - (std::unique(ids.begin(), ids.end()) - ids.begin());
-  }
-  return missing;
-}
-
 uint8_t SeqMesh::owned_sface(int32_t t, int f, uint8_t* on_s) const {
   const int32_t o = across(t, f);
   uint8_t kind = 0, own = 0;
@@ -753,223 +511,6 @@ uint8_t SeqMesh::owned_sface(int32_t t, int f, uint8_t* on_s) const {
   }
   if (on_s) *on_s = kind;
   return own;
-}
-
-void SeqMesh::guard_cells(const tc_d3* p, int (&lo)[3], int (&hi)[3]) const {
-  tc_d3 blo, bhi;
-  box_of(p, blo, bhi);
-  const double l[3] = {blo.x, blo.y, blo.z}, h[3] = {bhi.x, bhi.y, bhi.z}, o[3] = {guard_org_.x, guard_org_.y, guard_org_.z};
-  for (int c = 0; c < 3; ++c) {
-    auto cell = [&](double v) {
-      const double x = std::floor((v - o[c]) / guard_h_);
-      return !(x > 0.0) ? 0 : x >= double(guard_dim_[c]) ? guard_dim_[c] - 1 : int(x);
-    };
-    lo[c] = cell(l[c]);
-    hi[c] = cell(h[c]);
-  }
-}
-
-SeqMesh::GuardBox SeqMesh::guard_box(const tc_d3* p) {
-  tc_d3 lo, hi;
-  box_of(p, lo, hi);
-  const double l[3] = {lo.x, lo.y, lo.z}, h[3] = {hi.x, hi.y, hi.z};
-  GuardBox b;
-  constexpr double kMax = std::numeric_limits<float>::max();
-  for (int c = 0; c < 3; ++c) {
-    // rounded outward; beyond the float range to infinity (a double-to-float conversion of a
-    // value out of range is undefined); a NaN stays NaN: never apart, as with the doubles
-    b.lo[c] = l[c] > kMax ? float(kMax) : l[c] < -kMax ? -INFINITY : float(l[c]);
-    if (double(b.lo[c]) > l[c]) b.lo[c] = std::nextafter(b.lo[c], -INFINITY);
-    b.hi[c] = h[c] < -kMax ? -float(kMax) : h[c] > kMax ? INFINITY : float(h[c]);
-    if (double(b.hi[c]) < h[c]) b.hi[c] = std::nextafter(b.hi[c], INFINITY);
-  }
-  return b;
-}
-
-void SeqMesh::guard_insert(int32_t t, int f) {
-  const uint32_t ver = ++gver_[4 * size_t(t) + size_t(f)];  // its earlier entries are stale now
-  tc_d3 p[3];
-  face_points(t, f, p);
-  const GuardBox box = guard_box(p);
-  each_guard_cell(p, [&](size_t cell) {
-    // (unreachable at any size the method can hold in memory; were it thrown within collapse(),
-    // the SeqMesh would be left half changed, and the run is abandoned)
-    if (gnodes_.size() + 1 >= size_t(std::numeric_limits<int32_t>::max()))
-      throw InputError("<mesh>", "the sequential method's surface guard needs more than 2^31 grid entries");
-    gnodes_.push_back({4 * t + f, ghead_[cell], ver, box});
-    ghead_[cell] = int32_t(gnodes_.size() - 1);
-  });
-}
-
-void SeqMesh::build_guard(double h) {
-  guard_on_ = true;
-  guard_h_req_ = h;
-  gnodes_.clear();
-  gver_.assign(4 * size_t(nt_), 0);
-  gseen_.assign(4 * size_t(nt_), 0);
-  gstamp_ = 0;
-  // the S faces (all three vertices on S, owned), their mean extent and the bounding box
-  std::vector<int32_t> faces;
-  double extent = 0;
-  tc_d3 lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
-  for (int32_t v = 0; v < nv_; ++v) {
-    if (!valive_[v]) continue;
-    const tc_d3 p = point(v);
-    lo = {std::fmin(lo.x, p.x), std::fmin(lo.y, p.y), std::fmin(lo.z, p.z)};
-    hi = {std::fmax(hi.x, p.x), std::fmax(hi.y, p.y), std::fmax(hi.z, p.z)};
-  }
-  for (int32_t t = 0; t < nt_; ++t) {
-    if (!talive_[t]) continue;
-    const int32_t* q = tet(t);
-    for (int f = 0; f < 4; ++f) {
-      bool all_s = true;
-      for (int j = 0; j < 4 && all_s; ++j) all_s = j == f || vflags_[q[j]] != 0;
-      if (!all_s || !owned_sface(t, f)) continue;
-      faces.push_back(4 * t + f);
-      tc_d3 p[3];
-      face_points(t, f, p);
-      tc_d3 flo, fhi;
-      box_of(p, flo, fhi);
-      extent += std::fmax(fhi.x - flo.x, std::fmax(fhi.y - flo.y, fhi.z - flo.z));
-    }
-  }
-  guard_h_ = faces.empty() ? h : extent / double(faces.size());  // a few S faces per cell
-  const double span = std::fmax(hi.x - lo.x, std::fmax(hi.y - lo.y, hi.z - lo.z));
-  if (!(guard_h_ > 0) || !std::isfinite(guard_h_)) guard_h_ = std::isfinite(span) && span > 0 ? span : 1.0;
-  guard_h_ = std::fmax(guard_h_, span / double(1 << 20));  // at most 2^20 cells per axis
-  guard_org_ = std::isfinite(lo.x) ? lo : tc_d3{0, 0, 0};
-  const double d[3] = {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
-  const double max_cells = std::fmax(65536.0, 8.0 * double(faces.size()));
-  for (;;) {
-    for (int c = 0; c < 3; ++c)
-      guard_dim_[c] = std::isfinite(d[c]) ? std::max(1, std::min(1 << 20, int(std::floor(d[c] / guard_h_)) + 1)) : 1;
-    const double cells = double(guard_dim_[0]) * double(guard_dim_[1]) * double(guard_dim_[2]);
-    if (cells <= max_cells) break;
-    guard_h_ *= std::fmax(1.01, std::cbrt(cells / max_cells));  // larger cells, fewer of them
-  }
-  // the faces by cell (counted, then placed), each in every cell its box meets
-  const size_t ncells = size_t(guard_dim_[0]) * size_t(guard_dim_[1]) * size_t(guard_dim_[2]);
-  ghead_.assign(ncells, -1);
-  gcell_off_.assign(ncells + 1, 0);
-  for (int pass = 0; pass < 2; ++pass) {
-    for (int32_t e : faces) {
-      tc_d3 p[3];
-      face_points(e >> 2, e & 3, p);
-      const GuardBox box = pass == 1 ? guard_box(p) : GuardBox{};
-      each_guard_cell(p, [&](size_t c) {
-        if (pass == 0) {
-          ++gcell_off_[c + 1];
-        } else {  // the offsets moved one cell on (restored below)
-          gbuilt_box_[gcell_off_[c]] = box;
-          gbuilt_[gcell_off_[c]++] = e;
-        }
-      });
-    }
-    if (pass == 0) {
-      for (size_t c = 0; c < ncells; ++c) {
-        if (double(gcell_off_[c]) + double(gcell_off_[c + 1]) >= double(std::numeric_limits<int32_t>::max()))
-          throw InputError("<mesh>", "the sequential method's surface guard needs more than 2^31 grid entries");
-        gcell_off_[c + 1] += gcell_off_[c];
-      }
-      gbuilt_.assign(gcell_off_[ncells], -1);
-      gbuilt_box_.resize(gcell_off_[ncells]);
-    }
-  }
-  for (size_t c = ncells; c > 0; --c) gcell_off_[c] = gcell_off_[c - 1];
-  gcell_off_[0] = 0;
-}
-
-bool SeqMesh::guard_ok(int32_t a, int32_t b, uint8_t dir, bool scan_all) {
-  if (!guard_on_) return true;
-  if (a > b) std::swap(a, b);
-  const bool remove_b = (dir & TCC_DIR_REMOVE_V1) != 0;
-  const int32_t x = remove_b ? b : a, y = remove_b ? a : b;
-  const tc_d3 p = placement(a, b, dir), py = point(y);
-  const bool moves_y = !(py.x == p.x && py.y == p.y && py.z == p.z);
-  if (!vflags_[x] && !(moves_y && vflags_[y])) return true;  // S is not touched
-  // the new S triangles (tcc_sg_new_tri)
-  newtris_.clear();
-  for (int side = 0; side < 2; ++side) {
-    const int32_t z = side == 0 ? x : y, w = side == 0 ? y : x;
-    const int32_t* rz = ring(z);
-    for (uint32_t i = 0; i < rlen_[z]; ++i) {
-      const int32_t t = rz[i];
-      const int32_t* q = tet(t);
-      if (has(q, w)) continue;  // removed by the collapse, or seen from ring(x)
-      for (int f = 0; f < 4; ++f) {
-        if (q[f] == z) continue;  // the face opposite z does not contain it
-        // a face taken below is on S now, or glued to one through a removed tet: either way its
-        // two vertices other than z are on S now (cheap, and it spares most ring scans)
-        bool others_on_s = true;
-        for (int j = 0; j < 4 && others_on_s; ++j) others_on_s = j == f || q[j] == z || vflags_[q[j]] != 0;
-        if (!others_on_s) continue;
-        const int32_t o = across(t, f);
-        bool take;
-        if (o >= 0 && has(tet(o), x) && has(tet(o), y)) {  // glued through the removed tet o
-          const int32_t ac = across(o, local(tet(o), z));
-          take = ac < 0 || (labels_ && label(t) != label(ac));
-        } else {
-          if (side == 1 && !moves_y) continue;  // unchanged
-          take = o < 0 || (labels_ && label(t) != label(o));
-        }
-        if (!take) continue;
-        NewTri nt;
-        for (int k = 0; k < 3; ++k) {
-          int32_t v = q[geo::TC_TET_FACES[f][k]];
-          if (v == x) v = y;
-          nt.id[k] = v;
-          nt.pos[k] = v == y ? p : point(v);
-        }
-        newtris_.push_back(nt);
-      }
-    }
-  }
-  // among themselves (S folded over itself around y)
-  for (size_t i = 0; i < newtris_.size(); ++i)
-    for (size_t j = i + 1; j < newtris_.size(); ++j)
-      if (!boxes_apart(newtris_[i].pos, newtris_[j].pos) &&
-          geo::tc_sg_tri_tri(newtris_[i].id, newtris_[i].pos, newtris_[j].id, newtris_[j].pos))
-        return false;
-  // against the current S faces near them, but those the collapse moves or removes
-  for (const NewTri& nt : newtris_) {
-    if (++gstamp_ == 0) {
-      std::fill(gseen_.begin(), gseen_.end(), 0u);
-      gstamp_ = 1;
-    }
-    tc_d3 nlo, nhi;
-    box_of(nt.pos, nlo, nhi);
-    // does the new triangle cross face e (4 t + f) of a live tet, once per face
-    auto crosses = [&](int32_t e) {
-      if (gseen_[e] == gstamp_) return false;
-      gseen_[e] = gstamp_;
-      const int32_t t = e >> 2;
-      const int f = e & 3;
-      const int32_t* q = tet(t);
-      int32_t fid[3];
-      bool replaced = false;
-      for (int c = 0; c < 3; ++c) {
-        fid[c] = q[geo::TC_TET_FACES[f][c]];
-        replaced = replaced || fid[c] == x || (moves_y && fid[c] == y);
-      }
-      if (replaced) return false;  // a face the collapse moves or removes
-      const tc_d3 fpos[3] = {point(fid[0]), point(fid[1]), point(fid[2])};
-      tc_d3 flo, fhi;
-      box_of(fpos, flo, fhi);
-      if (boxes_apart(nlo, nhi, flo, fhi) || !owned_sface(t, f)) return false;
-      return geo::tc_sg_tri_tri(nt.id, nt.pos, fid, fpos) != 0;
-    };
-    bool crossed = false;
-    if (scan_all) {  // every face of every live tet (the tests' reference)
-      for (int32_t t = 0; t < nt_ && !crossed; ++t)
-        for (int f = 0; f < 4 && !crossed && talive_[t]; ++f) crossed = crosses(4 * t + f);
-    } else {  // those of the grid's live entries in the triangle's cells (alive)
-      each_guard_cell(nt.pos, [&](size_t cell) {
-        crossed = crossed || any_live_guard_face(cell, nlo, nhi, [&](int32_t e, const GuardBox&) { return crosses(e); });
-      });
-    }
-    if (crossed) return false;
-  }
-  return true;
 }
 
 }  // namespace tc::sequential_detail

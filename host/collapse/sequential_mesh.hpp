@@ -2,6 +2,8 @@
 // over a dynamic mesh: vertex -> tets lists updated in place by every collapse, so nothing is
 // rebuilt between two collapses. Used by tc::collapse_sequential (sequential.cpp) and by the
 // tests, which step it one iteration at a time and compare its checks with the device's.
+// Defined in sequential_mesh.cpp (rings, flags and classes, collapses, compaction),
+// sequential_checks.cpp (the admissible checks) and sequential_guard.cpp (the surface guard).
 //
 // Same semantics as the parallel pipeline (cl/collapse_*.cl):
 //   * the feature surface S (boundary faces and, with labels, interfaces between different
@@ -10,8 +12,9 @@
 //     vertex: every face through v lies in a tet of ring(v), so the star of v alone decides
 //     which of its faces are on S, who owns them, and so the class of v;
 //   * Q is cl/collapse_predicate.h itself (compiled as C++); the link condition with the
-//     virtual vertex, the volume test and the quality guard follow tcc_link_and_volume
-//     (cl/collapse_admissible.cl) step by step, including its list limits (TCC_MAX_LINK);
+//     virtual vertex, the volume test and the quality guard are cl/collapse_checks.h itself,
+//     list limits (TCC_MAX_LINK) included, read over this mesh's rings (SeqStar); only the
+//     gathering of an edge's common neighbours is the host's own;
 //   * geometry from cl/geometry.h (tc::geo);
 //   * the surface guard of cl/collapse_guard.cl (guard_ok), with its triangle test
 //     (cl/collapse_guard_geometry.h) and its choice of the new S triangles.
@@ -48,6 +51,21 @@ struct SeqParams {
 struct Verdict {
   uint8_t reason = 0;
   uint8_t dir = 0;
+};
+
+// The mesh as the link and volume tests of cl/collapse_checks.h read it (sequential_mesh.cpp
+// defines their access to it): ring(v) = pool[roff[v] .. roff[v] + rlen[v]), the tets (4 vertices
+// each), their neighbours (SeqMesh::across), the primary labels (null: no interfaces), the vertex
+// flags and the points.
+struct SeqStar {
+  const int32_t* pool;
+  const uint32_t* roff;
+  const uint32_t* rlen;
+  const int32_t* tets;
+  const int32_t* nbr;
+  const int32_t* labels;
+  const uint8_t* vflags;
+  const double* pts;
 };
 
 class SeqMesh {
@@ -159,8 +177,6 @@ class SeqMesh {
 
   uint32_t next_stamp();
   void classify(int32_t v, uint8_t& flags, uint8_t& cls);
-  bool ring_has(int32_t x, int32_t y, int32_t z, int32_t w) const;
-  uint8_t triangle_kind(int32_t x, int32_t y, int32_t z) const;
   // tet_nbr (collapse_common.h): -1 none, -2 several, else the tet; kept current by collapse()
   // and compact() (nbr_), built once from the rings (build_nbr) unless given
   int32_t across(int32_t t, int f) const { return nbr_[4 * size_t(t) + size_t(f)]; }
@@ -232,6 +248,8 @@ class SeqMesh {
   size_t guard_cell(int i, int j, int k) const {
     return size_t(i) + size_t(guard_dim_[0]) * (size_t(j) + size_t(guard_dim_[1]) * size_t(k));
   }
+  // the link and volume tests of cl/collapse_checks.h over star()
+  SeqStar star() const;
   bool link_ok(int32_t a, int32_t b, uint8_t fe);
   uint8_t volume_and_quality(int32_t a, int32_t b, int dir) const;
   geo::tc_d3 placement(int32_t a, int32_t b, unsigned dir) const;
@@ -254,9 +272,9 @@ class SeqMesh {
   std::vector<int32_t> fwd_;  // removed vertex -> the vertex it went into
 
   // scratch, reused: no allocation per check or collapse once warm
-  std::vector<uint32_t> mark_, lmark_;
+  std::vector<uint32_t> mark_;
   uint32_t stamp_ = 0;
-  std::vector<int32_t> cn_, pc_, pd_, rr_, touched_, gone_, reclass_;
+  std::vector<int32_t> cn_, rr_, touched_, gone_, reclass_;
   std::vector<FaceAt> faces_;
   // surface guard: cells of the grid -> S faces (4 t + f) registered there, possibly stale
   // (a dead tet, a face no longer on S, or one registered again after it moved): checked on use

@@ -239,8 +239,9 @@ TEST(SequentialVerdicts, SameAsDeviceOnBracketAndSharedMeshes) {
 
 // With the volume test out of the way (eps_v = -infinity: no tet is too small), every marked
 // edge that passes Q reaches the link condition, whose refusals the volume test otherwise hides
-// (it runs first): the device's link test (cl/collapse_admissible.cl) and the host's
-// (SeqMesh::link_ok), written apart, must refuse the same edges, and refuse many.
+// (it runs first): the device's link test and the host's (SeqMesh::link_ok), one test
+// (cl/collapse_checks.h) over two stars, each with its own gathering of the common neighbours,
+// must refuse the same edges, and refuse many.
 TEST(SequentialVerdicts, LinkConditionAloneAgreesWithTheDevice) {
   Context ctx;
   std::vector<std::pair<std::string, Mesh>> meshes;
