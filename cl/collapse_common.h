@@ -116,27 +116,6 @@ inline uint tcc_owned_sface(__global const int* tet_nbr, __global const int* lab
   return 0u;
 }
 
-/* Is the triangle (x, y, z) an S-face (boundary or interface)? Scans ring(x), without the tets
- * flagged in tdead when live (cl/collapse_select.h). */
-inline uint tcc_triangle_kind(__global const int* tets, __global const uint* vt_off, __global const int* vt,
-                              __global const int* labels, int use_labels, int x, int y, int z, int live,
-                              __global const uchar* tdead) {
-  int n = 0, t0 = -1, t1 = -1;
-  for (uint i = vt_off[x]; i < vt_off[x + 1]; ++i) {
-    int u = vt[i];
-    if (live && tdead[u]) continue;
-    if (tcc_has(tets, u, y) && tcc_has(tets, u, z)) {
-      if (n == 0) t0 = u;
-      else if (n == 1) t1 = u;
-      ++n;
-    }
-  }
-  if (n == 0) return 0u; /* not a triangle of the mesh */
-  if (n != 2) return TCC_BOUNDARY;
-  if (use_labels && labels[t0] != labels[t1]) return TCC_INTERFACE;
-  return 0u;
-}
-
 /* Bit-exact twins of tc::geo::cross / dot / normalize on the host (no built-ins, whose rounding
  * is implementation-defined). */
 inline double3 tcc_cross(double3 a, double3 b) {
