@@ -8,8 +8,8 @@
 
 namespace tc::collapse_detail {
 
-StageParams params_from(const CollapseOptions& o) {
-  StageParams p;
+CheckParams check_params_from(const CollapseOptions& o) {
+  CheckParams p;
   p.mode = o.boundary == CollapseOptions::Strict ? 0 : o.boundary == CollapseOptions::Features ? 1 : 2;
   p.paper_rule = o.paper_boundary_rule;
   p.use_labels = o.use_labels;
@@ -17,6 +17,12 @@ StageParams params_from(const CollapseOptions& o) {
   p.eps_r = o.eps_r;
   p.eps_v = o.eps_v;
   p.min_quality = o.min_quality;
+  return p;
+}
+
+StageParams params_from(const CollapseOptions& o) {
+  StageParams p;
+  static_cast<CheckParams&>(p) = check_params_from(o);
   p.priority_levels = o.tuning.priority_levels;
   p.mask_mode = o.vertex_mask.empty() ? 0 : o.mask_either ? 2 : 1;
   p.cost_source = o.cost_cl_source;

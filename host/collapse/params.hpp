@@ -18,12 +18,17 @@ enum Reason : uint8_t {
   kVolumeOk = 8         // in verdict[] only (TCC_VOLUME_OK): the volume test passed, the link not yet run
 };
 
-struct StageParams {
-  int mode = 1;  // 0 strict, 1 features, 2 free
+// What the admissible checks of both methods are told: the boundary mode and the thresholds.
+struct CheckParams {
+  int mode = 1;  // TCC_STRICT 0, TCC_FEATURES 1, TCC_FREE 2 (collapse_predicate.h)
   bool paper_rule = false;
   bool use_labels = true;
   double eps_f = 0.01, eps_r = 0.1, eps_v = 2e-12;
   double min_quality = 0;  // quality guard, 0 = off
+};
+CheckParams check_params_from(const CollapseOptions& o);
+
+struct StageParams : CheckParams {
   double target = 0;
   int mask_mode = 0;  // 0 none, 1 both, 2 either
   std::string cost_source;  // user cost, "" for the edge length

@@ -74,19 +74,7 @@ bool after(double ca, int32_t aa, int32_t ab, double cb, int32_t ba, int32_t bb)
 
 }  // namespace
 
-SeqParams seq_params_from(const CollapseOptions& o) {
-  SeqParams p;
-  p.mode = o.boundary == CollapseOptions::Strict ? TCC_STRICT
-           : o.boundary == CollapseOptions::Features ? TCC_FEATURES
-                                                     : TCC_FREE;
-  p.paper_rule = o.paper_boundary_rule;
-  p.use_labels = o.use_labels;
-  p.eps_f = o.eps_f;
-  p.eps_r = o.eps_r;
-  p.eps_v = o.eps_v;
-  p.min_quality = o.min_quality;
-  return p;
-}
+SeqParams seq_params_from(const CollapseOptions& o) { return collapse_detail::check_params_from(o); }
 
 SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const TailSeed* seed)
     : mesh_(mesh),

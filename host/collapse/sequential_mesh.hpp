@@ -32,19 +32,14 @@
 #include <cstdint>
 #include <vector>
 
+#include "collapse/params.hpp"
 #include "geometry.h"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/mesh.hpp"
 
 namespace tc::sequential_detail {
 
-struct SeqParams {
-  int mode = 1;  // TCC_STRICT / TCC_FEATURES / TCC_FREE
-  bool paper_rule = false;
-  bool use_labels = true;
-  double eps_f = 0.01, eps_r = 0.1, eps_v = 2e-12;
-  double min_quality = 0;
-};
+using SeqParams = collapse_detail::CheckParams;  // the same checks as the parallel method's
 
 // Result of the admissible checks of one edge: reason as collapse_detail::Reason (kOk, kRefusedQ,
 // kRefusedLink, kRefusedVolume, kRefusedQuality) and, when kOk, the edge_dir bits.
