@@ -201,17 +201,7 @@ void compare_work_group_sizes(Context& ctx, const Mesh& mesh, const TopologyOpti
 
 // cube_tets(n) with the tets of centroid x < 0.5 labelled 2, the others 1: the interface faces
 // owned by the tets on the x > 0.5 side (the smaller label), unlike two_materials.
-Mesh two_materials_x(int n) {
-  Mesh m = test::cube_tets(n);
-  Labels lab{"material", {}};
-  for (int64_t i = 0; i < m.num_tets(); ++i) {
-    double cx = 0;
-    for (int k = 0; k < 4; ++k) cx += m.points[3 * m.tets[4 * i + k]] / 4;
-    lab.values.push_back(cx < 0.5 ? 2 : 1);
-  }
-  m.tet_labels.push_back(lab);
-  return m;
-}
+Mesh two_materials_x(int n) { return test::split_materials(n, 0, 2, 1); }
 
 }  // namespace
 

@@ -67,12 +67,7 @@ inline void meshio_cross_read(const std::string& path, int64_t points, int64_t t
 // Runs `f`, which must throw tc::InputError; returns its message ("" when nothing was thrown).
 template <class F>
 std::string input_error_of(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+  return error_of<InputError>(f);
 }
 
 }  // namespace tc::test

@@ -117,17 +117,19 @@ Mesh single_tet() {
 
 Mesh cube_tets(int n) { return make_cube_mesh(n); }
 
-Mesh two_materials(int n) {
+Mesh split_materials(int n, int axis, int32_t below, int32_t above) {
   Mesh m = cube_tets(n);
   Labels l{"material", {}};
   for (int64_t t = 0; t < m.num_tets(); ++t) {
-    double z = 0;
-    for (int k = 0; k < 4; ++k) z += m.points[3 * m.tets[4 * t + k] + 2] / 4;
-    l.values.push_back(z > 0.5 ? 2 : 1);
+    double c = 0;
+    for (int k = 0; k < 4; ++k) c += m.points[3 * m.tets[4 * t + k] + axis] / 4;
+    l.values.push_back(c > 0.5 ? above : below);
   }
   m.tet_labels.push_back(l);
   return m;
 }
+
+Mesh two_materials(int n) { return split_materials(n, 2, 1, 2); }
 
 Mesh sub_mesh(const Mesh& m, const std::function<bool(int64_t)>& keep) {
   Mesh out;

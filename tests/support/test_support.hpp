@@ -62,6 +62,9 @@ Mesh single_tet();             // the unit right-corner tet, positively oriented
 Mesh cube_tets(int n);         // [0,1]^3 split into n^3 cubes of 6 tets each (Kuhn), labels none
 Mesh slab(int n);              // the bottom layer of cube_tets(n): one tet thick, every vertex on the boundary
 Mesh two_materials(int n);     // cube_tets(n) with labels 1 below z = 0.5 and 2 above (an interface plane)
+// cube_tets(n) labelled ("material") by the side of the plane coordinate `axis` = 0.5 each tet's
+// centroid lies on: `below` or `above`
+Mesh split_materials(int n, int axis, int32_t below, int32_t above);
 // The tets t of m with keep(t), in order, with only their vertices (renumbered in order of use).
 Mesh sub_mesh(const Mesh& m, const std::function<bool(int64_t)>& keep);
 // m closed by a cone: a new last vertex at (x, y, z) joined by a tet to every boundary face (each
@@ -83,6 +86,17 @@ std::vector<size_t> triangles_off_surface(const Mesh& m);
 
 // Runs a shell command, returns its exit code; its stdout+stderr go into *output.
 int run_command(const std::string& cmd, std::string* output);
+
+// Runs `f`, which must throw E; returns its message ("" when nothing was thrown).
+template <class E, class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const E& e) {
+    return e.what();
+  }
+  return "";
+}
 
 }  // namespace tc::test
 

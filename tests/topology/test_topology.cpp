@@ -187,14 +187,7 @@ TEST(Topology, CoarseCylinderSideNeedsLargerEpsF) {
 
 TEST(Topology, TwoMaterialBlock) {
   const int n = 4;
-  Mesh m = test::cube_tets(n);
-  Labels lab{"material", {}};
-  for (int64_t i = 0; i < m.num_tets(); ++i) {
-    double cx = 0;
-    for (int k = 0; k < 4; ++k) cx += m.points[3 * m.tets[4 * i + k]] / 4;
-    lab.values.push_back(cx < 0.5 ? 7 : 3);
-  }
-  m.tet_labels.push_back(lab);
+  Mesh m = test::split_materials(n, 0, 7, 3);
   Topology t = build_topology(m);
   check_invariants(m, t);
   int iface = 0;
@@ -203,7 +196,7 @@ TEST(Topology, TwoMaterialBlock) {
     ++iface;
     for (int k = 0; k < 3; ++k) ASSERT_EQ(m.points[3 * t.sfaces[3 * s + k]], 0.5);
     // owned by the smaller label (3, the x > 0.5 side), normal into label 7: -x
-    EXPECT_EQ(lab.values[t.sface_tet[s]], 3);
+    EXPECT_EQ(m.tet_labels[0].values[t.sface_tet[s]], 3);
     EXPECT_NEAR(t.sface_normals[3 * s], -1.0, 1e-15);
   }
   EXPECT_EQ(iface, 2 * n * n);
