@@ -2,10 +2,9 @@
 // vertices whose rings did not change.
 #include "collapse/connectivity.hpp"
 
-#include "collapse/edge_state.hpp"
-
 #include <atomic>
 
+#include "collapse/edge_state.hpp"
 #include "device/primitives.hpp"
 
 namespace tc::collapse_detail {

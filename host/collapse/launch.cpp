@@ -1,73 +1,92 @@
 // Named kernel arguments (launch.hpp).
 #include "collapse/launch.hpp"
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <functional>
+#include <map>
+#include <mutex>
 
 #include "collapse/stages.hpp"
 #include "device/primitives.hpp"
+#include "stopwatch.hpp"
 #include "tetcollapse/error.hpp"
 
 namespace tc::collapse_detail {
 
 const bool kProfile = std::getenv("TETCOLLAPSE_PROFILE") != nullptr;
 
-double now_seconds() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
 void profile_line(Context& ctx, const char* what, size_t n, double t0, const char* note) {
   if (!kProfile) return;
   ctx.finish();
-  std::fprintf(stderr, "  %-28s n=%-9zu %8.4f s%s\n", what, n, now_seconds() - t0, note);
+  std::fprintf(stderr, "  %-28s n=%-9zu %8.4f s%s\n", what, n, Stopwatch::now() - t0, note);
 }
 
-Kernel::Kernel(cl::Kernel k, std::string name) : k_(std::move(k)), name_(std::move(name)) {
+namespace {
+
+// The parameters of kernel k, read from the compiled kernel.
+std::vector<Kernel::Param> read_params(cl::Kernel& k) {
+  using Kind = Kernel::Kind;
+  std::vector<Kernel::Param> params(k.getInfo<CL_KERNEL_NUM_ARGS>());
+  for (cl_uint i = 0; i < params.size(); ++i) {
+    Kernel::Param& p = params[i];
+    p.name = k.getArgInfo<CL_KERNEL_ARG_NAME>(i);
+    // (the strings may carry a terminating NUL)
+    p.name.erase(std::find(p.name.begin(), p.name.end(), '\0'), p.name.end());
+    // PoCL reports a parameter named like a built-in function (round) as _cl_round
+    if (p.name.rfind("_cl_", 0) == 0) p.name.erase(0, 4);
+    std::string type = k.getArgInfo<CL_KERNEL_ARG_TYPE_NAME>(i);
+    type.erase(std::find(type.begin(), type.end(), '\0'), type.end());
+    const bool global = k.getArgInfo<CL_KERNEL_ARG_ADDRESS_QUALIFIER>(i) == CL_KERNEL_ARG_ADDRESS_GLOBAL;
+    p.kind = global              ? Kind::Buffer
+             : type == "int"     ? Kind::Int
+             : type == "uint"    ? Kind::Uint
+             : type == "long"    ? Kind::Long
+             : type == "ulong"   ? Kind::Ulong
+             : type == "uchar"   ? Kind::Uchar
+             : type == "char"    ? Kind::Char
+             : type == "double"  ? Kind::Double
+             : type == "float"   ? Kind::Float
+                                 : Kind::Other;
+  }
+  return params;
+}
+
+}  // namespace
+
+// A kernel's signature is its file's, whatever the program it is built in (the user's
+// functions, the tuning's -D options): cached by (file, name), read again should the number of
+// parameters differ.
+Kernel::Kernel(cl::Kernel k, std::string name, const std::string& file) : k_(std::move(k)), name_(std::move(name)) {
+  static std::mutex mutex;
+  static std::map<std::pair<std::string, std::string>, std::shared_ptr<const std::vector<Param>>> cache;
   detail::cl_call(("clGetKernelArgInfo(" + name_ + ")").c_str(), [&] {
-    const cl_uint n = k_.getInfo<CL_KERNEL_NUM_ARGS>();
-    params_.resize(n);
-    for (cl_uint i = 0; i < n; ++i) {
-      Param& p = params_[i];
-      p.name = k_.getArgInfo<CL_KERNEL_ARG_NAME>(i);
-      // (the strings may carry a terminating NUL)
-      p.name.erase(std::find(p.name.begin(), p.name.end(), '\0'), p.name.end());
-      // PoCL reports a parameter named like a built-in function (round) as _cl_round
-      if (p.name.rfind("_cl_", 0) == 0) p.name.erase(0, 4);
-      std::string type = k_.getArgInfo<CL_KERNEL_ARG_TYPE_NAME>(i);
-      type.erase(std::find(type.begin(), type.end(), '\0'), type.end());
-      const bool global = k_.getArgInfo<CL_KERNEL_ARG_ADDRESS_QUALIFIER>(i) == CL_KERNEL_ARG_ADDRESS_GLOBAL;
-      p.kind = global                ? Kind::Buffer
-               : type == "int"       ? Kind::Int
-               : type == "uint"      ? Kind::Uint
-               : type == "long"      ? Kind::Long
-               : type == "ulong"     ? Kind::Ulong
-               : type == "uchar"     ? Kind::Uchar
-               : type == "char"      ? Kind::Char
-               : type == "double"    ? Kind::Double
-               : type == "float"     ? Kind::Float
-                                     : Kind::Other;
-    }
+    const size_t n = k_.getInfo<CL_KERNEL_NUM_ARGS>();
+    const std::lock_guard<std::mutex> lock(mutex);
+    auto& params = cache[{file, name_}];
+    if (!params || params->size() != n) params = std::make_shared<const std::vector<Param>>(read_params(k_));
+    params_ = params;
   });
+  set_.assign(params_->size(), false);
 }
 
 size_t Kernel::index(const char* param) const {
-  for (size_t i = 0; i < params_.size(); ++i)
-    if (params_[i].name == param) return i;
+  const std::vector<Param>& params = *params_;
+  for (size_t i = 0; i < params.size(); ++i)
+    if (params[i].name == param) return i;
   std::string names;
-  for (const Param& p : params_) names += (names.empty() ? "" : ", ") + p.name;
+  for (const Param& p : params) names += (names.empty() ? "" : ", ") + p.name;
   throw DeviceError("kernel " + name_ + " has no parameter '" + param + "' (its parameters: " + names + ")");
 }
 
 void Kernel::set_buffer(const char* param, const cl::Buffer& b) {
   const size_t i = index(param);
-  if (params_[i].kind != Kind::Buffer)
+  if ((*params_)[i].kind != Kind::Buffer)
     throw DeviceError("kernel " + name_ + ": parameter '" + param + "' is not a global buffer");
   detail::cl_call(name_.c_str(), [&] { k_.setArg(cl_uint(i), b); });
-  params_[i].set = true;
+  set_[i] = true;
 }
 
 void Kernel::set_number(const char* param, long double v, bool integral) {
@@ -80,7 +99,7 @@ void Kernel::set_number(const char* param, long double v, bool integral) {
     if (v < lo || v > hi) fail("out of its type's range");
   };
   detail::cl_call(name_.c_str(), [&] {
-    switch (params_[i].kind) {
+    switch ((*params_)[i].kind) {
       case Kind::Int: in(INT32_MIN, INT32_MAX); k_.setArg(cl_uint(i), cl_int(v)); break;
       case Kind::Uint: in(0, UINT32_MAX); k_.setArg(cl_uint(i), cl_uint(v)); break;
       case Kind::Long: in(INT64_MIN, INT64_MAX); k_.setArg(cl_uint(i), cl_long(v)); break;
@@ -92,17 +111,17 @@ void Kernel::set_number(const char* param, long double v, bool integral) {
       default: fail("is neither a buffer nor a number");
     }
   });
-  params_[i].set = true;
+  set_[i] = true;
 }
 
 void Kernel::check_all_set() const {
-  for (const Param& p : params_)
-    if (!p.set) throw DeviceError("kernel " + name_ + ": parameter '" + p.name + "' is not set");
+  for (size_t i = 0; i < set_.size(); ++i)
+    if (!set_[i]) throw DeviceError("kernel " + name_ + ": parameter '" + (*params_)[i].name + "' is not set");
 }
 
 void Kernel::launch(Context& ctx, size_t n) {
   check_all_set();
-  const double t0 = kProfile ? now_seconds() : 0;
+  const double t0 = kProfile ? Stopwatch::now() : 0;
   ctx.launch(k_, n, name_.c_str());
   profile_line(ctx, name_.c_str(), n, t0);
 }
@@ -113,7 +132,7 @@ void Kernel::launch_one_group(Context& ctx) {
 }
 
 Kernel kernel(Context& ctx, const std::string& file, const char* name) {
-  return Kernel(ctx.kernel(file, name), name);
+  return Kernel(ctx.kernel(file, name), name, file);
 }
 
 Kernel user_kernel(Context& ctx, const std::string& what, const std::string& file, const char* name,
@@ -125,7 +144,7 @@ Kernel user_kernel(Context& ctx, const std::string& what, const std::string& fil
       ctx.build(what + " (" + file + " " + std::to_string(std::hash<std::string>{}(src)) + ")", src, defines);
   return Kernel(detail::cl_call(("clCreateKernel(" + std::string(name) + ")").c_str(),
                                 [&] { return cl::Kernel(prog, name); }),
-                name);
+                name, file);
 }
 
 Kernel stage_kernel(Context& ctx, const StageParams& p, const std::string& file, const char* name) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -31,7 +32,9 @@ Arg<T> arg(const char* name, const T& value) {
 class Kernel {
  public:
   Kernel() = default;
-  Kernel(cl::Kernel k, std::string name);
+  // `file`: the .cl file the kernel is defined in; its parameters are read once per file and
+  // name (a kernel object is made per launch, reading them each time is measurable).
+  Kernel(cl::Kernel k, std::string name, const std::string& file);
 
   template <class... T>
   Kernel& set(const Arg<T>&... args) {
@@ -44,13 +47,13 @@ class Kernel {
   void launch_one_group(Context& ctx);
   const std::string& name() const { return name_; }
 
- private:
   enum class Kind : uint8_t { Buffer, Int, Uint, Long, Ulong, Uchar, Char, Double, Float, Other };
   struct Param {
     std::string name;
     Kind kind;
-    bool set = false;
   };
+
+ private:
   size_t index(const char* param) const;
   void set_buffer(const char* param, const cl::Buffer& b);
   void set_number(const char* param, long double v, bool integral);
@@ -69,7 +72,8 @@ class Kernel {
 
   cl::Kernel k_;
   std::string name_;
-  std::vector<Param> params_;
+  std::shared_ptr<const std::vector<Param>> params_;
+  std::vector<bool> set_;  // per parameter
 };
 
 // Kernel `name` of the embedded file `file` (Context::kernel).
@@ -96,9 +100,9 @@ void run_stage(Context& ctx, const StageParams& p, const std::string& file, cons
 
 // TETCOLLAPSE_PROFILE set: the stages print the wall time of every launch on stderr.
 extern const bool kProfile;
-// With kProfile: waits for the queue and prints `what`, n and the seconds since t0.
+// With kProfile: waits for the queue and prints `what`, n and the seconds since t0 (a
+// Stopwatch::now()).
 void profile_line(Context& ctx, const char* what, size_t n, double t0, const char* note = "");
-double now_seconds();
 
 // A device buffer of n elements: allocated on first use, else resized (DeviceBuffer::resize).
 template <class T>

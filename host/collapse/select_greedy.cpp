@@ -3,9 +3,8 @@
 
 #include <memory>
 
-#include "collapse/selection.hpp"
-
 #include "collapse/select_lazy.hpp"
+#include "collapse/selection.hpp"
 
 namespace tc::collapse_detail {
 

@@ -1,15 +1,14 @@
 // What the lazy filter, the greedy and the matching selections share (select_lazy.cpp).
 #pragma once
 
-#include <chrono>
 #include <cstdint>
-#include <cstdio>
 #include <initializer_list>
 
 #include "collapse/connectivity.hpp"
 #include "collapse/edge_state.hpp"
 #include "collapse/params.hpp"
 #include "collapse/upload.hpp"
+#include "stopwatch.hpp"
 
 namespace tc::collapse_detail {
 
@@ -37,7 +36,7 @@ uint32_t selection_rounds(Context& ctx, Connectivity& c, EdgeState& s, const Sta
   s.list_counts.download(&nt, 1);
   int cur = 0;  // the turn list of this round
   for (cl_uint round = 0; nt > 0; ++round) {
-    auto t0 = std::chrono::steady_clock::now();
+    const double t0 = Stopwatch::now();
     s.list_counts.fill(0);
     const bool one_group = nt <= p.greedy_loop_size;
     if (one_group) {
@@ -53,12 +52,7 @@ uint32_t selection_rounds(Context& ctx, Connectivity& c, EdgeState& s, const Sta
       s.list_counts.download(&nt, 1, size_t(1 - cur));
       cur = 1 - cur;
     }
-    if (kProfile) {
-      ctx.finish();
-      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s%s\n", name, nt,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-                   one_group ? " (one work-group)" : "");
-    }
+    profile_line(ctx, name, nt, t0, one_group ? " (one work-group)" : "");
   }
   run(ctx, A, "greedy_finish", c.ne, arg("ne", c.ne), arg("state", s.edges2state), arg("p1", s.edges_pass1), arg("fin", s.edges_are_final), arg("counters", s.counters));
   uint32_t cnt[6];

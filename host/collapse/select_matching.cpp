@@ -1,15 +1,13 @@
 // The matching selection and its undo (cl/collapse_matching.cl).
 #include "collapse/select_matching.hpp"
 
-#include <memory>
-
-#include "collapse/selection.hpp"
-
 #include <algorithm>
+#include <memory>
 #include <numeric>
 
 #include "collapse/guard_surface.hpp"
 #include "collapse/select_lazy.hpp"
+#include "collapse/selection.hpp"
 #include "device/primitives.hpp"
 
 namespace tc::collapse_detail {

@@ -4,14 +4,11 @@
 
 #include <memory>
 
-#include "collapse/selection.hpp"
-
-#include <chrono>
-#include <cstdio>
-
 #include "collapse/select_lazy.hpp"
+#include "collapse/selection.hpp"
 #include "collapse/verdict_carry.hpp"
 #include "device/primitives.hpp"
+#include "stopwatch.hpp"
 
 namespace tc::collapse_detail {
 
@@ -42,22 +39,16 @@ void rounds(Context& ctx, EdgeState& s, uint32_t n, const char* what, const Roun
   int cur = 0;
   for (cl_int first = 1; n > 0; first = 0) {
     s.list_counts.fill(0);
-    auto t0 = std::chrono::steady_clock::now();
+    const double t0 = Stopwatch::now();
     if (tail && n <= tail_size) {
       (*tail)(n, first, cur);
-      if (kProfile) {
-        ctx.finish();
-        std::fprintf(stderr, "  %-28s n=%-9u %8.4f s (all remaining rounds)\n", what, n,
-                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-      }
+      profile_line(ctx, what, n, t0, " (all remaining rounds)");
       return;
     }
     round(n, first, cur);
     uint32_t next = 0;
     s.list_counts.download(&next, 1);
-    if (kProfile)
-      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s\n", what, n,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    profile_line(ctx, what, n, t0);
     n = next;
     cur = 1 - cur;
   }
@@ -112,7 +103,7 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, Kernel& d
   int cur = 0;  // the list of this round
   cl_uint round = 0;
   while (nt > 0) {
-    auto t0 = std::chrono::steady_clock::now();
+    const double t0 = Stopwatch::now();
     s.list_counts.fill(0);
     const bool one_group = nu <= p.loop_tests && nt <= p.loop_turns;
     if (one_group) {
@@ -135,12 +126,7 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, Kernel& d
       cur = 1 - cur;
       ++round;
     }
-    if (kProfile) {
-      ctx.finish();
-      std::fprintf(stderr, "  %-28s n=%-9u %8.4f s%s\n", "lazy_p1_round", nt,
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-                   one_group ? " (one work-group)" : "");
-    }
+    profile_line(ctx, "lazy_p1_round", nt, t0, one_group ? " (one work-group)" : "");
   }
 }
 }  // namespace
