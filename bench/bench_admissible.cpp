@@ -40,12 +40,12 @@ int main(int argc, char** argv) {
     uint32_t adm = admissible(ctx, dm, c, s, p);  // warm-up (the first: kernel build)
     std::vector<double> t;
     for (int r = 0; r < runs; ++r) {
-      s.counters.fill(0u);
+      s.cost.counters.fill(0u);
       auto t0 = std::chrono::steady_clock::now();
       adm = admissible(ctx, dm, c, s, p);  // reads back its counter: the launch is finished
       t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     }
-    std::vector<uint8_t> reason = s.edges2reason.download_range(0, c.ne);
+    std::vector<uint8_t> reason = s.result.edges2reason.download_range(0, c.ne);
     size_t by[9] = {0};  // by reason; [8]: a code this program does not know
     for (uint8_t r : reason) ++by[r < 8 ? r : 8];
     if (by[8] || by[kUntested] || by[kRefusedSurface])
@@ -63,7 +63,7 @@ int main(int argc, char** argv) {
     if (set == 0) {  // mark only the admissible edges
       std::vector<uint32_t> m(c.ne);
       for (uint32_t e = 0; e < c.ne; ++e) m[e] = reason[e] == kOk ? 1u : 0u;
-      s.edges_are_marked.upload(m);
+      s.cost.edges_are_marked.upload(m);
     }
   }
   return 0;

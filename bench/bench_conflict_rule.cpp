@@ -64,9 +64,9 @@ int main(int argc, char** argv) {
   EdgeState s;
   const uint32_t marked = cost_and_mark(ctx, dm, c, s, p);
   const uint32_t adm = admissible(ctx, dm, c, s, p);
-  const std::vector<uint8_t> reason = s.edges2reason.download_range(0, c.ne);
-  const std::vector<uint8_t> dir = s.edges2dir.download_range(0, c.ne);
-  const std::vector<double> cost = s.edges2cost.download_range(0, c.ne);
+  const std::vector<uint8_t> reason = s.result.edges2reason.download_range(0, c.ne);
+  const std::vector<uint8_t> dir = s.result.edges2dir.download_range(0, c.ne);
+  const std::vector<double> cost = s.cost.edges2cost.download_range(0, c.ne);
   const std::vector<int32_t> edges = c.edges.download_range(0, size_t(c.ne) * 2);
   const std::vector<uint32_t> nb_off = c.nb_off.download_range(0, size_t(dm.nv) + 1);
   const std::vector<int32_t> nb = c.nb.download_range(0, nb_off.back());

@@ -78,13 +78,14 @@ int main(int argc, char** argv) {
   p.greedy_loop_exit = loop_exit;
   DeviceMesh next;
   EdgeState s;
+  MatchingState m;
   DeviceBuffer<int32_t> origin(ctx, 1);
   uint32_t passed_q = 0, tested = 0;
   for (int it = 0; it < iteration; ++it) {  // the earlier iterations, matching
     cost_and_mark(ctx, dm, c, s, p);
-    s.verdict_ready = false;
-    matching_backup(ctx, dm, s);
-    matching_selection(ctx, dm, c, s, p, passed_q, tested);
+    s.carry.verdict_ready = false;
+    matching_backup(ctx, dm, m);
+    matching_selection(ctx, dm, c, s, m, p, passed_q, tested);
     collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
     build_connectivity(ctx, dm, c, p);
   }
@@ -105,11 +106,11 @@ int main(int argc, char** argv) {
   Timing greedy, matching, greedy_nw, matching_nw;
   auto time_one = [&](Timing& t, bool match, bool waiting) {
     p.waiting_lists = waiting;
-    s.counters.fill(0u);
-    s.counters.upload(&marked, 1, 0);
-    s.verdict_ready = false;
+    s.cost.counters.fill(0u);
+    s.cost.counters.upload(&marked, 1, 0);
+    s.carry.verdict_ready = false;
     const double t0 = now();
-    t.taken = match ? matching_selection(ctx, dm, c, s, p, passed_q, t.tested)
+    t.taken = match ? matching_selection(ctx, dm, c, s, m, p, passed_q, t.tested)
                     : greedy_selection(ctx, dm, c, s, p, passed_q, t.tested);
     ctx.finish();
     t.t.push_back(now() - t0);

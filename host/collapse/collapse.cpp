@@ -6,6 +6,7 @@
 #include "collapse/compact.hpp"
 #include "collapse/connectivity.hpp"
 #include "collapse/cost.hpp"
+#include "collapse/edge_state.hpp"
 #include "collapse/host_tail.hpp"
 #include "collapse/selection.hpp"
 #include "collapse/target.hpp"

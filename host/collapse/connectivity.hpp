@@ -32,11 +32,11 @@ struct Connectivity {
 
 struct EdgeState;  // edge_state.hpp
 
-// With carry (an EdgeState after note_compaction), the data (N(v), tet_nbr, vclass,
-// eflags) of the vertices whose rings did not change is copied from the previous iteration
-// instead of recomputed, and the rings and tet_nbr computed by collapse_and_compact are taken
-// over (carry->upd_*, swapped into c).
+// With s (an EdgeState after note_compaction), the data (N(v), tet_nbr, vclass, eflags) of the
+// vertices whose rings did not change is copied from the previous iteration (s->carry) instead
+// of recomputed, and the rings and tet_nbr computed by collapse_and_compact are taken over
+// (s->compact.upd_*, swapped into c).
 void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const StageParams& p,
-                        EdgeState* carry = nullptr);
+                        EdgeState* s = nullptr);
 
 }  // namespace tc::collapse_detail

@@ -4,11 +4,27 @@
 #include <cstdint>
 
 #include "collapse/connectivity.hpp"
-#include "collapse/edge_state.hpp"
 #include "collapse/params.hpp"
 #include "collapse/upload.hpp"
 
 namespace tc::collapse_detail {
+
+// The cost and the marking. The surface guard unmarks the collapses it refuses, and every stage
+// after adds its counts to counters (zeroed here, once per iteration).
+struct CostState {
+  DeviceBuffer<double> edges2cost;
+  DeviceBuffer<uint32_t> edges_are_marked;
+  DeviceBuffer<uint32_t> counters;  // marked, admissible, pass 1, pass 2, tested, passed Q
+};
+
+// Counter i of counters (marked, admissible, pass1, pass2, tested, passed Q).
+inline uint32_t read_counter(CostState& s, int i) {
+  uint32_t v = 0;
+  s.counters.download(&v, 1, size_t(i));
+  return v;
+}
+
+struct EdgeState;  // edge_state.hpp
 
 // Returns the number of marked edges.
 uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p);

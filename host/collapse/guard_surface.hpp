@@ -10,11 +10,12 @@
 #include <vector>
 
 #include "collapse/connectivity.hpp"
-#include "collapse/edge_state.hpp"
 #include "collapse/params.hpp"
 #include "collapse/upload.hpp"
 
 namespace tc::collapse_detail {
+
+struct EdgeState;  // edge_state.hpp
 
 struct SurfaceGuard {
   DeviceBuffer<int32_t> qedge, tid;          // per query: its edge; per new triangle: ids
@@ -44,11 +45,11 @@ struct SurfaceGuard {
   bool each_pair_once = true;
   bool last_run_each_pair_once = false;
 
-  // Tests the `chosen` collapses of s.edges_are_final / s.edges2dir; returns how many were refused (their edges
-  // are unmarked in s.edges_are_marked).
+  // Tests the `chosen` collapses of s.result (edges_are_final, edges2dir); returns how many were
+  // refused (their edges are unmarked in s.cost.edges_are_marked).
   uint32_t run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p, uint32_t chosen);
   // The same for the matching selection, whose collapses are applied to dm and c.tet_nbr
-  // (EdgeState::in_place): on the result (cl/collapse_guard_applied.cl).
+  // (SelectionResult::in_place): on the result (cl/collapse_guard_applied.cl).
   uint32_t run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                        uint32_t chosen);
   // After the matching selection undid the collapses of `undone` (after a run_applied that

@@ -7,13 +7,14 @@
 #include <vector>
 
 #include "collapse/connectivity.hpp"
-#include "collapse/edge_state.hpp"
 #include "collapse/params.hpp"
 #include "collapse/sequential_run.hpp"
 #include "collapse/upload.hpp"
 #include "tetcollapse/collapse.hpp"
 
 namespace tc::collapse_detail {
+
+struct EdgeState;  // edge_state.hpp
 
 class HostTail {
  public:

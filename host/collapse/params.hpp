@@ -55,7 +55,7 @@ struct StageParams : CheckParams {
   // vertex and is woken when the blocker decides (tcc_wait_on, cl/collapse_select.h), instead of
   // going to every turn list until then. Results do not depend on it.
   bool waiting_lists = true;
-  // Matching selection: a waiting edge's early volume test (cl/collapse_matching.cl; EdgeState::edges_early_tested).
+  // Matching selection: a waiting edge's early volume test (cl/collapse_matching.cl; MatchingState::edges_early_tested).
   bool match_early_tests = true;
 };
 StageParams params_from(const CollapseOptions& o);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "collapse/admissible.hpp"
+#include "collapse/edge_state.hpp"
 #include "collapse/selection.hpp"
 #include "tetcollapse/error.hpp"
 
@@ -30,10 +31,10 @@ uint32_t conflicts_atomic_min(Context& ctx, DeviceMesh& dm, Connectivity& c, Edg
                       "atomic-min conflict detection needs; use --conflicts two-pass or another device");
   const std::string F = "collapse_atomic_min.cl";
   const cl_uint ne = c.ne, nt = dm.nt, k = index_bits(c.ne);
-  ensure(s.edges_are_final, ctx, ne);
-  ensure(s.edges_pass1, ctx, ne);
-  ensure(s.verts2collapse, ctx, dm.nv);
-  s.verts2collapse.fill(-1);
+  ensure(s.result.edges_are_final, ctx, ne);
+  ensure(s.result.edges_pass1, ctx, ne);
+  ensure(s.result.verts2collapse, ctx, dm.nv);
+  s.result.verts2collapse.fill(-1);
   // One descriptor (ulong) per tet in c.scratch: build_connectivity's scratch area (12 ints per
   // tet), unused until the next build_connectivity.
   if (c.scratch.size() < size_t(nt) * 2) ensure(c.scratch, ctx, size_t(nt) * 2);
@@ -42,10 +43,10 @@ uint32_t conflicts_atomic_min(Context& ctx, DeviceMesh& dm, Connectivity& c, Edg
     collapse_detail::run(ctx, F, name, n, args...);
   };
   run("atomic_min_reset", nt, arg("nt", nt), arg("desc", desc));
-  run("atomic_min_propagate", ne, arg("ne", ne), arg("edges", c.edges), arg("adm", s.edges_are_admissible), arg("cost", s.edges2cost), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("idx_bits", k), arg("desc", desc));
-  run("atomic_min_select", ne, arg("ne", ne), arg("edges", c.edges), arg("adm", s.edges_are_admissible), arg("cost", s.edges2cost), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("idx_bits", k), arg("desc", desc), arg("fin", s.edges_are_final), arg("p1", s.edges_pass1), arg("vaff", s.verts2collapse), arg("counters", s.counters));
+  run("atomic_min_propagate", ne, arg("ne", ne), arg("edges", c.edges), arg("adm", s.result.edges_are_admissible), arg("cost", s.cost.edges2cost), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("idx_bits", k), arg("desc", desc));
+  run("atomic_min_select", ne, arg("ne", ne), arg("edges", c.edges), arg("adm", s.result.edges_are_admissible), arg("cost", s.cost.edges2cost), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("idx_bits", k), arg("desc", desc), arg("fin", s.result.edges_are_final), arg("p1", s.result.edges_pass1), arg("vaff", s.result.verts2collapse), arg("counters", s.cost.counters));
   uint32_t n = 0;
-  s.counters.download(&n, 1, 3);
+  s.cost.counters.download(&n, 1, 3);
   return n;
 }
 
@@ -58,7 +59,7 @@ class AtomicMinSelection final : public Selection {
                 const IterationStats&) override {
     Chosen r;
     admissible(ctx, dm, c, s, p);
-    r.candidates = read_counter(s, 5);
+    r.candidates = read_counter(s.cost, 5);
     r.tested = r.candidates;
     r.selected = conflicts_atomic_min(ctx, dm, c, s);
     return r;

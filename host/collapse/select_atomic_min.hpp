@@ -4,11 +4,12 @@
 #include <cstdint>
 
 #include "collapse/connectivity.hpp"
-#include "collapse/edge_state.hpp"
 #include "collapse/params.hpp"
 #include "collapse/upload.hpp"
 
 namespace tc::collapse_detail {
+
+struct EdgeState;  // edge_state.hpp
 
 // Atomic-min conflict detection (select_atomic_min.cpp) over the admissible edges
 // of admissible(): replaces both conflict passes, with the same outputs as conflict_pass2.

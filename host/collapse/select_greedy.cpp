@@ -3,6 +3,7 @@
 
 #include <memory>
 
+#include "collapse/edge_state.hpp"
 #include "collapse/select_lazy.hpp"
 #include "collapse/selection.hpp"
 
@@ -20,14 +21,14 @@ uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
   Kernel block = kernel(ctx, A, "greedy_block"), recompute = kernel(ctx, A, "lazy_p1_recompute"),
              turns = kernel(ctx, A, "lazy_p1_turns");
   auto one_round = [&](uint32_t nt, int cur, cl_uint round) {
-    decide.set(arg("n", nt), arg("cur", cl_uint(cur)), arg("tlist", s.turn_lists[cur]), arg("tnext", s.turn_lists[1 - cur]), arg("cnt", s.list_counts), arg("edges", c.edges), arg("prio", prio), arg("slot", s.verts2slot[0]), arg("blocker", s.edges2blocker), arg("queued", s.edges2queued), arg("round", round), arg("inlist", s.round_taken), arg("vstamp", s.verts2listed), arg("dlist", s.vertex_list), arg("state", s.edges2state), arg("vaff", s.verts2collapse), arg("waiting", W), arg("whead", s.verts2waiting), arg("wnext", s.edges2next_waiting));
+    decide.set(arg("n", nt), arg("cur", cl_uint(cur)), arg("tlist", s.lazy.turn_lists[cur]), arg("tnext", s.lazy.turn_lists[1 - cur]), arg("cnt", s.lazy.list_counts), arg("edges", c.edges), arg("prio", prio), arg("slot", s.lazy.verts2slot[0]), arg("blocker", s.lazy.edges2blocker), arg("queued", s.lazy.edges2queued), arg("round", round), arg("inlist", s.lazy.round_taken), arg("vstamp", s.lazy.verts2listed), arg("dlist", s.lazy.vertex_list), arg("state", s.result.edges2state), arg("vaff", s.result.verts2collapse), arg("waiting", W), arg("whead", s.lazy.verts2waiting), arg("wnext", s.lazy.edges2next_waiting));
     decide.launch(ctx, nt);
-    block.set(arg("inlist", s.round_taken), arg("cnt", s.list_counts), arg("edges", c.edges), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("slot", s.verts2slot[0]), arg("vstamp", s.verts2listed), arg("round", round), arg("dlist", s.vertex_list), arg("state", s.edges2state));
+    block.set(arg("inlist", s.lazy.round_taken), arg("cnt", s.lazy.list_counts), arg("edges", c.edges), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("slot", s.lazy.verts2slot[0]), arg("vstamp", s.lazy.verts2listed), arg("round", round), arg("dlist", s.lazy.vertex_list), arg("state", s.result.edges2state));
     block.launch(ctx, nt);  // over the round's taken edges (cnt[4] <= nt)
     vertex_part(ctx, s, c, recompute, turns, prio, cur, round, nullptr, p.waiting_lists);
   };
   auto in_one_group = [&](uint32_t nt, int cur, cl_uint round) {
-    loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.turn_lists[0]), arg("t1", s.turn_lists[1]), arg("cnt", s.list_counts), arg("edges", c.edges), arg("prio", prio), arg("slot", s.verts2slot[0]), arg("blocker", s.edges2blocker), arg("queued", s.edges2queued), arg("inlist", s.round_taken), arg("vstamp", s.verts2listed), arg("dlist", s.vertex_list), arg("state", s.edges2state), arg("vaff", s.verts2collapse), arg("max_n", p.greedy_loop_exit), arg("resume", s.loop_resume), arg("waiting", W), arg("whead", s.verts2waiting), arg("wnext", s.edges2next_waiting));
+    loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.lazy.turn_lists[0]), arg("t1", s.lazy.turn_lists[1]), arg("cnt", s.lazy.list_counts), arg("edges", c.edges), arg("prio", prio), arg("slot", s.lazy.verts2slot[0]), arg("blocker", s.lazy.edges2blocker), arg("queued", s.lazy.edges2queued), arg("inlist", s.lazy.round_taken), arg("vstamp", s.lazy.verts2listed), arg("dlist", s.lazy.vertex_list), arg("state", s.result.edges2state), arg("vaff", s.result.verts2collapse), arg("max_n", p.greedy_loop_exit), arg("resume", s.lazy.loop_resume), arg("waiting", W), arg("whead", s.lazy.verts2waiting), arg("wnext", s.lazy.edges2next_waiting));
     loop.launch_one_group(ctx);
   };
   return selection_rounds(ctx, c, s, p, "greedy_round", one_round, in_one_group, passed_q, tested);

@@ -4,11 +4,12 @@
 #include <cstdint>
 
 #include "collapse/connectivity.hpp"
-#include "collapse/edge_state.hpp"
 #include "collapse/params.hpp"
 #include "collapse/upload.hpp"
 
 namespace tc::collapse_detail {
+
+struct EdgeState;  // edge_state.hpp
 
 // The greedy selection (cl/collapse_admissible.cl, greedy_*), in place of
 // lazy_admissible_pass1 and conflict_pass2: the edges that taking the candidates one after

@@ -1,6 +1,7 @@
 // The selection and surface guard loop every conflict detection shares (selection.hpp).
 #include "collapse/selection.hpp"
 
+#include "collapse/edge_state.hpp"
 #include "stopwatch.hpp"
 
 namespace tc::collapse_detail {
@@ -24,7 +25,7 @@ uint32_t Selection::select(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
     stats.refused_by_guard += refused;
     stats.seconds_guard += clock.lap();
     if (refused == 0 || guard_leaves_final()) return left;
-    s.verdict_ready = true;  // this iteration's verdicts still hold for the next selection
+    s.carry.verdict_ready = true;  // this iteration's verdicts still hold for the next selection
   }
 }
 

@@ -16,7 +16,6 @@
 #include <memory>
 
 #include "collapse/connectivity.hpp"
-#include "collapse/edge_state.hpp"
 #include "collapse/guard_surface.hpp"
 #include "collapse/params.hpp"
 #include "collapse/upload.hpp"
@@ -24,12 +23,14 @@
 
 namespace tc::collapse_detail {
 
+struct EdgeState;  // edge_state.hpp
+
 class Selection {
  public:
   virtual ~Selection() = default;
-  // This iteration's collapses in s.edges_are_final, s.edges2dir and s.verts2collapse, tested by the surface guard; returns
-  // how many. Fills stats' candidates, tested, selected, refused_by_guard, seconds_select and
-  // seconds_guard.
+  // This iteration's collapses in s.result (edges_are_final, edges2dir, verts2collapse), tested by
+  // the surface guard; returns how many. Fills stats' candidates, tested, selected,
+  // refused_by_guard, seconds_select and seconds_guard.
   uint32_t select(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                   IterationStats& stats);
 

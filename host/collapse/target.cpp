@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "collapse/cost.hpp"
+#include "collapse/edge_state.hpp"
 #include "geometry.h"
 
 namespace tc {
@@ -70,7 +71,7 @@ double target_length(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s
   q.cost_source.clear();
   q.target = 0;
   cost_and_mark(ctx, dm, c, s, q);
-  report.median_edge_length = median_of(s.edges2cost.download_range(0, c.ne));
+  report.median_edge_length = median_of(s.cost.edges2cost.download_range(0, c.ne));
   return o.target_factor * report.median_edge_length;
 }
 

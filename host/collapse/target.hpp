@@ -2,12 +2,13 @@
 #pragma once
 
 #include "collapse/connectivity.hpp"
-#include "collapse/edge_state.hpp"
 #include "collapse/params.hpp"
 #include "collapse/upload.hpp"
 #include "tetcollapse/collapse.hpp"
 
 namespace tc::collapse_detail {
+
+struct EdgeState;  // edge_state.hpp
 
 // o.target_length, or o.target_factor x the median edge length of the mesh of `c` (the
 // device's edge list; also in report.median_edge_length).

@@ -59,11 +59,11 @@ struct AtomicStage {
     n = conflicts_atomic_min(ctx, dm, c, s);
     ne = c.ne;
     edges = c.edges.download_range(0, 2 * size_t(ne));
-    adm = s.edges_are_admissible.download_range(0, ne);
-    fin = s.edges_are_final.download_range(0, ne);
-    cost = s.edges2cost.download_range(0, ne);
-    dir = s.edges2dir.download_range(0, ne);
-    vaff = s.verts2collapse.download_range(0, dm.nv);
+    adm = s.result.edges_are_admissible.download_range(0, ne);
+    fin = s.result.edges_are_final.download_range(0, ne);
+    cost = s.cost.edges2cost.download_range(0, ne);
+    dir = s.result.edges2dir.download_range(0, ne);
+    vaff = s.result.verts2collapse.download_range(0, dm.nv);
     tets = m.tets;
     ring.assign(m.num_vertices(), {});
     for (size_t t = 0; t < tets.size() / 4; ++t)
@@ -177,7 +177,7 @@ TEST(CollapseAtomicMin, SelectsTheEdgesHoldingEveryMinimum) {
     EXPECT_GT(selected, 0u);
     EXPECT_EQ(st.n, selected);
     uint32_t counters[6];
-    st.s.counters.download(counters, 6);
+    st.s.cost.counters.download(counters, 6);
     EXPECT_EQ(counters[3], selected);
     EXPECT_EQ(counters[2], selected);
     // vaff: exactly the end points of the selected edges, each in one edge
@@ -228,8 +228,9 @@ TEST(CollapseAtomicMin, SelectedEdgesAreLocalMinimaAndASubsetOfTwoPass) {
     // the two passes on the same admissible edges (they overwrite fin and vaff)
     const std::vector<uint32_t> atomic_fin = st.fin;
     conflict_pass1(ctx, st.dm, st.c, st.s);
-    const uint32_t n2 = conflict_pass2(ctx, st.dm, st.c, st.s);
-    const std::vector<uint32_t> two = st.s.edges_are_final.download_range(0, st.ne);
+    TwoPassState two_pass;
+    const uint32_t n2 = conflict_pass2(ctx, st.dm, st.c, st.s, two_pass);
+    const std::vector<uint32_t> two = st.s.result.edges_are_final.download_range(0, st.ne);
     uint32_t outside = 0;
     for (uint32_t e = 0; e < st.ne; ++e) outside += atomic_fin[e] && !two[e];
     std::printf("%s: atomic-min %u, two-pass %u, atomic edges not in two-pass %u, resolution ties %d\n",

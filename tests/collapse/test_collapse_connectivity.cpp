@@ -414,13 +414,14 @@ TEST(CollapseConnectivity, CarriedAfterCollapsesEqualsFreshBuild) {
     upload_mesh(ctx, mesh, o, dm);
     Connectivity c;
     EdgeState s;
+    TwoPassState two_pass;
     DeviceBuffer<int32_t> origin(ctx, 0);
     build_connectivity(ctx, dm, c, p);
     std::vector<double> len = [&] {
       StageParams q = p;
       q.target = 1e300;  // every edge marked: cost = length
       cost_and_mark(ctx, dm, c, s, q);
-      return s.edges2cost.download_range(0, c.ne);
+      return s.cost.edges2cost.download_range(0, c.ne);
     }();
     std::nth_element(len.begin(), len.begin() + len.size() / 2, len.end());
     p.target = 2 * len[len.size() / 2];
@@ -429,15 +430,15 @@ TEST(CollapseConnectivity, CarriedAfterCollapsesEqualsFreshBuild) {
       cost_and_mark(ctx, dm, c, s, p);
       uint32_t passed_q = 0, tested = 0;
       lazy_admissible_pass1(ctx, dm, c, s, p, passed_q, tested);
-      if (conflict_pass2(ctx, dm, c, s) == 0) break;
+      if (conflict_pass2(ctx, dm, c, s, two_pass) == 0) break;
       remember_for_carry(ctx, dm, c, s);
       collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
       note_compaction(ctx, dm, c, s);
       Connectivity fresh;
       build_connectivity(ctx, dm, fresh, p);
-      EXPECT_TRUE(s.has_update);  // the rings and tet_nbr of collapse_update.cl are taken over
+      EXPECT_TRUE(s.compact.has_update);  // the rings and tet_nbr of collapse_update.cl are taken over
       build_connectivity(ctx, dm, c, p, &s);
-      EXPECT_FALSE(s.has_update);
+      EXPECT_FALSE(s.compact.has_update);
       carry_verdicts(ctx, dm, c, s);
       ASSERT_EQ(c.ne, fresh.ne);
       // rings and tet_nbr carried through the compaction (collapse_update.cl) = rebuilt ones
@@ -452,7 +453,7 @@ TEST(CollapseConnectivity, CarriedAfterCollapsesEqualsFreshBuild) {
       EXPECT_EQ(c.vclass.download_range(0, dm.nv), fresh.vclass.download_range(0, dm.nv));
       EXPECT_EQ(c.eflags.download_range(0, c.ne), fresh.eflags.download_range(0, c.ne));
       // some vertices were carried, not recomputed (else this test would test nothing)
-      std::vector<uint8_t> nd = s.verts_are_dirty.download_range(0, dm.nv);
+      std::vector<uint8_t> nd = s.carry.verts_are_dirty.download_range(0, dm.nv);
       EXPECT_GT(std::count(nd.begin(), nd.end(), uint8_t(0)), 0) << "iteration " << it;
       ++carried_iterations;
     }

@@ -70,20 +70,20 @@ struct GreedyStage {
     test::run_to_admissible(ctx, m, p, target, dm, c, s);
     ne = c.ne;
     edges = c.edges.download_range(0, 2 * size_t(ne));
-    adm = s.edges_are_admissible.download_range(0, ne);
-    reason = s.edges2reason.download_range(0, ne);
-    cost = s.edges2cost.download_range(0, ne);
-    marked = s.edges_are_marked.download_range(0, ne);
+    adm = s.result.edges_are_admissible.download_range(0, ne);
+    reason = s.result.edges2reason.download_range(0, ne);
+    cost = s.cost.edges2cost.download_range(0, ne);
+    marked = s.cost.edges_are_marked.download_range(0, ne);
     select(ctx, p);
   }
   void select(Context& ctx, const StageParams& p, bool keep_verdicts = false) {
     uint32_t passed_q = 0;
-    s.verdict_ready = keep_verdicts;  // else every verdict unknown: tested again
-    s.counters.fill(0u);              // as before each selection of a run
+    s.carry.verdict_ready = keep_verdicts;  // else every verdict unknown: tested again
+    s.cost.counters.fill(0u);               // as before each selection of a run
     taken = greedy_selection(ctx, dm, c, s, p, passed_q, tested);
-    fin = s.edges_are_final.download_range(0, ne);
-    greedy_reason = s.edges2reason.download_range(0, ne);
-    prio = p.priority_levels > 0 ? s.edges2priority.download_range(0, ne) : cost;
+    fin = s.result.edges_are_final.download_range(0, ne);
+    greedy_reason = s.result.edges2reason.download_range(0, ne);
+    prio = p.priority_levels > 0 ? s.lazy.edges2priority.download_range(0, ne) : cost;
   }
 };
 
@@ -192,7 +192,7 @@ TEST(CollapseGreedy, SelectingAgainKeepsTheVerdicts) {
     p.target = in.target;
     GreedyStage st(ctx, in.mesh, p, in.target);
     std::vector<uint32_t> marked = st.marked;
-    std::vector<uint8_t> verdict = st.s.edges2verdict.download_range(0, st.ne);
+    std::vector<uint8_t> verdict = st.s.carry.edges2verdict.download_range(0, st.ne);
     const int64_t volume_ok = std::count(verdict.begin(), verdict.end(), uint8_t(kVolumeOk));
     int64_t dropped = 0, k = 0;
     for (uint32_t e = 0; e < st.ne; ++e)
@@ -202,8 +202,8 @@ TEST(CollapseGreedy, SelectingAgainKeepsTheVerdicts) {
         st.adm[e] = 0;
         ++dropped;
       }
-    st.s.edges_are_marked.upload(marked);
-    st.s.edges2verdict.upload(verdict);
+    st.s.cost.edges_are_marked.upload(marked);
+    st.s.carry.edges2verdict.upload(verdict);
     const uint32_t tested_before = st.tested;
     st.select(ctx, p, true);
     const std::vector<uint32_t> expect = host_greedy(st, st.dm.nv);

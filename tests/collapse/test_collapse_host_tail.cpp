@@ -306,8 +306,8 @@ TEST(CollapseHostTail, TouchedFlagsFromDirtyVerticesAndGuardRefusals) {
   const uint32_t refused = c.ne / 2;
   verdict[refused] = kRefusedSurface;
   verdict[refused / 2] = kRefusedVolume;  // a refusal of the star: not touched for it
-  s.verts_are_dirty = DeviceBuffer<uint8_t>(ctx, ndirty);
-  s.edges2verdict = DeviceBuffer<uint8_t>(ctx, verdict);
+  s.carry.verts_are_dirty = DeviceBuffer<uint8_t>(ctx, ndirty);
+  s.carry.edges2verdict = DeviceBuffer<uint8_t>(ctx, verdict);
   const std::vector<uint8_t> touched = tail_touched(ctx, dm, c, s);
   const std::vector<int32_t> edges = c.edges.download_range(0, 2 * size_t(c.ne));
   ASSERT_EQ(touched.size(), size_t(dm.nv));

@@ -86,6 +86,7 @@ struct MatchStage {
   DeviceMesh dm;
   Connectivity c;
   EdgeState s;
+  MatchingState matching;
   StageParams p;
   uint32_t ne = 0, taken = 0, tested = 0;
   std::vector<int32_t> edges;
@@ -107,16 +108,16 @@ struct MatchStage {
     cost_and_mark(ctx, dm, c, s, p);
     ne = c.ne;
     edges = c.edges.download_range(0, 2 * size_t(ne));
-    marked = s.edges_are_marked.download_range(0, ne);
-    matching_backup(ctx, dm, s);
+    marked = s.cost.edges_are_marked.download_range(0, ne);
+    matching_backup(ctx, dm, matching);
     uint32_t passed_q = 0;
-    s.verdict_ready = false;
-    taken = matching_selection(ctx, dm, c, s, p, passed_q, tested);
-    fin = s.edges_are_final.download_range(0, ne);
-    dround = s.edges2round.download_range(0, ne);
-    dir = s.edges2dir.download_range(0, ne);
-    reason = s.edges2reason.download_range(0, ne);
-    prio = s.edges2priority.download_range(0, ne);
+    s.carry.verdict_ready = false;
+    taken = matching_selection(ctx, dm, c, s, matching, p, passed_q, tested);
+    fin = s.result.edges_are_final.download_range(0, ne);
+    dround = matching.edges2round.download_range(0, ne);
+    dir = s.result.edges2dir.download_range(0, ne);
+    reason = s.result.edges2reason.download_range(0, ne);
+    prio = s.lazy.edges2priority.download_range(0, ne);
   }
   // The mesh as the collapses left it, compacted.
   Mesh result(Context& ctx, const Mesh& input) {
@@ -275,9 +276,9 @@ TEST(CollapseMatching, UndoLeavesTheOtherCollapses) {
     for (uint32_t e = 0; e < st.ne; ++e)
       if (st.fin[e]) taken.push_back(e);
     for (size_t i = 0; i < taken.size(); i += 3) refused.push_back(taken[i]);
-    const uint32_t undone = matching_undo(ctx, st.dm, st.c, st.s, refused);
-    const std::vector<uint32_t> fin = st.s.edges_are_final.download_range(0, st.ne);
-    const std::vector<uint8_t> reason = st.s.edges2reason.download_range(0, st.ne);
+    const uint32_t undone = matching_undo(ctx, st.dm, st.c, st.s, st.matching, refused);
+    const std::vector<uint32_t> fin = st.s.result.edges_are_final.download_range(0, st.ne);
+    const std::vector<uint8_t> reason = st.s.result.edges2reason.download_range(0, st.ne);
     // the closure on the host
     std::vector<std::vector<int32_t>> nbr(size_t(in.mesh.num_vertices()));
     for (uint32_t e = 0; e < st.ne; ++e) {
@@ -367,7 +368,7 @@ TEST(CollapseMatching, LinkConditionPerKindOfSurface) {
   EdgeState s;
   test::run_to_admissible(ctx, m, p, 10, dm, c, s);
   const std::vector<int32_t> edges = c.edges.download_range(0, 2 * size_t(c.ne));
-  const std::vector<uint8_t> reason = s.edges2reason.download_range(0, c.ne), eflags = c.eflags.download_range(0, c.ne);
+  const std::vector<uint8_t> reason = s.result.edges2reason.download_range(0, c.ne), eflags = c.eflags.download_range(0, c.ne);
   int32_t e = -1;
   for (uint32_t i = 0; i < c.ne; ++i)
     if (edges[2 * i] == std::min(a, b) && edges[2 * i + 1] == std::max(a, b)) e = int32_t(i);
@@ -457,8 +458,8 @@ std::vector<std::pair<std::string, double>> guard_refusal_runs() {
 
 // The matching selection's iterations on `in` (target factor x its median edge length, in the
 // spatial order, as collapse() without the host tail); after each selection
-// guard(iteration, dm, c, s, p, chosen) runs the surface guard and its undos and returns the
-// collapses left. Returns the result.
+// guard(iteration, dm, c, s, matching, p, chosen) runs the surface guard and its undos and returns
+// the collapses left. Returns the result.
 template <class Guard>
 Mesh run_guarded_matching(Context& ctx, const Mesh& in, double factor, const Guard& guard) {
   CollapseOptions o;
@@ -469,14 +470,16 @@ Mesh run_guarded_matching(Context& ctx, const Mesh& in, double factor, const Gua
   upload_mesh(ctx, in, o, dm, &vertex_new);
   Connectivity c;
   EdgeState s;
+  MatchingState matching;
   DeviceBuffer<int32_t> origin(ctx, 1);
   for (int it = 0; it < 40; ++it) {
     build_connectivity(ctx, dm, c, p, &s);
     carry_verdicts(ctx, dm, c, s);
     cost_and_mark(ctx, dm, c, s, p);
-    matching_backup(ctx, dm, s);
+    matching_backup(ctx, dm, matching);
     uint32_t passed_q = 0, tested = 0;
-    const uint32_t chosen = guard(it, dm, c, s, p, matching_selection(ctx, dm, c, s, p, passed_q, tested));
+    const uint32_t chosen =
+        guard(it, dm, c, s, matching, p, matching_selection(ctx, dm, c, s, matching, p, passed_q, tested));
     if (chosen == 0) break;
     remember_for_carry(ctx, dm, c, s);
     collapse_and_compact(ctx, p, dm, next, c, s, origin, 0);
@@ -503,22 +506,23 @@ TEST(CollapseMatching, GuardAfterUndoTestsWhatTheUndoChanged) {
     const Mesh in = read_mesh(path);
     SurfaceGuard guard;
     const Mesh out = run_guarded_matching(ctx, in, factor, [&](int it, DeviceMesh& dm, Connectivity& c, EdgeState& s,
-                                                               const StageParams& p, uint32_t chosen) {
+                                                               MatchingState& matching, const StageParams& p,
+                                                               uint32_t chosen) {
       while (guard.run_applied(ctx, dm, c, s, p, chosen) > 0) {
-        chosen -= matching_undo(ctx, dm, c, s, guard);
+        chosen -= matching_undo(ctx, dm, c, s, matching, guard);
         ++undos;
         // a guard testing every query of the result, beside the restricted one the loop runs next
         SurfaceGuard full;
         full.each_pair_once = false;
         const uint32_t full_refused = full.run_applied(ctx, dm, c, s, p, chosen);
         full_queries += int(full.last_queries);
-        const std::vector<uint32_t> marked = s.edges_are_marked.download_range(0, c.ne);
+        const std::vector<uint32_t> marked = s.cost.edges_are_marked.download_range(0, c.ne);
         const uint32_t refused = guard.run_applied(ctx, dm, c, s, p, chosen);
         restricted_queries += int(guard.last_queries);
         EXPECT_EQ(refused, full_refused) << "iteration " << it;
-        EXPECT_EQ(s.edges_are_marked.download_range(0, c.ne), marked) << "iteration " << it;  // the same ones unmarked
+        EXPECT_EQ(s.cost.edges_are_marked.download_range(0, c.ne), marked) << "iteration " << it;  // the same ones unmarked
         if (refused == 0) break;
-        chosen -= matching_undo(ctx, dm, c, s, guard);
+        chosen -= matching_undo(ctx, dm, c, s, matching, guard);
       }
       return chosen;
     });
@@ -545,7 +549,8 @@ TEST(CollapseMatching, GuardTestsEachPairOnceWithTheSameRefusals) {
   for (const auto& [path, factor] : runs) {
     SCOPED_TRACE(path);
     run_guarded_matching(ctx, read_mesh(path), factor, [&](int it, DeviceMesh& dm, Connectivity& c, EdgeState& s,
-                                                          const StageParams& p, uint32_t chosen) {
+                                                          MatchingState& matching, const StageParams& p,
+                                                          uint32_t chosen) {
       // the refused edges of a guard's last run, flagged (SurfaceGuard::refused_edges)
       auto refused_flags = [&](SurfaceGuard& g) {
         DeviceBuffer<uint8_t> flag(ctx, std::max<size_t>(c.ne, 1));
@@ -568,7 +573,7 @@ TEST(CollapseMatching, GuardTestsEachPairOnceWithTheSameRefusals) {
         EXPECT_EQ(refused_flags(once), flags_every) << "iteration " << it;  // the same edges refused
         refusals += refused;
         if (refused == 0) return chosen;
-        chosen -= matching_undo(ctx, dm, c, s, once);
+        chosen -= matching_undo(ctx, dm, c, s, matching, once);
       }
     });
   }

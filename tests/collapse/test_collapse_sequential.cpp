@@ -47,9 +47,9 @@ DeviceVerdicts device_verdicts(Context& ctx, const Mesh& m, const CollapseOption
   admissible(ctx, dm, c, s, p);
   DeviceVerdicts d;
   d.edges = c.edges.download_range(0, 2 * size_t(c.ne));
-  d.marked = s.edges_are_marked.download_range(0, c.ne);
-  d.reason = s.edges2reason.download_range(0, c.ne);
-  d.dir = s.edges2dir.download_range(0, c.ne);
+  d.marked = s.cost.edges_are_marked.download_range(0, c.ne);
+  d.reason = s.result.edges2reason.download_range(0, c.ne);
+  d.dir = s.result.edges2dir.download_range(0, c.ne);
   d.vflags = c.vflags.download_range(0, dm.nv);
   d.vclass = c.vclass.download_range(0, dm.nv);
   d.eflags = c.eflags.download_range(0, c.ne);

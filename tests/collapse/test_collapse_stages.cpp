@@ -35,8 +35,8 @@ struct Staged {
     cost_and_mark(ctx, dm, c, s, p);
     admissible(ctx, dm, c, s, p);
     edges = c.edges.download_range(0, 2 * size_t(c.ne));
-    reason = s.edges2reason.download_range(0, c.ne);
-    dir = s.edges2dir.download_range(0, c.ne);
+    reason = s.result.edges2reason.download_range(0, c.ne);
+    dir = s.result.edges2dir.download_range(0, c.ne);
     for (uint32_t e = 0; e < c.ne; ++e) id[{edges[2 * e], edges[2 * e + 1]}] = int32_t(e);
   }
   int32_t edge(int32_t a, int32_t b) const {
@@ -320,12 +320,13 @@ std::pair<std::vector<uint32_t>, std::vector<uint32_t>> conflicts(Context& ctx, 
     adm[e] = 1;
     cost[e] = costs[i];
   }
-  st.s.edges_are_admissible.upload(adm);
-  st.s.edges2cost.upload(cost);
+  st.s.result.edges_are_admissible.upload(adm);
+  st.s.cost.edges2cost.upload(cost);
   conflict_pass1(ctx, st.dm, st.c, st.s);
-  std::vector<uint32_t> p1 = st.s.edges_pass1.download_range(0, st.c.ne);
-  conflict_pass2(ctx, st.dm, st.c, st.s);
-  std::vector<uint32_t> fin = st.s.edges_are_final.download_range(0, st.c.ne);
+  std::vector<uint32_t> p1 = st.s.result.edges_pass1.download_range(0, st.c.ne);
+  TwoPassState two_pass;
+  conflict_pass2(ctx, st.dm, st.c, st.s, two_pass);
+  std::vector<uint32_t> fin = st.s.result.edges_are_final.download_range(0, st.c.ne);
   std::vector<uint32_t> a, b;
   for (size_t i = 0; i < es.size(); ++i) {
     int32_t e = st.edge(es[i].first, es[i].second);
@@ -333,7 +334,7 @@ std::pair<std::vector<uint32_t>, std::vector<uint32_t>> conflicts(Context& ctx, 
     if (fin[e]) b.push_back(uint32_t(i));
   }
   // vaff holds exactly the end points of the final edges
-  std::vector<int32_t> vaff = st.s.verts2collapse.download_range(0, st.dm.nv);
+  std::vector<int32_t> vaff = st.s.result.verts2collapse.download_range(0, st.dm.nv);
   int marked = 0;
   for (int32_t x : vaff) marked += x >= 0;
   EXPECT_EQ(marked, int(2 * b.size()));
@@ -398,26 +399,27 @@ void expect_lazy_equals_full(Context& ctx, const Mesh& m, const CollapseOptions&
   DeviceMesh dm;
   Connectivity c;
   EdgeState full, lazy;
+  TwoPassState two_pass;
   upload_mesh(ctx, m, o, dm);
   build_connectivity(ctx, dm, c, p);
   const uint32_t marked = cost_and_mark(ctx, dm, c, full, p);
   const uint32_t n_adm = admissible(ctx, dm, c, full, p);
   const uint32_t n1 = conflict_pass1(ctx, dm, c, full);
-  const std::vector<int32_t> vaff_full = full.verts2collapse.download_range(0, dm.nv);
-  const uint32_t n2 = conflict_pass2(ctx, dm, c, full);
+  const std::vector<int32_t> vaff_full = full.result.verts2collapse.download_range(0, dm.nv);
+  const uint32_t n2 = conflict_pass2(ctx, dm, c, full, two_pass);
   EXPECT_EQ(cost_and_mark(ctx, dm, c, lazy, p), marked);
   uint32_t passed_q = 0, tested = 0;
   EXPECT_EQ(lazy_admissible_pass1(ctx, dm, c, lazy, p, passed_q, tested), n1);
-  const std::vector<uint8_t> reason = full.edges2reason.download_range(0, c.ne);
+  const std::vector<uint8_t> reason = full.result.edges2reason.download_range(0, c.ne);
   uint32_t q_ok = 0;
   for (uint8_t r : reason) q_ok += r != kNotMarked && r != kRefusedQ;
   EXPECT_EQ(passed_q, q_ok);
   EXPECT_LE(tested, passed_q);
   EXPECT_GE(tested, n1);
-  const std::vector<uint32_t> p1_full = full.edges_pass1.download_range(0, c.ne), p1_lazy = lazy.edges_pass1.download_range(0, c.ne);
+  const std::vector<uint32_t> p1_full = full.result.edges_pass1.download_range(0, c.ne), p1_lazy = lazy.result.edges_pass1.download_range(0, c.ne);
   EXPECT_EQ(p1_lazy, p1_full);
-  const std::vector<uint8_t> dir_full = full.edges2dir.download_range(0, c.ne), dir_lazy = lazy.edges2dir.download_range(0, c.ne);
-  const std::vector<uint8_t> reason_lazy = lazy.edges2reason.download_range(0, c.ne);
+  const std::vector<uint8_t> dir_full = full.result.edges2dir.download_range(0, c.ne), dir_lazy = lazy.result.edges2dir.download_range(0, c.ne);
+  const std::vector<uint8_t> reason_lazy = lazy.result.edges2reason.download_range(0, c.ne);
   int mismatched_dir = 0, mismatched_reason = 0;
   for (uint32_t e = 0; e < c.ne; ++e) {
     if (p1_full[e] && dir_full[e] != dir_lazy[e]) ++mismatched_dir;
@@ -426,9 +428,9 @@ void expect_lazy_equals_full(Context& ctx, const Mesh& m, const CollapseOptions&
   }
   EXPECT_EQ(mismatched_dir, 0);
   EXPECT_EQ(mismatched_reason, 0);
-  EXPECT_EQ(lazy.verts2collapse.download_range(0, dm.nv), vaff_full);
-  EXPECT_EQ(conflict_pass2(ctx, dm, c, lazy, loops.pass2), n2);
-  EXPECT_EQ(lazy.edges_are_final.download_range(0, c.ne), full.edges_are_final.download_range(0, c.ne));
+  EXPECT_EQ(lazy.result.verts2collapse.download_range(0, dm.nv), vaff_full);
+  EXPECT_EQ(conflict_pass2(ctx, dm, c, lazy, two_pass, loops.pass2), n2);
+  EXPECT_EQ(lazy.result.edges_are_final.download_range(0, c.ne), full.result.edges_are_final.download_range(0, c.ne));
   std::printf("marked %u, passed Q %u, admissible %u, tested lazily %u, pass 1 %u, pass 2 %u\n", marked, passed_q,
               n_adm, tested, n1, n2);
   EXPECT_GT(n1, 0u);
@@ -496,7 +498,7 @@ TEST(CollapseCost, UserCostFromOpenCLSource) {
   o.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) {\n"
                      "  return 0.5 * (p0.z + p1.z) + f0 + f1;\n}\n";
   Staged st(ctx, m, o, 0.4);
-  std::vector<uint32_t> marked = st.s.edges_are_marked.download_range(0, st.c.ne);
+  std::vector<uint32_t> marked = st.s.cost.edges_are_marked.download_range(0, st.c.ne);
   int expected_count = 0;
   for (uint32_t e = 0; e < st.c.ne; ++e) {
     int32_t a = st.edges[2 * e], b = st.edges[2 * e + 1];
