@@ -134,6 +134,43 @@ TC_FN double tc_tet_quality(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3) {
   return tc_tet_quality_v(p0, p1, p2, p3, tc_tet_volume(p0, p1, p2, p3));
 }
 
+/* Smallest sine of the six interior dihedral angles, signed by the volume: 1 at most, small for
+ * a tet with a dihedral angle near 0 or 180 degrees, negative when inverted. The improvement's
+ * measure (Klingner and Shewchuk's "minimum sine"): it penalises both kinds of sliver, and the
+ * sine of the angle at edge (i, j) is 3 V |e_ij| / (2 A_k A_l) with A_k, A_l the two faces
+ * through the edge, so no arc cosine is taken. */
+TC_FN double tc_tet_min_sine(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3) {
+  double v = tc_tet_volume(p0, p1, p2, p3);
+  /* twice the areas of the faces opposite each vertex */
+  double a0 = length(cross(p2 - p1, p3 - p1)), a1 = length(cross(p2 - p0, p3 - p0));
+  double a2 = length(cross(p1 - p0, p3 - p0)), a3 = length(cross(p1 - p0, p2 - p0));
+  if (a0 <= 0.0 || a1 <= 0.0 || a2 <= 0.0 || a3 <= 0.0) return 0.0;
+  /* edge (i, j) lies on the faces opposite the other two vertices; with doubled areas the
+   * sine is 6 V |e| / (a_k a_l) */
+  double s = length(p1 - p0) / (a2 * a3), t;
+  t = length(p2 - p0) / (a1 * a3); s = t < s ? t : s;
+  t = length(p3 - p0) / (a1 * a2); s = t < s ? t : s;
+  t = length(p2 - p1) / (a0 * a3); s = t < s ? t : s;
+  t = length(p3 - p1) / (a0 * a2); s = t < s ? t : s;
+  t = length(p3 - p2) / (a0 * a1); s = t < s ? t : s;
+  return 6.0 * v * s;
+}
+
+/* Cosine of the smallest interior dihedral angle (the largest cosine of the six): the angle at
+ * edge (i, j) is pi minus the angle between the outward normals of the two faces through it. */
+TC_FN double tc_tet_max_dihedral_cos(tc_d3 p0, tc_d3 p1, tc_d3 p2, tc_d3 p3) {
+  /* outward normals of the faces opposite each vertex (TC_TET_FACES order) */
+  tc_d3 n0 = normalize(cross(p2 - p1, p3 - p1)), n1 = normalize(cross(p3 - p0, p2 - p0));
+  tc_d3 n2 = normalize(cross(p1 - p0, p3 - p0)), n3 = normalize(cross(p2 - p0, p1 - p0));
+  double c = -dot(n2, n3), t;
+  t = -dot(n1, n3); c = t > c ? t : c;
+  t = -dot(n1, n2); c = t > c ? t : c;
+  t = -dot(n0, n3); c = t > c ? t : c;
+  t = -dot(n0, n2); c = t > c ? t : c;
+  t = -dot(n0, n1); c = t > c ? t : c;
+  return c;
+}
+
 #ifndef __OPENCL_C_VERSION__
 }  // namespace tc::geo
 #endif

@@ -1,0 +1,195 @@
+// Topological improvement: edge removal (n tets around an interior edge -> 2n - 4; n = 3 is the
+// 3-2 flip) and the 2-3 flip (Shewchuk, "Two discrete optimization algorithms for the
+// topological improvement of tetrahedral meshes"; Klingner and Shewchuk 2007). Only faces
+// inside one label are removed, so the boundary and the interfaces stay as they are.
+#include <algorithm>
+#include <limits>
+
+#include "improve/improve_mesh.hpp"
+
+namespace tc::improve_detail {
+
+namespace {
+
+constexpr int kMaxRing = 7;  // Shewchuk: larger rings rarely give a better triangulation
+
+// The two vertices of q other than a and b, ordered so that (a, b, c, d) is an even
+// permutation of q, i.e. has q's (positive) orientation.
+void others(const Tet& q, int32_t a, int32_t b, int32_t& c, int32_t& d) {
+  int pos[4], n = 0, ia = -1, ib = -1;
+  for (int k = 0; k < 4; ++k) {
+    if (q[k] == a) ia = k;
+    else if (q[k] == b) ib = k;
+    else pos[n++] = k;
+  }
+  int perm[4] = {ia, ib, pos[0], pos[1]};
+  int inversions = 0;
+  for (int i = 0; i < 4; ++i)
+    for (int j = i + 1; j < 4; ++j) inversions += perm[i] > perm[j];
+  c = q[pos[0]];
+  d = q[pos[1]];
+  if (inversions & 1) std::swap(c, d);
+}
+
+}  // namespace
+
+// The ring of the edge (a, b): r[0..n) with (a, b, r[i], r[i+1]) the tets around it. Only a
+// closed ring of tets of one label qualifies: then no boundary or interface face contains the
+// edge, and the faces the operation keeps (a r_i r_i+1, b r_i r_i+1) are exactly the ring's
+// outside. The new tets pair each triangle (r_i, r_j, r_k), i < j < k, of a triangulation of
+// the ring with a and with b: (r_i, r_j, r_k, b) and (r_k, r_j, r_i, a) are then positive.
+bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b) {
+  if (m.tagged_edge(a, b) || !m.selected(a) || !m.selected(b)) return false;
+  std::vector<int32_t> ring_tets;
+  for (int32_t t : m.tets_of(a)) {
+    const Tet& q = m.tet(t);
+    if (q[0] == b || q[1] == b || q[2] == b || q[3] == b) ring_tets.push_back(t);
+  }
+  const int n = int(ring_tets.size());
+  if (n < 3 || n > kMaxRing) return false;
+  int32_t from[kMaxRing] = {}, to[kMaxRing] = {};
+  double old_min = std::numeric_limits<double>::infinity(), old_cos = -1;
+  for (int i = 0; i < n; ++i) {
+    if (m.label(ring_tets[size_t(i)]) != m.label(ring_tets[0])) return false;
+    others(m.tet(ring_tets[size_t(i)]), a, b, from[i], to[i]);
+    old_min = std::min(old_min, m.quality(ring_tets[size_t(i)]));
+    old_cos = std::max(old_cos, m.max_cos(ring_tets[size_t(i)]));
+  }
+  int32_t r[kMaxRing] = {};
+  r[0] = from[0];
+  for (int i = 1; i < n; ++i) {
+    const int32_t prev = r[i - 1];
+    int j = 0;
+    while (j < n && from[j] != prev) ++j;
+    if (j == n) return false;  // an open ring: the edge is on the boundary
+    r[i] = to[j];
+    for (int k = 0; k < i; ++k)
+      if (r[k] == r[i]) return false;  // a shorter cycle: not a simple ring
+  }
+  {
+    int j = 0;
+    while (j < n && from[j] != r[n - 1]) ++j;
+    if (j == n || to[j] != r[0]) return false;
+  }
+  for (int i = 0; i < n; ++i)  // a face of the old tets that the input tags must stay
+    if (m.tagged_face(a, b, r[i]) || !m.selected(r[i])) return false;
+
+  // Klincsek's dynamic programme: best[i][j] is the best worst quality of a triangulation of
+  // the sub-polygon r_i..r_j; a chord that is already an edge of the mesh is not allowed.
+  const double kNone = -std::numeric_limits<double>::infinity();
+  double best[kMaxRing][kMaxRing];
+  int split[kMaxRing][kMaxRing];
+  auto chord_ok = [&](int i, int j) {
+    return j - i == 1 || (i == 0 && j == n - 1) || !m.has_edge(r[i], r[j]);
+  };
+  auto triangle = [&](int i, int j, int k) {
+    if (m.tagged_face(r[i], r[j], r[k]) || m.has_face(r[i], r[j], r[k])) return kNone;
+    return std::min(m.quality_of({r[i], r[j], r[k], b}), m.quality_of({r[k], r[j], r[i], a}));
+  };
+  for (int len = 1; len < n; ++len)
+    for (int i = 0; i + len < n; ++i) {
+      const int j = i + len;
+      split[i][j] = -1;
+      if (len == 1) {
+        best[i][j] = std::numeric_limits<double>::infinity();
+        continue;
+      }
+      best[i][j] = kNone;
+      if (!chord_ok(i, j)) continue;
+      for (int k = i + 1; k < j; ++k) {
+        const double q = std::min({best[i][k], best[k][j], triangle(i, k, j)});
+        if (q > best[i][j]) {
+          best[i][j] = q;
+          split[i][j] = k;
+        }
+      }
+    }
+  if (!(best[0][n - 1] > old_min) || split[0][n - 1] < 0) return false;
+  std::vector<Tet> added;
+  int stack[2 * kMaxRing][2], top = 0;
+  stack[top][0] = 0;
+  stack[top++][1] = n - 1;
+  while (top > 0) {
+    --top;
+    const int i = stack[top][0], j = stack[top][1];
+    if (j - i < 2) continue;
+    const int k = split[i][j];
+    added.push_back({r[i], r[k], r[j], b});
+    added.push_back({r[j], r[k], r[i], a});
+    stack[top][0] = i;
+    stack[top++][1] = k;
+    stack[top][0] = k;
+    stack[top++][1] = j;
+  }
+  double new_cos = -1;
+  for (const Tet& q : added) new_cos = std::max(new_cos, m.max_cos_of(q));
+  if (!m.improves(old_min, old_cos, best[0][n - 1], new_cos)) return false;
+  m.replace(ring_tets, added, ring_tets[0]);
+  return true;
+}
+
+// The 2-3 flip: tets t = (face u v w, apex p) and its neighbour o across that face (apex q)
+// become three tets around the new edge (p, q).
+bool try_flip23(ImpMesh& m, int32_t t, int face) {
+  const Tet& qt = m.tet(t);
+  const int32_t p = qt[face];
+  // TC_TET_FACES is oriented away from the opposite vertex: q lies on its positive side.
+  const int32_t u = qt[geo::TC_TET_FACES[face][0]], v = qt[geo::TC_TET_FACES[face][1]],
+                w = qt[geo::TC_TET_FACES[face][2]];
+  if (m.tagged_face(u, v, w)) return false;
+  int32_t o = -1, q = -1;
+  for (int32_t s : m.tets_of(u)) {
+    if (s == t) continue;
+    const Tet& qs = m.tet(s);
+    int hits = 0;
+    int32_t apex = -1;
+    for (int32_t x : qs) {
+      if (x == v || x == w || x == u) ++hits;
+      else apex = x;
+    }
+    if (hits == 3) {
+      o = s;
+      q = apex;
+      break;
+    }
+  }
+  if (o < 0 || m.label(o) != m.label(t) || m.has_edge(p, q)) return false;
+  if (!m.selected(p) || !m.selected(q) || !m.selected(u) || !m.selected(v) || !m.selected(w)) return false;
+  const std::vector<Tet> added = {{p, q, u, v}, {p, q, v, w}, {p, q, w, u}};
+  double new_min = std::numeric_limits<double>::infinity(), new_cos = -1;
+  for (const Tet& a : added) {
+    new_min = std::min(new_min, m.quality_of(a));
+    new_cos = std::max(new_cos, m.max_cos_of(a));
+  }
+  if (!m.improves(std::min(m.quality(t), m.quality(o)), std::max(m.max_cos(t), m.max_cos(o)), new_min, new_cos))
+    return false;
+  m.replace({t, o}, added, t);
+  return true;
+}
+
+void flip_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& stats) {
+  for (int32_t t : bad) {
+    if (!m.alive(t)) continue;
+    const Tet q = m.tet(t);
+    // Where every operation failed before and nothing changed since, they fail again.
+    if (m.settled(m.flip_failed_at, q[0]) && m.settled(m.flip_failed_at, q[1]) &&
+        m.settled(m.flip_failed_at, q[2]) && m.settled(m.flip_failed_at, q[3]))
+      continue;
+    bool done = false;
+    // The edges first: removing an edge takes the sliver with it whichever way it is bad.
+    for (int e = 0; e < 6 && !done; ++e)
+      if (try_edge_removal(m, q[geo::TC_TET_EDGES[e][0]], q[geo::TC_TET_EDGES[e][1]])) {
+        ++stats.edge_removals;
+        done = true;
+      }
+    for (int f = 0; f < 4 && !done; ++f)
+      if (try_flip23(m, t, f)) {
+        ++stats.flips23;
+        done = true;
+      }
+    if (!done)
+      for (int32_t v : q) m.failed(m.flip_failed_at, v);
+  }
+}
+
+}  // namespace tc::improve_detail

@@ -1,0 +1,190 @@
+// The improvement's driver: the algorithm of tetcollapse/improve.hpp.
+#include "tetcollapse/improve.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "improve/improve_mesh.hpp"
+#include "stopwatch.hpp"
+
+namespace tc {
+
+using namespace improve_detail;
+
+namespace {
+
+constexpr double kDeg = 180.0 / 3.14159265358979323846;
+constexpr double kMinAngleGain = 0.05;  // degrees
+constexpr double kMinCountGain = 0.02;  // share of the tets below 10 or 13 degrees
+
+// The live tets below the threshold, worst first (ties by index: deterministic).
+std::vector<int32_t> bad_tets(const ImpMesh& m, double threshold) {
+  std::vector<int32_t> bad;
+  for (int32_t t = 0; t < m.num_tet_slots(); ++t)
+    if (m.alive(t) && m.quality(t) < threshold) bad.push_back(t);
+  std::sort(bad.begin(), bad.end(), [&](int32_t a, int32_t b) {
+    return m.quality(a) < m.quality(b) || (m.quality(a) == m.quality(b) && a < b);
+  });
+  return bad;
+}
+
+// The smallest dihedral angle and the tets below 10 and 13 degrees, from the kept cosines.
+void measure(const ImpMesh& m, ImprovePassStats& s) {
+  const double c10 = std::cos(10 / kDeg), c13 = std::cos(13 / kDeg);
+  double c = -1;
+  for (int32_t t = 0; t < m.num_tet_slots(); ++t)
+    if (m.alive(t)) {
+      c = std::max(c, m.max_cos(t));
+      s.below_10_deg += m.max_cos(t) > c10;
+      s.below_13_deg += m.max_cos(t) > c13;
+    }
+  s.min_dihedral_deg = std::acos(std::min(1.0, c)) * kDeg;
+}
+
+int64_t pinned_below_13(const ImpMesh& m) {
+  const double c13 = std::cos(13 / kDeg);
+  int64_t n = 0;
+  for (int32_t t = 0; t < m.num_tet_slots(); ++t) {
+    if (!m.alive(t) || m.max_cos(t) <= c13) continue;
+    const Tet& q = m.tet(t);
+    n += m.motion(q[0]) == kFixed && m.motion(q[1]) == kFixed && m.motion(q[2]) == kFixed && m.motion(q[3]) == kFixed;
+  }
+  return n;
+}
+
+}  // namespace
+
+QualitySummary quality_summary(const Mesh& mesh) {
+  QualitySummary s;
+  s.tets = mesh.num_tets();
+  if (s.tets == 0) return s;
+  std::vector<double> mins(size_t(s.tets));
+  for (int64_t t = 0; t < s.tets; ++t) {
+    geo::tc_d3 p[4];
+    for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(mesh.points.data(), mesh.tets[size_t(4 * t + k)]);
+    const double d = geo::tc_min_dihedral(p[0], p[1], p[2], p[3]) * kDeg;
+    mins[size_t(t)] = d;
+    s.below_10_deg += d < 10;
+    s.below_13_deg += d < 13;
+  }
+  s.min_dihedral_deg = *std::min_element(mins.begin(), mins.end());
+  std::nth_element(mins.begin(), mins.begin() + ptrdiff_t(mins.size() / 2), mins.end());
+  s.median_dihedral_deg = mins[mins.size() / 2];
+  return s;
+}
+
+namespace {
+
+// Passes of flips and relocation on `mesh` until they stall; appends them to the report.
+void passes(Mesh& mesh, const ImproveOptions& options, int max_passes, ImproveReport& report, bool first) {
+  ImpMesh m(mesh, options);
+  if (first) report.pinned_below_13_before = pinned_below_13(m);
+  const double threshold = std::sin(options.threshold_deg / kDeg);
+  for (int it = 0; it < max_passes; ++it) {
+    const Stopwatch pass_clock;
+    ImprovePassStats stats;
+    stats.iteration = int(report.passes.size());
+    const std::vector<int32_t> bad = bad_tets(m, threshold);
+    stats.bad_tets = int64_t(bad.size());
+    if (options.flips) flip_pass(m, bad, stats);
+    if (options.smoothing) smooth_pass(m, bad_tets(m, threshold), stats);
+    measure(m, stats);
+    stats.seconds = pass_clock.peek();
+    report.passes.push_back(stats);
+    if (options.progress) options.progress(stats);
+    if (stats.edge_removals + stats.flips23 + stats.relocated == 0) break;
+    // Later passes make ever smaller gains on the same vertices: stop once a pass leaves the
+    // worst angle and the counts below 10 and 13 degrees (nearly) as they were.
+    if (it > 0) {
+      const ImprovePassStats& prev = report.passes[report.passes.size() - 2];
+      if (stats.min_dihedral_deg < prev.min_dihedral_deg + kMinAngleGain &&
+          stats.below_10_deg > prev.below_10_deg * (1 - kMinCountGain) &&
+          stats.below_13_deg > prev.below_13_deg * (1 - kMinCountGain))
+        break;
+    }
+  }
+  report.pinned_below_13_after = pinned_below_13(m);
+  m.write_back();
+}
+
+double median_edge_length_of(const Mesh& mesh) {
+  std::vector<double> l;
+  l.reserve(size_t(mesh.num_tets()) * 6);
+  for (int64_t t = 0; t < mesh.num_tets(); ++t)
+    for (const auto& e : geo::TC_TET_EDGES) {
+      const auto a = geo::tc_point(mesh.points.data(), mesh.tets[size_t(4 * t + e[0])]);
+      const auto b = geo::tc_point(mesh.points.data(), mesh.tets[size_t(4 * t + e[1])]);
+      l.push_back(geo::length(b - a));
+    }
+  if (l.empty()) return 0;
+  std::nth_element(l.begin(), l.begin() + ptrdiff_t(l.size() / 2), l.end());
+  return l[l.size() / 2];
+}
+
+// The collapse step: edges between vertices of tets below 13 degrees.
+int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options) {
+  const double c13 = std::cos(13 / kDeg);
+  std::vector<uint8_t> mask(size_t(mesh.num_vertices()), 0);
+  int64_t bad = 0;
+  for (int64_t t = 0; t < mesh.num_tets(); ++t) {
+    geo::tc_d3 p[4];
+    for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(mesh.points.data(), mesh.tets[size_t(4 * t + k)]);
+    if (geo::tc_tet_max_dihedral_cos(p[0], p[1], p[2], p[3]) <= c13) continue;
+    ++bad;
+    for (int k = 0; k < 4; ++k) mask[size_t(mesh.tets[size_t(4 * t + k)])] = 1;
+  }
+
+  if (bad == 0) return 0;
+  CollapseOptions o;
+  o.method = CollapseOptions::Sequential;
+  o.boundary = options.boundary;
+  o.eps_f = options.eps_f;
+  o.eps_r = options.eps_r;
+  o.use_labels = options.use_labels;
+  o.min_quality = 1;  // the guard at its strictest: never below the worst quality before
+  o.target_length = options.collapse_length > 0 ? options.collapse_length : 1.5 * median_edge_length_of(mesh);
+  o.vertex_mask = std::move(mask);
+  int64_t collapsed = 0;
+  for (const IterationStats& it : collapse_sequential(mesh, o).iterations) collapsed += it.collapsed;
+  return collapsed;
+}
+
+}  // namespace
+
+ImproveReport improve(Mesh& mesh, const ImproveOptions& options) {
+  const Stopwatch clock;
+  ImproveReport report;
+  report.before = quality_summary(mesh);
+  passes(mesh, options, options.max_iterations, report, true);
+  // (With a vertex mask the step does not run: the collapse renumbers the vertices.)
+  if (options.collapse && options.vertex_mask.empty() && int(report.passes.size()) < options.max_iterations) {
+    const Stopwatch step;
+    ImprovePassStats stats;
+    stats.iteration = int(report.passes.size());
+    // The collapse's guard measures the mean ratio, not the dihedral angles: the step is kept
+    // only if it left the smallest angle and the counts below 10 and 13 degrees no worse.
+    const QualitySummary q0 = quality_summary(mesh);
+    Mesh kept = mesh;
+    stats.collapsed = collapse_bad(mesh, options);
+    const QualitySummary q = quality_summary(mesh);
+    if (q.min_dihedral_deg < q0.min_dihedral_deg || q.below_10_deg > q0.below_10_deg ||
+        q.below_13_deg > q0.below_13_deg) {
+      mesh = std::move(kept);
+      stats.collapsed = 0;
+    }
+    if (stats.collapsed > 0) {
+      stats.min_dihedral_deg = q.min_dihedral_deg;
+      stats.below_10_deg = q.below_10_deg;
+      stats.below_13_deg = q.below_13_deg;
+      stats.seconds = step.peek();
+      report.passes.push_back(stats);
+      if (options.progress) options.progress(stats);
+      passes(mesh, options, options.max_iterations - int(report.passes.size()), report, false);
+    }
+  }
+  report.after = quality_summary(mesh);
+  report.seconds_total = clock.peek();
+  return report;
+}
+
+}  // namespace tc

@@ -1,0 +1,116 @@
+// The mesh the improvement edits: tets with a dead flag and free slots, each vertex's tets,
+// each tet's quality, and what may change (which vertices move and how, which faces and edges
+// the input tags).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <unordered_set>
+#include <vector>
+
+#include "geometry.h"
+#include "tetcollapse/improve.hpp"
+#include "tetcollapse/mesh.hpp"
+
+namespace tc::improve_detail {
+
+using geo::tc_d3;
+using Tet = std::array<int32_t, 4>;
+
+enum Motion : uint8_t { kFixed = 0, kFree = 1, kInPlane = 2 };
+
+class ImpMesh {
+ public:
+  // Reads `mesh`; positions are edited in mesh.points directly.
+  ImpMesh(Mesh& mesh, const ImproveOptions& options);
+  // Writes the live tets (and their labels and tet fields) back to the mesh.
+  void write_back();
+
+  tc_d3 point(int32_t v) const { return geo::tc_point(points_.data(), v); }
+  // Moves v to p, a point inside its star, with its vertex field values interpolated there.
+  void move(int32_t v, tc_d3 p);
+  bool selected(int32_t v) const { return mask_.empty() || mask_[size_t(v)] != 0; }
+  const Tet& tet(int32_t t) const { return tets_[size_t(t)]; }
+  bool alive(int32_t t) const { return !dead_[size_t(t)]; }
+  int32_t num_tet_slots() const { return int32_t(tets_.size()); }
+  int32_t num_vertices() const { return int32_t(vtets_.size()); }
+  const std::vector<int32_t>& tets_of(int32_t v) const { return vtets_[size_t(v)]; }
+  double quality(int32_t t) const { return quality_[size_t(t)]; }
+  int32_t label(int32_t t) const { return label_[size_t(t)]; }
+  Motion motion(int32_t v) const { return Motion(motion_[size_t(v)]); }
+  tc_d3 plane_normal(int32_t v) const { return normal_[size_t(v)]; }
+
+  // Quality of tet t with vertex v at p (v need not be in t).
+  double quality_with(int32_t t, int32_t v, tc_d3 p) const;
+  double quality_of(const Tet& q) const {
+    return geo::tc_tet_min_sine(point(q[0]), point(q[1]), point(q[2]), point(q[3]));
+  }
+
+  bool has_edge(int32_t a, int32_t b) const;
+  bool has_face(int32_t a, int32_t b, int32_t c) const;
+  bool tagged_edge(int32_t a, int32_t b) const { return tagged_edges_.count(key2(a, b)) != 0; }
+  bool tagged_face(int32_t a, int32_t b, int32_t c) const { return tagged_faces_.count(key3(a, b, c)) != 0; }
+
+  // Replaces the tets `old` by `added` (label and tet fields of `like`).
+  void replace(const std::vector<int32_t>& old, const std::vector<Tet>& added, int32_t like);
+
+  // Change tracking, so that a pass retries an operation that found nothing only where the
+  // mesh changed since: every change stamps the vertices whose stars it altered.
+  // A vertex is `settled` for an operation when the operation found nothing there and nothing
+  // changed around it since.
+  uint32_t stamp() const { return stamp_; }
+  bool settled(const std::vector<uint32_t>& failed_at, int32_t v) const {
+    return failed_at[size_t(v)] >= changed_[size_t(v)];
+  }
+  void failed(std::vector<uint32_t>& failed_at, int32_t v) const { failed_at[size_t(v)] = stamp_; }
+  std::vector<uint32_t> smooth_failed_at, flip_failed_at;  // per vertex
+
+  // Whether replacing tets of qualities (sine, cos) by (new_sine, new_cos) improves: the worst
+  // min-sine rises and the smallest dihedral angle does not fall below min(before, threshold).
+  bool improves(double sine, double cos, double new_sine, double new_cos) const {
+    return new_sine > sine && new_cos <= std::max(cos, cos_threshold_);
+  }
+  // The quality measure's second half: the smallest dihedral angle must not fall below
+  // min(its value before, the threshold) (as a cosine: not rise above max(before, cos threshold)).
+  double max_cos(int32_t t) const { return max_cos_[size_t(t)]; }
+  double max_cos_of(const Tet& q) const {
+    return geo::tc_tet_max_dihedral_cos(point(q[0]), point(q[1]), point(q[2]), point(q[3]));
+  }
+  double max_cos_with(int32_t t, int32_t v, tc_d3 p) const;
+  double cos_threshold() const { return cos_threshold_; }
+
+ private:
+  static uint64_t key2(int32_t a, int32_t b);
+  static uint64_t key3(int32_t a, int32_t b, int32_t c);
+  void mark_motion(const ImproveOptions& options);
+  void touch_star(int32_t v);
+
+  Mesh& mesh_;
+  std::vector<double>& points_;
+  std::vector<Tet> tets_;
+  std::vector<int32_t> label_;   // per tet: which tuple of the input's label values it carries
+  std::vector<int32_t> origin_;  // per tet: the input tet whose labels and tet fields it takes
+  std::vector<uint8_t> dead_;
+  std::vector<int32_t> free_;
+  std::vector<double> quality_, max_cos_;
+  std::vector<uint32_t> changed_;
+  uint32_t stamp_ = 1;
+  double cos_threshold_ = 1;
+  std::vector<std::vector<int32_t>> vtets_;
+  std::vector<uint8_t> motion_, mask_;
+  std::vector<tc_d3> normal_;
+  std::unordered_set<uint64_t> tagged_edges_, tagged_faces_;
+};
+
+// One topological pass over the bad tets (worst first); returns the counts in `stats`.
+void flip_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& stats);
+// One smoothing pass over the vertices of the bad tets.
+void smooth_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& stats);
+
+// The operations alone (tests): each returns whether it changed the mesh.
+bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b);
+bool try_flip23(ImpMesh& m, int32_t t, int face);
+bool try_smooth(ImpMesh& m, int32_t v);
+
+}  // namespace tc::improve_detail

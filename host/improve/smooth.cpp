@@ -1,0 +1,129 @@
+// Vertex relocation: a vertex moves to raise the worst quality of its star. The objective (the
+// smallest min-sine of the star) is not smooth, so each step follows the gradient of the worst
+// tet, or the mean of the gradients of the nearly worst ones, with a halving line search that
+// accepts only a rise of the worst (after Freitag and Ollivier-Gooch's non-smooth smoothing, in
+// its simplest form). The gradients are taken numerically: the measure is cheap and a star has
+// a few dozen tets.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "improve/improve_mesh.hpp"
+
+namespace tc::improve_detail {
+
+namespace {
+
+constexpr int kSteps = 4;         // ascent steps per vertex and pass
+constexpr int kHalvings = 8;      // line search
+constexpr double kNearlyWorst = 1e-3;
+// A relocation that raises the star's worst min-sine by less is not made: such gains do not
+// change what a user measures, and a vertex making them would be retried every pass.
+constexpr double kMinGain = 1e-3;
+
+// The worst quality of the star with v at p, or any value <= bound once one tet is that bad:
+// most trial positions fail, and the worst tets come first in `star`.
+double star_min(const ImpMesh& m, const std::vector<int32_t>& star, int32_t v, tc_d3 p, double bound) {
+  double q = std::numeric_limits<double>::infinity();
+  for (int32_t t : star) {
+    q = std::min(q, m.quality_with(t, v, p));
+    if (q <= bound) break;
+  }
+  return q;
+}
+
+double star_max_cos(const ImpMesh& m, int32_t v, tc_d3 p) {
+  double c = -1;
+  for (int32_t t : m.tets_of(v)) c = std::max(c, m.max_cos_with(t, v, p));
+  return c;
+}
+
+tc_d3 gradient(const ImpMesh& m, int32_t t, int32_t v, tc_d3 p, double h) {
+  const tc_d3 ex{h, 0, 0}, ey{0, h, 0}, ez{0, 0, h};
+  return tc_d3{m.quality_with(t, v, p + ex) - m.quality_with(t, v, p - ex),
+               m.quality_with(t, v, p + ey) - m.quality_with(t, v, p - ey),
+               m.quality_with(t, v, p + ez) - m.quality_with(t, v, p - ez)} /
+         (2 * h);
+}
+
+}  // namespace
+
+bool try_smooth(ImpMesh& m, int32_t v) {
+  const Motion motion = m.motion(v);
+  if (motion == kFixed || m.tets_of(v).empty()) return false;
+  const tc_d3 n = m.plane_normal(v);
+  auto allowed = [&](tc_d3 d) { return motion == kInPlane ? d - n * geo::dot(d, n) : d; };
+  tc_d3 p = m.point(v);
+  // The scale of the star: its mean edge length at v.
+  double scale = 0;
+  int count = 0;
+  for (int32_t t : m.tets_of(v))
+    for (int32_t x : m.tet(t))
+      if (x != v) {
+        scale += geo::length(m.point(x) - p);
+        ++count;
+      }
+  scale /= count;
+  const double h = 1e-7 * scale;
+  std::vector<int32_t> star = m.tets_of(v);
+  std::sort(star.begin(), star.end(), [&](int32_t a, int32_t b) { return m.quality(a) < m.quality(b); });
+  const double inf = std::numeric_limits<double>::infinity();
+  double current = star_min(m, star, v, p, -inf), current_cos = star_max_cos(m, v, p);
+  const double start = current;
+  bool moved = false;
+  for (int step = 0; step < kSteps; ++step) {
+    double worst = std::numeric_limits<double>::infinity();
+    int32_t worst_tet = -1;
+    for (int32_t t : m.tets_of(v)) {
+      const double q = m.quality_with(t, v, p);
+      if (q < worst) {
+        worst = q;
+        worst_tet = t;
+      }
+    }
+    tc_d3 directions[2] = {allowed(gradient(m, worst_tet, v, p, h)), {0, 0, 0}};
+    for (int32_t t : m.tets_of(v))
+      if (m.quality_with(t, v, p) <= worst + kNearlyWorst)
+        directions[1] = directions[1] + geo::normalize(allowed(gradient(m, t, v, p, h)));
+    bool improved = false;
+    for (tc_d3 d : directions) {
+      const double len = geo::length(d);
+      if (!(len > 0)) continue;
+      d = d / len;
+      for (double s = 0.25 * scale, k = 0; k < kHalvings && !improved; ++k, s *= 0.5) {
+        const tc_d3 candidate = p + d * s;
+        const double q = star_min(m, star, v, candidate, current);
+        if (!(q > current)) continue;
+        const double c = star_max_cos(m, v, candidate);
+        if (m.improves(current, current_cos, q, c)) {
+          p = candidate;
+          current = q;
+          current_cos = c;
+          improved = true;
+        }
+      }
+      if (improved) break;
+    }
+    if (!improved) break;
+    moved = true;
+  }
+  if (!moved || current < start + kMinGain) return false;
+  m.move(v, p);
+  return true;
+}
+
+void smooth_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& stats) {
+  std::vector<int32_t> verts;
+  for (int32_t t : bad)
+    if (m.alive(t))
+      for (int32_t v : m.tet(t)) verts.push_back(v);
+  std::sort(verts.begin(), verts.end());
+  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+  for (int32_t v : verts) {
+    if (m.settled(m.smooth_failed_at, v)) continue;  // it found nothing and nothing changed since
+    if (try_smooth(m, v)) ++stats.relocated;
+    else m.failed(m.smooth_failed_at, v);
+  }
+}
+
+}  // namespace tc::improve_detail

@@ -1,0 +1,98 @@
+// Mesh improvement: raise the worst element quality of a tetrahedral mesh without changing
+// its boundary beyond what the boundary mode allows (the paper's Section 4.6, after Klingner
+// and Shewchuk's Stellar).
+//
+//   improve(mesh):
+//     q(t) = smallest sine of t's six dihedral angles (tc_tet_min_sine; < 0 when inverted)
+//     repeat up to max_iterations times:
+//       bad = tets with q < sin(threshold_deg), worst first
+//       for t in bad:                     -- topological pass
+//         edge removal on t's edges       (n tets around an interior edge -> 2n - 4, n <= 7:
+//                                          the 3-2 flip and Shewchuk's generalisation, the
+//                                          best triangulation of the edge's ring by Klincsek's
+//                                          dynamic programme)
+//         else a 2-3 flip on t's faces
+//         accepted only if the worst q of the changed tets rises
+//       for v in vertices of bad tets:    -- smoothing pass
+//         move v to raise the worst q of its star (ascent along the worst tets' gradients
+//         with a line search; a Face vertex of a flat boundary patch moves within its plane;
+//         other boundary vertices do not move)
+//       stop when nothing changed, or when a pass left the smallest dihedral angle and the
+//       counts of tets below 10 and 13 degrees as they were
+//     collapse short edges between vertices of the tets still below 13 degrees, each only when
+//     it does not lower the worst quality of what it reshapes; then the passes above again
+//
+// The worst quality of the mesh never falls: each operation is accepted only when the worst
+// quality of what it changes rises. Flips change interior faces of one label only, so the
+// boundary, the material interfaces, tagged triangles and vertex numbering are kept; in strict
+// mode no boundary vertex moves, so the boundary stays bit for bit.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/mesh.hpp"
+
+namespace tc {
+
+// What a user reads of a mesh's quality (dihedral angles in degrees).
+struct QualitySummary {
+  int64_t tets = 0;
+  double min_dihedral_deg = 0;     // smallest dihedral angle of the mesh
+  double median_dihedral_deg = 0;  // median of the tets' smallest dihedral angles
+  int64_t below_10_deg = 0, below_13_deg = 0;  // tets with a dihedral angle below
+};
+QualitySummary quality_summary(const Mesh& mesh);
+
+struct ImprovePassStats {
+  int iteration = 0;
+  int64_t edge_removals = 0;  // n -> 2n - 4 (n = 3: the 3-2 flip)
+  int64_t flips23 = 0;
+  int64_t relocated = 0;      // vertices moved
+  int64_t collapsed = 0;      // edges collapsed (the collapse step, between two series of passes)
+  int64_t bad_tets = 0;       // tets below the threshold at the start of the pass
+  double min_dihedral_deg = 0;  // after the pass
+  int64_t below_10_deg = 0, below_13_deg = 0;
+  double seconds = 0;
+};
+
+struct ImproveReport {
+  QualitySummary before, after;
+  // Tets below 13 degrees whose four vertices may not move (boundary mode, corners, ridges,
+  // curved faces): only a flip of an interior edge or face can remove them.
+  int64_t pinned_below_13_before = 0, pinned_below_13_after = 0;
+  std::vector<ImprovePassStats> passes;
+  double seconds_total = 0;
+};
+
+struct ImproveOptions {
+  CollapseOptions::Boundary boundary = CollapseOptions::Features;
+  double eps_f = 0.01;     // as CollapseOptions: which boundary vertices are Face vertices
+  double eps_r = 0.1;
+  bool use_labels = true;  // material interfaces from tet_labels[0] are kept
+  int max_iterations = 10;
+  // Tets with a dihedral angle below this (or above 180 minus it) are worked on.
+  double threshold_deg = 25;
+  bool flips = true, smoothing = true;
+  // Collapse of the short edges of the tets below 13 degrees that flips and relocation left
+  // (the paper's improvement by collapse), through the sequential method's checks, with the
+  // quality guard at its strictest (no collapse lowers the worst mean ratio of what it
+  // reshapes). Edges up to collapse_length; 0: 1.5 x the mesh's median edge length. After
+  // it, flips and relocation run again.
+  bool collapse = true;
+  double collapse_length = 0;
+  // With a non-empty mask (one byte per vertex, non-zero = selected), only selected vertices
+  // move, and only tets whose vertices are all selected are flipped; the collapse step does not
+  // run (it renumbers the vertices).
+  std::vector<uint8_t> vertex_mask;
+  std::function<void(const ImprovePassStats&)> progress;
+};
+
+// Improves `mesh` in place: tets, labels and tet fields (a new tet takes those of a tet it
+// replaces), vertex positions (a moved vertex takes the values of the vertex fields at its new
+// place, interpolated linearly in the tets around it). Throws InputError for an inverted tet.
+ImproveReport improve(Mesh& mesh, const ImproveOptions& options = {});
+
+}  // namespace tc

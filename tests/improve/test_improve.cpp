@@ -1,0 +1,304 @@
+// The improvement: each operation alone on a configuration built for it, then the whole phase
+// on coarsened meshes (validity by the checker, the boundary kept, determinism).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "geometry.h"
+#include "improve/improve_mesh.hpp"
+#include "test_support.hpp"
+#include "tetcollapse/check.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/improve.hpp"
+#include "tetcollapse/io.hpp"
+
+namespace tc {
+namespace {
+
+using improve_detail::ImpMesh;
+using namespace test;
+constexpr double kPi = 3.14159265358979323846;
+
+double volume_of(const Mesh& m) {
+  double v = 0;
+  for (int64_t t = 0; t < m.num_tets(); ++t) {
+    geo::tc_d3 p[4];
+    for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(m.points.data(), m.tets[size_t(4 * t + k)]);
+    v += geo::tc_tet_volume(p[0], p[1], p[2], p[3]);
+  }
+  return v;
+}
+
+double worst(const Mesh& m) {
+  double q = 2;
+  for (int64_t t = 0; t < m.num_tets(); ++t) {
+    geo::tc_d3 p[4];
+    for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(m.points.data(), m.tets[size_t(4 * t + k)]);
+    q = std::min(q, geo::tc_tet_min_sine(p[0], p[1], p[2], p[3]));
+  }
+  return q;
+}
+
+// n ring vertices on the unit circle (z = 0), a = (0, 0, h) and b = (0, 0, -h); the n tets
+// around the edge (a, b), positively oriented. Vertices: 0 = a, 1 = b, 2.. = ring.
+Mesh edge_ring(int n, double h) {
+  Mesh m;
+  m.points = {0, 0, h, 0, 0, -h};
+  for (int i = 0; i < n; ++i) {
+    m.points.push_back(std::cos(2 * kPi * i / n));
+    m.points.push_back(std::sin(2 * kPi * i / n));
+    m.points.push_back(0);
+  }
+  // A ring counterclockwise seen from a gives (a, b, r_i+1, r_i) positive.
+  for (int i = 0; i < n; ++i) m.tets.insert(m.tets.end(), {0, 1, 2 + (i + 1) % n, 2 + i});
+  return m;
+}
+
+// The same bipyramid as two tets sharing the triangle of a 3-ring.
+Mesh two_tets(double h) {
+  Mesh m = edge_ring(3, h);
+  m.tets = {2, 3, 4, 0, 4, 3, 2, 1};
+  return m;
+}
+
+TEST(ImproveMeasure, MinSineMatchesTheDihedralAngles) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int i = 0; i < 200; ++i) {
+    geo::tc_d3 p[4];
+    for (auto& x : p) x = {u(rng), u(rng), u(rng)};
+    if (geo::tc_tet_volume(p[0], p[1], p[2], p[3]) < 0) std::swap(p[0], p[1]);
+    const double lo = geo::tc_min_dihedral(p[0], p[1], p[2], p[3]), hi = geo::tc_max_dihedral(p[0], p[1], p[2], p[3]);
+    EXPECT_NEAR(geo::tc_tet_min_sine(p[0], p[1], p[2], p[3]), std::min(std::sin(lo), std::sin(hi)), 1e-9);
+    EXPECT_LT(geo::tc_tet_min_sine(p[1], p[0], p[2], p[3]), 0) << "inverted: negative";
+    EXPECT_NEAR(std::acos(geo::tc_tet_max_dihedral_cos(p[0], p[1], p[2], p[3])), lo, 1e-7);
+  }
+  const geo::tc_d3 r[4] = {{1, 1, 1}, {-1, 1, -1}, {1, -1, -1}, {-1, -1, 1}};
+  EXPECT_NEAR(geo::tc_tet_min_sine(r[0], r[1], r[2], r[3]), std::sqrt(8.0) / 3, 1e-12) << "regular tet";
+}
+
+TEST(ImproveOps, ThreeTwoFlipRemovesALongEdge) {
+  Mesh m = edge_ring(3, 1.0);
+  const double v0 = volume_of(m), q0 = worst(m);
+  ImpMesh im(m, {});
+  EXPECT_TRUE(improve_detail::try_edge_removal(im, 0, 1));
+  im.write_back();
+  ASSERT_EQ(m.num_tets(), 2);
+  EXPECT_NEAR(volume_of(m), v0, 1e-12);
+  EXPECT_GT(worst(m), q0);
+  EXPECT_FALSE(ImpMesh(m, {}).has_edge(0, 1));
+}
+
+TEST(ImproveOps, ThreeTwoFlipRefusedWhenItWouldWorsen) {
+  Mesh m = edge_ring(3, 0.3);  // the three tets are better than the two
+  ImpMesh im(m, {});
+  EXPECT_FALSE(improve_detail::try_edge_removal(im, 0, 1));
+  im.write_back();
+  EXPECT_EQ(m.num_tets(), 3);
+}
+
+TEST(ImproveOps, TwoThreeFlipSplitsAFlatPair) {
+  Mesh m = two_tets(0.2);
+  const double v0 = volume_of(m), q0 = worst(m);
+  ImpMesh im(m, {});
+  int flipped = 0;
+  for (int f = 0; f < 4; ++f) flipped += improve_detail::try_flip23(im, 0, f);
+  EXPECT_EQ(flipped, 1);
+  im.write_back();
+  ASSERT_EQ(m.num_tets(), 3);
+  EXPECT_NEAR(volume_of(m), v0, 1e-12);
+  EXPECT_GT(worst(m), q0);
+  EXPECT_GT(worst(m), 0);
+}
+
+TEST(ImproveOps, EdgeOfFiveTetsBecomesSix) {
+  Mesh m = edge_ring(5, 3.0);
+  const double v0 = volume_of(m), q0 = worst(m);
+  ImpMesh im(m, {});
+  EXPECT_TRUE(improve_detail::try_edge_removal(im, 0, 1));
+  im.write_back();
+  ASSERT_EQ(m.num_tets(), 6);
+  EXPECT_NEAR(volume_of(m), v0, 1e-12);
+  EXPECT_GT(worst(m), q0);
+}
+
+TEST(ImproveOps, BoundaryEdgeIsNotRemoved) {
+  Mesh m = edge_ring(5, 3.0);
+  m.tets.resize(4 * 4);  // drop one tet: the ring opens, the edge lies on the boundary
+  ImpMesh im(m, {});
+  EXPECT_FALSE(improve_detail::try_edge_removal(im, 0, 1));
+}
+
+TEST(ImproveOps, FlipsKeepLabelsApart) {
+  Mesh m = edge_ring(3, 1.0);
+  m.tet_labels.push_back({"material", {1, 1, 2}});
+  ImpMesh im(m, {});
+  EXPECT_FALSE(improve_detail::try_edge_removal(im, 0, 1)) << "the faces around the edge include an interface";
+}
+
+// An octahedron around an interior vertex pushed towards one corner.
+TEST(ImproveOps, SmoothingCentresAnInteriorVertex) {
+  Mesh m;
+  m.points = {0.7, 0.1, 0.05, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
+  const int32_t x[2] = {1, 2}, y[2] = {3, 4}, z[2] = {5, 6};
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int k = 0; k < 2; ++k) {
+        int32_t q[4] = {0, x[i], y[j], z[k]};
+        geo::tc_d3 p[4];
+        for (int c = 0; c < 4; ++c) p[c] = geo::tc_point(m.points.data(), q[c]);
+        if (geo::tc_tet_volume(p[0], p[1], p[2], p[3]) < 0) std::swap(q[2], q[3]);
+        m.tets.insert(m.tets.end(), q, q + 4);
+      }
+  // a linear field: the interpolation at the new place reproduces it
+  m.vertex_fields.push_back({"f", 1, {}});
+  for (int64_t v = 0; v < m.num_vertices(); ++v)
+    m.vertex_fields[0].values.push_back(m.points[3 * v] + 2 * m.points[3 * v + 1] + 3 * m.points[3 * v + 2]);
+  const double q0 = worst(m);
+  ImpMesh im(m, {});
+  EXPECT_EQ(im.motion(0), improve_detail::kFree);
+  EXPECT_EQ(im.motion(1), improve_detail::kFixed) << "a corner of the octahedron";
+  EXPECT_TRUE(improve_detail::try_smooth(im, 0));
+  EXPECT_GT(worst(m), q0 + 0.2);
+  EXPECT_LT(std::hypot(m.points[0], m.points[1], m.points[2]), 0.2) << "near the centre";
+  EXPECT_NEAR(m.vertex_fields[0].values[0], m.points[0] + 2 * m.points[1] + 3 * m.points[2], 1e-12);
+}
+
+TEST(ImprovePhase, OnlyTheMaskedVerticesMove) {
+  Mesh m = cube_tets(5);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-0.03, 0.03);
+  for (double& x : m.points)
+    if (x > 0 && x < 1) x += u(rng);
+  ImproveOptions o;
+  o.threshold_deg = 40;
+  o.vertex_mask.resize(size_t(m.num_vertices()));
+  for (int64_t v = 0; v < m.num_vertices(); ++v) o.vertex_mask[size_t(v)] = m.points[3 * v] < 0.5;
+  const Mesh before = m;
+  improve(m, o);
+  int64_t moved = 0;
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    const bool same = m.points[3 * v] == before.points[3 * v] && m.points[3 * v + 1] == before.points[3 * v + 1] &&
+                      m.points[3 * v + 2] == before.points[3 * v + 2];
+    if (!o.vertex_mask[size_t(v)]) {
+      EXPECT_TRUE(same) << "vertex " << v << " is not selected";
+    }
+    moved += !same;
+  }
+  EXPECT_GT(moved, 0);
+}
+
+// Coarsened meshes (the sequential method: no device needed), improved.
+Mesh coarsened(const std::string& path, double factor, CollapseOptions::Boundary boundary) {
+  Mesh m = read_mesh(path);
+  CollapseOptions o;
+  o.method = CollapseOptions::Sequential;
+  o.target_factor = factor;
+  o.boundary = boundary;
+  collapse_sequential(m, o);
+  return m;
+}
+
+TEST(ImprovePhase, BracketGetsValidAndBetter) {
+  for (auto mode : {CollapseOptions::Features, CollapseOptions::Strict}) {
+    Mesh m = coarsened(project_mesh("bracket.msh"), 2, mode);
+    const Mesh before = m;
+    ImproveOptions o;
+    o.boundary = mode;
+    const ImproveReport r = improve(m, o);
+    EXPECT_LT(r.before.min_dihedral_deg, 8) << "the coarsened bracket has slivers to remove";
+    EXPECT_GT(r.after.min_dihedral_deg, r.before.min_dihedral_deg + 2.5);
+    EXPECT_LT(r.after.below_10_deg, r.before.below_10_deg / 4 + 1);
+    EXPECT_GE(worst(m), worst(before)) << "the worst tet is never made worse";
+    CheckOptions co;
+    co.hausdorff = true;
+    const CheckReport cr = check_mesh(m, co, &before);
+    EXPECT_TRUE(cr.valid) << check_report_text(cr);
+    EXPECT_NEAR(cr.reference.volume_change_rel, 0, 1e-12);
+    if (mode == CollapseOptions::Strict) {
+      EXPECT_EQ(cr.reference.hausdorff, 0) << "strict: the boundary stays bit for bit";
+      const auto keys = sface_keys(before);
+      for (const auto& f : keys)
+        for (int32_t v : f)
+          for (int k = 0; k < 3; ++k) ASSERT_EQ(m.points[3 * size_t(v) + k], before.points[3 * size_t(v) + k]);
+    }
+    Mesh again = before;
+    improve(again, o);
+    expect_same_mesh(m, again, "deterministic");
+  }
+}
+
+TEST(ImprovePhase, FlatFacesStayInTheirPlanes) {
+  Mesh m = cube_tets(6);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.02, 0.02);
+  for (int64_t v = 0; v < m.num_vertices(); ++v)  // jiggle within the faces: off them no coordinate changes
+    for (int k = 0; k < 3; ++k) {
+      double& x = m.points[3 * size_t(v) + k];
+      if (x > 0 && x < 1) x += u(rng);
+    }
+  const Mesh before = m;
+  ImproveOptions o;
+  o.threshold_deg = 40;
+  const ImproveReport r = improve(m, o);
+  EXPECT_GT(r.after.min_dihedral_deg, r.before.min_dihedral_deg);
+  int64_t moved_on_faces = 0;
+  for (int64_t v = 0; v < m.num_vertices(); ++v)
+    for (int k = 0; k < 3; ++k) {
+      const double x = before.points[3 * size_t(v) + k];
+      if (x == 0 || x == 1) {
+        EXPECT_EQ(m.points[3 * size_t(v) + k], x) << "vertex " << v << " left its face plane";
+        moved_on_faces += m.points[3 * size_t(v) + (k + 1) % 3] != before.points[3 * size_t(v) + (k + 1) % 3];
+      }
+    }
+  EXPECT_GT(moved_on_faces, 0) << "face vertices move within their planes";
+  const CheckReport cr = check_mesh(m, {}, &before);
+  EXPECT_TRUE(cr.valid) << check_report_text(cr);
+}
+
+TEST(ImprovePhase, MaterialInterfacesStay) {
+  Mesh m = two_materials(5);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.025, 0.025);
+  for (int64_t v = 0; v < m.num_vertices(); ++v)
+    for (int k = 0; k < 3; ++k) {
+      double& x = m.points[3 * size_t(v) + k];
+      if (x > 0 && x < 1 && !(k == 2 && x == 0.5)) x += u(rng);
+    }
+  const Mesh before = m;
+  ImproveOptions o;
+  o.threshold_deg = 40;
+  const ImproveReport r = improve(m, o);
+  ASSERT_FALSE(r.passes.empty());
+  EXPECT_GT(r.passes[0].relocated + r.passes[0].edge_removals, 0) << "something to do";
+  EXPECT_EQ(sface_keys(m), sface_keys(before)) << "boundary and interface faces, labels included";
+  const CheckReport cr = check_mesh(m, {}, &before);
+  EXPECT_TRUE(cr.valid) << check_report_text(cr);
+}
+
+TEST(ImprovePhase, SharedMeshesCoarsenedAndImprovedAreValid) {
+  const std::vector<std::string> meshes = shared_volume_meshes();
+  if (meshes.empty()) GTEST_SKIP() << "no shared meshes at " << shared_meshes_dir();
+  int tried = 0;
+  for (const std::string& path : meshes) {
+    Mesh m = read_mesh(path);
+    if (m.num_tets() > 30000) continue;  // a unit test: the small ones
+    ++tried;
+    CollapseOptions o;
+    o.method = CollapseOptions::Sequential;
+    o.target_factor = 2;
+    collapse_sequential(m, o);
+    const Mesh coarse = m;
+    if (!check_mesh(coarse, {}, nullptr).valid) continue;  // an input the checker refuses already
+    const ImproveReport r = improve(m, {});
+    EXPECT_GE(r.after.min_dihedral_deg, r.before.min_dihedral_deg) << path << ": the worst angle never falls";
+    EXPECT_LE(r.after.below_13_deg, r.before.below_13_deg) << path;
+    const CheckReport cr = check_mesh(m, {}, &coarse);
+    EXPECT_TRUE(cr.valid) << path << "\n" << check_report_text(cr);
+  }
+  EXPECT_GT(tried, 2);
+}
+
+}  // namespace
+}  // namespace tc
