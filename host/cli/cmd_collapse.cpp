@@ -6,13 +6,11 @@
 #include <sstream>
 
 #include "cli/common.hpp"
+#include "cli/improve_cli.hpp"
 #include "io/io_util.hpp"
 #include "json.hpp"
 #include "stopwatch.hpp"
 #include "tetcollapse/collapse.hpp"
-#ifdef TETCOLLAPSE_HAVE_CHECK
-#include "tetcollapse/check.hpp"
-#endif
 
 namespace tc::cli {
 
@@ -29,7 +27,8 @@ struct CollapseCli {
   double priority_levels = -1;  // not given
   std::string boundary = "features", method = "parallel", conflicts = "matching";
   std::string region, sizing_field, labels, cost_cl, placement_cl, predicate_cl, device, stats;
-  bool check = false, quiet = false, no_labels = false, no_spatial_order = false;
+  bool check = false, quiet = false, no_labels = false, no_spatial_order = false, no_improve = false;
+  ImproveCli improve;
 };
 
 std::vector<double> parse_numbers(const std::string& s, const std::string& what) {
@@ -97,8 +96,8 @@ void combine(std::vector<uint8_t>& mask, const std::vector<uint8_t>& more) {
   for (size_t i = 0; i < mask.size(); ++i) mask[i] = mask[i] && more[i];
 }
 
-std::string stats_json(const CollapseCli& c, const CollapseReport& r, double seconds_total, double seconds_read,
-                       double seconds_write, const std::string& check_verdict) {
+std::string stats_json(const CollapseCli& c, const CollapseReport& r, const ImproveReport* ir, double seconds_total,
+                       double seconds_read, double seconds_write, const std::string& check_verdict) {
   JsonWriter w;
   w.begin_object()
       .field("input", c.in)
@@ -125,6 +124,7 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, double sec
       .field("seconds_read", seconds_read)
       .field("seconds_write", seconds_write);
   if (!check_verdict.empty()) w.field("check", check_verdict);
+  if (ir) write_improve(w, *ir);
   w.key("iterations").begin_array();
   for (const auto& it : r.iterations) {
     w.begin_object()
@@ -256,6 +256,11 @@ void register_collapse(CLI::App& app, int& exit_code) {
                                         "default: $TETCOLLAPSE_DEVICE, else the first GPU, else the first CPU");
   app.add_option("--stats", c->stats, "Write the run's statistics as JSON to this file ('-' for stdout)");
   app.add_flag("--check", c->check, "Check the result (validity, unchanged boundary topology) and fail if invalid");
+  app.add_flag("--no-improve", c->no_improve,
+               "Coarsen only, as the paper (default: end with the improvement phase of 'tetcollapse\n"
+               "improve': flips, vertex relocation and collapses that raise the worst element quality;\n"
+               "only within --region/--labels when given; not with --predicate-cl or --placement-cl)");
+  add_improve_options(app, c->improve);
   app.add_flag("-q,--quiet", c->quiet, "No progress lines, only errors");
   add_input_options(app, c->input);
   add_output_options(app, c->output);
@@ -350,24 +355,23 @@ void register_collapse(CLI::App& app, int& exit_code) {
       r = collapse(mesh, opt, ctx);
     }
     if (!c->sizing_field.empty()) std::swap(mesh.vertex_fields[0], mesh.vertex_fields[sizing_index]);
-
-    std::string verdict;
-    if (c->check) {
-#ifdef TETCOLLAPSE_HAVE_CHECK
-      CheckOptions co;
-      co.hausdorff = opt.boundary == CollapseOptions::Strict;  // 0 expected in strict mode
-      CheckReport cr = check_mesh(mesh, co, &input);
-      verdict = cr.valid ? "valid" : "invalid";
-      if (!cr.valid) {
-        std::cerr << "check: the result is INVALID\n" << check_report_text(cr);
-        exit_code = kCheckFailed;
-      } else if (!c->quiet) {
-        std::cerr << "check: valid, boundary topology unchanged\n";
-      }
-#else
-      throw CLI::ValidationError("--check", "this build has no checker (CGAL)");
-#endif
+    ImproveReport ir;
+    // A user's predicate or placement states rules the improvement cannot know: no phase then.
+    if (!opt.predicate_cl_source.empty() || !opt.placement_cl_source.empty()) c->no_improve = true;
+    if (!c->no_improve) {
+      ImproveOptions& io = c->improve.opt;
+      io.boundary = opt.boundary;
+      io.eps_f = opt.eps_f;
+      io.eps_r = opt.eps_r;
+      io.use_labels = opt.use_labels;
+      // --region, --labels: improve there only (the masks of the coarse mesh)
+      if (!c->region.empty()) combine(io.vertex_mask, region_mask(mesh, c->region));
+      if (!c->labels.empty()) combine(io.vertex_mask, label_mask(mesh, c->labels));
+      ir = run_improve(mesh, c->improve, c->quiet);
     }
+
+    const std::string verdict =
+        c->check ? check_result(mesh, input, opt.boundary == CollapseOptions::Strict, c->quiet, exit_code) : "";
     stage.lap();
     if (exit_code != kCheckFailed) write_mesh(c->out, mesh, write_options(c->output));
     double seconds_write = stage.lap();
@@ -390,8 +394,13 @@ void register_collapse(CLI::App& app, int& exit_code) {
                    r.tets_in ? 100.0 * (1.0 - double(r.tets_out) / double(r.tets_in)) : 0.0, r.iterations.size(),
                    r.target_length, r.seconds_total, stage[0], stage[1], stage[2], stage[3], stage[4],
                    seconds_read, seconds_write, seconds_total);
+      if (!c->no_improve)
+        std::fprintf(stderr, "  improve %.3f s\n  quality before: %s\n  quality after:  %s\n", ir.seconds_total,
+                     quality_line(ir.before).c_str(), quality_line(ir.after).c_str());
     }
-    if (!c->stats.empty()) write_report(c->stats, stats_json(*c, r, seconds_total, seconds_read, seconds_write, verdict));
+    if (!c->stats.empty())
+      write_report(c->stats, stats_json(*c, r, c->no_improve ? nullptr : &ir, seconds_total, seconds_read,
+                                        seconds_write, verdict));
     if (exit_code != kCheckFailed) exit_code = kOk;
   });
 }

@@ -3,6 +3,9 @@
 #include <iostream>
 
 #include "io/io_util.hpp"
+#ifdef TETCOLLAPSE_HAVE_CHECK
+#include "tetcollapse/check.hpp"
+#endif
 
 namespace tc::cli {
 
@@ -52,6 +55,24 @@ void check_output_path(const std::string& path, const OutputOptions* o) {
   // the checks write_mesh and io::AtomicFile make (an unknown --out-format: InputError naming it)
   if (o) io::output_format(path, write_options(*o).format);
   io::require_output_folder(path);
+}
+
+std::string check_result(const Mesh& result, const Mesh& input, bool hausdorff, bool quiet, int& exit_code) {
+#ifdef TETCOLLAPSE_HAVE_CHECK
+  CheckOptions co;
+  co.hausdorff = hausdorff;
+  const CheckReport cr = check_mesh(result, co, &input);
+  if (!cr.valid) {
+    std::cerr << "check: the result is INVALID\n" << check_report_text(cr);
+    exit_code = kCheckFailed;
+  } else if (!quiet) {
+    std::cerr << "check: valid, boundary topology unchanged\n";
+  }
+  return cr.valid ? "valid" : "invalid";
+#else
+  (void)result, (void)input, (void)hausdorff, (void)quiet, (void)exit_code;
+  throw CLI::ValidationError("--check", "this build has no checker (CGAL)");
+#endif
 }
 
 }  // namespace tc::cli

@@ -40,6 +40,11 @@ WriteOptions write_options(const OutputOptions& o);
 // them. `o` null: a report file (JSON), whose format is not a mesh format, and "-" is stdout.
 void check_output_path(const std::string& path, const OutputOptions* o);
 
+// --check of the commands that change a mesh: checks `result` against `input` (validity, the
+// boundary's topology; with `hausdorff` also the boundary distance, 0 expected in strict mode),
+// prints the verdict, sets exit_code to kCheckFailed when invalid; returns "valid"/"invalid".
+std::string check_result(const Mesh& result, const Mesh& input, bool hausdorff, bool quiet, int& exit_code);
+
 // Registration of each subcommand: adds it to `app` and returns a flag set when it ran.
 void register_collapse(CLI::App& app, int& exit_code);
 void register_info(CLI::App& app, int& exit_code);
@@ -47,5 +52,6 @@ void register_convert(CLI::App& app, int& exit_code);
 void register_devices(CLI::App& app, int& exit_code);
 void register_check(CLI::App& app, int& exit_code);
 void register_features(CLI::App& app, int& exit_code);
+void register_improve(CLI::App& app, int& exit_code);
 
 }  // namespace tc::cli

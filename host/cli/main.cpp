@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   register_check(app, exit_code);
 #endif
   register_features(app, exit_code);
+  register_improve(app, exit_code);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,150 @@
+// tetcollapse improve IN OUT: raise the worst element quality (flips and vertex relocation).
+#include <cstdio>
+#include <iostream>
+
+#include "cli/common.hpp"
+#include "cli/improve_cli.hpp"
+#include "stopwatch.hpp"
+
+namespace tc::cli {
+
+void write_report(const std::string& path, const std::string& text);  // cmd_check.cpp
+
+void add_improve_options(CLI::App& cmd, ImproveCli& c) {
+  cmd.add_option("--improve-iterations", c.opt.max_iterations,
+                 "Improvement: at most N passes of flips and vertex relocation (each stops early when\n"
+                 "nothing changes)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  cmd.add_option("--improve-threshold", c.opt.threshold_deg,
+                 "Improvement: work on the tets with a dihedral angle below DEG (or above 180 - DEG)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0));
+  cmd.add_flag("--no-flips", c.no_flips, "Improvement: no edge removal or 2-3 flips");
+  cmd.add_flag("--no-smoothing", c.no_smoothing, "Improvement: no vertex relocation");
+  cmd.add_flag("--no-improve-collapse", c.no_collapse,
+               "Improvement: no collapse of the short edges of the tets still below 13 degrees after\n"
+               "the flips and relocation (that step removes a few vertices)");
+}
+
+std::string quality_line(const QualitySummary& q) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "min dihedral %.2f, median %.2f degrees, %lld below 10, %lld below 13",
+                q.min_dihedral_deg, q.median_dihedral_deg, (long long)q.below_10_deg, (long long)q.below_13_deg);
+  return buf;
+}
+
+ImproveReport run_improve(Mesh& mesh, ImproveCli& c, bool quiet) {
+  c.opt.flips = !c.no_flips;
+  c.opt.smoothing = !c.no_smoothing;
+  c.opt.collapse = !c.no_collapse;
+  if (!quiet)
+    c.opt.progress = [](const ImprovePassStats& s) {
+      std::fprintf(stderr,
+                   "improve %3d: bad tets %8lld  edge removals %6lld  2-3 flips %6lld  moved %7lld  collapsed %6lld  "
+                   "min dihedral %6.2f  below 10: %6lld  below 13: %6lld  %.3f s\n",
+                   s.iteration + 1, (long long)s.bad_tets, (long long)s.edge_removals, (long long)s.flips23,
+                   (long long)s.relocated, (long long)s.collapsed, s.min_dihedral_deg, (long long)s.below_10_deg,
+                   (long long)s.below_13_deg, s.seconds);
+    };
+  return improve(mesh, c.opt);
+}
+
+void write_quality(JsonWriter& w, std::string_view key, const QualitySummary& q) {
+  w.key(key)
+      .begin_object()
+      .field("tets", q.tets)
+      .field("min_dihedral_deg", q.min_dihedral_deg)
+      .field("median_dihedral_deg", q.median_dihedral_deg)
+      .field("below_10_deg", q.below_10_deg)
+      .field("below_13_deg", q.below_13_deg)
+      .end_object();
+}
+
+void write_improve(JsonWriter& w, const ImproveReport& r) {
+  w.key("improve").begin_object().field("seconds", r.seconds_total);
+  write_quality(w, "quality_before", r.before);
+  write_quality(w, "quality_after", r.after);
+  w.field("pinned_below_13_before", r.pinned_below_13_before).field("pinned_below_13_after", r.pinned_below_13_after);
+  w.key("passes").begin_array();
+  for (const auto& p : r.passes)
+    w.begin_object()
+        .field("iteration", p.iteration)
+        .field("bad_tets", p.bad_tets)
+        .field("edge_removals", p.edge_removals)
+        .field("flips23", p.flips23)
+        .field("relocated", p.relocated)
+        .field("collapsed", p.collapsed)
+        .field("min_dihedral_deg", p.min_dihedral_deg)
+        .field("below_10_deg", p.below_10_deg)
+        .field("below_13_deg", p.below_13_deg)
+        .field("seconds", p.seconds)
+        .end_object();
+  w.end_array().end_object();
+}
+
+void register_improve(CLI::App& app, int& exit_code) {
+  struct Opts {
+    std::string in, out, boundary = "features", stats;
+    InputOptions input;
+    OutputOptions output;
+    ImproveCli improve;
+    bool no_labels = false, check = false, quiet = false;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand(
+      "improve",
+      "Raise the worst element quality of a mesh without coarsening it: edge removal (3-2 and\n"
+      "n -> 2n-4 flips), 2-3 flips and vertex relocation, each accepted only when the worst\n"
+      "quality of what it changes rises. Boundary and interfaces are kept (see --boundary)");
+  cmd->add_option("IN", o->in, "Input mesh")->required();
+  cmd->add_option("OUT", o->out, "Output mesh (written to a temporary file and renamed)")->required();
+  cmd->add_option("--boundary", o->boundary,
+                  "strict: no boundary vertex moves (the boundary stays bit for bit); features (default)\n"
+                  "and free: a vertex of a flat boundary patch may move within its plane")
+      ->check(CLI::IsMember({"strict", "features", "free"}));
+  cmd->add_flag("--no-labels", o->no_labels, "Do not treat material interfaces as boundary (flips still keep labels)");
+  cmd->add_option("--eps-f", o->improve.opt.eps_f, "Face-vertex threshold on 1 - dot of normals")->capture_default_str();
+  cmd->add_option("--eps-r", o->improve.opt.eps_r, "Ridge-edge threshold on 1 - dot of normals")->capture_default_str();
+  add_improve_options(*cmd, o->improve);
+  cmd->add_option("--stats", o->stats, "Write the run's statistics as JSON to this file ('-' for stdout)");
+  cmd->add_flag("--check", o->check, "Check the result (validity, unchanged boundary topology) and fail if invalid");
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress lines, only errors");
+  add_input_options(*cmd, o->input);
+  add_output_options(*cmd, o->output);
+  cmd->callback([o, &exit_code] {
+    check_output_path(o->out, &o->output);
+    check_output_path(o->stats, nullptr);
+    const Stopwatch total;
+    Mesh mesh = read_input(o->in, o->input, o->quiet);
+    Mesh input;
+    if (o->check) input = mesh;
+    ImproveOptions& opt = o->improve.opt;
+    opt.boundary = o->boundary == "strict" ? CollapseOptions::Strict
+                   : o->boundary == "free" ? CollapseOptions::Free
+                                           : CollapseOptions::Features;
+    opt.use_labels = !o->no_labels;
+    ImproveReport r = run_improve(mesh, o->improve, o->quiet);
+    exit_code = kOk;
+    const std::string verdict =
+        o->check ? check_result(mesh, input, opt.boundary == CollapseOptions::Strict, o->quiet, exit_code) : "";
+    if (exit_code != kCheckFailed) write_mesh(o->out, mesh, write_options(o->output));
+    if (!o->quiet)
+      std::fprintf(stderr,
+                   "%s -> %s\n  before: %s\n  after:  %s\n  tets below 13 degrees whose vertices may not move: "
+                   "%lld -> %lld\n  improve %.3f s, total %.3f s\n",
+                   o->in.c_str(), o->out.c_str(), quality_line(r.before).c_str(), quality_line(r.after).c_str(),
+                   (long long)r.pinned_below_13_before, (long long)r.pinned_below_13_after, r.seconds_total,
+                   total.peek());
+    if (!o->stats.empty()) {
+      JsonWriter w;
+      w.begin_object().field("input", o->in).field("output", o->out).field("tets", r.after.tets);
+      if (!verdict.empty()) w.field("check", verdict);
+      write_improve(w, r);
+      w.field("seconds_total", total.peek()).end_object();
+      write_report(o->stats, w.str());
+    }
+  });
+}
+
+}  // namespace tc::cli
