@@ -21,6 +21,12 @@ void add_improve_options(CLI::App& cmd, ImproveCli& c) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 60.0));
   cmd.add_flag("--no-flips", c.no_flips, "Improvement: no edge removal or 2-3 flips");
+  cmd.add_option("--max-boundary-move", c.opt.max_boundary_move,
+                 "Improvement, features and free modes: a thin tet with two faces on the outer boundary\n"
+                 "may be removed when the boundary moves by at most this share of the bounding-box\n"
+                 "diagonal (0: never)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--no-smoothing", c.no_smoothing, "Improvement: no vertex relocation");
   cmd.add_flag("--no-improve-collapse", c.no_collapse,
                "Improvement: no collapse of the short edges of the tets still below 13 degrees after\n"
@@ -41,9 +47,10 @@ ImproveReport run_improve(Mesh& mesh, ImproveCli& c, bool quiet) {
   if (!quiet)
     c.opt.progress = [](const ImprovePassStats& s) {
       std::fprintf(stderr,
-                   "improve %3d: bad tets %8lld  edge removals %6lld  2-3 flips %6lld  moved %7lld  collapsed %6lld  "
-                   "min dihedral %6.2f  below 10: %6lld  below 13: %6lld  %.3f s\n",
+                   "improve %3d: bad tets %8lld  edge removals %6lld  2-3 flips %6lld  boundary %5lld  moved %7lld  "
+                   "collapsed %6lld  min dihedral %6.2f  below 10: %6lld  below 13: %6lld  %.3f s\n",
                    s.iteration + 1, (long long)s.bad_tets, (long long)s.edge_removals, (long long)s.flips23,
+                   (long long)s.boundary_removals,
                    (long long)s.relocated, (long long)s.collapsed, s.min_dihedral_deg, (long long)s.below_10_deg,
                    (long long)s.below_13_deg, s.seconds);
     };
@@ -73,6 +80,7 @@ void write_improve(JsonWriter& w, const ImproveReport& r) {
         .field("bad_tets", p.bad_tets)
         .field("edge_removals", p.edge_removals)
         .field("flips23", p.flips23)
+        .field("boundary_removals", p.boundary_removals)
         .field("relocated", p.relocated)
         .field("collapsed", p.collapsed)
         .field("min_dihedral_deg", p.min_dihedral_deg)

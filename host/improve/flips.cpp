@@ -187,6 +187,10 @@ void flip_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& st
         ++stats.flips23;
         done = true;
       }
+    if (!done && try_remove_boundary_sliver(m, t)) {
+      ++stats.boundary_removals;
+      done = true;
+    }
     if (!done)
       for (int32_t v : q) m.failed(m.flip_failed_at, v);
   }

@@ -92,7 +92,7 @@ void passes(Mesh& mesh, const ImproveOptions& options, int max_passes, ImproveRe
     stats.seconds = pass_clock.peek();
     report.passes.push_back(stats);
     if (options.progress) options.progress(stats);
-    if (stats.edge_removals + stats.flips23 + stats.relocated == 0) break;
+    if (stats.edge_removals + stats.flips23 + stats.boundary_removals + stats.relocated == 0) break;
     // Later passes make ever smaller gains on the same vertices: stop once a pass leaves the
     // worst angle and the counts below 10 and 13 degrees (nearly) as they were.
     if (it > 0) {

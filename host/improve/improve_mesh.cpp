@@ -15,14 +15,10 @@ uint64_t ImpMesh::key2(int32_t a, int32_t b) {
   return uint64_t(uint32_t(a)) << 32 | uint32_t(b);
 }
 
-// Three indices do not fit 64 bits: a hash of the sorted triple. A collision only makes a face
-// look tagged, which refuses a flip: safe.
-uint64_t ImpMesh::key3(int32_t a, int32_t b, int32_t c) {
-  int32_t s[3] = {a, b, c};
-  std::sort(s, s + 3);
-  uint64_t h = 0x9E3779B97F4A7C15ull;
-  for (int32_t x : s) h = (h ^ uint32_t(x)) * 0x100000001B3ull + (h >> 29);
-  return h;
+ImpMesh::FaceKey ImpMesh::face_key(int32_t a, int32_t b, int32_t c) {
+  FaceKey k{a, b, c};
+  std::sort(k.begin(), k.end());
+  return k;
 }
 
 ImpMesh::ImpMesh(Mesh& mesh, const ImproveOptions& options) : mesh_(mesh), points_(mesh.points) {
@@ -57,13 +53,57 @@ ImpMesh::ImpMesh(Mesh& mesh, const ImproveOptions& options) : mesh_(mesh), point
     }
   }
   for (int64_t i = 0; i < mesh.num_tris(); ++i)
-    tagged_faces_.insert(key3(mesh.tris[3 * i], mesh.tris[3 * i + 1], mesh.tris[3 * i + 2]));
+    tris_.emplace(face_key(mesh.tris[3 * i], mesh.tris[3 * i + 1], mesh.tris[3 * i + 2]), i);
   for (size_t i = 0; i + 1 < mesh.edges.size(); i += 2) tagged_edges_.insert(key2(mesh.edges[i], mesh.edges[i + 1]));
   if (!options.vertex_mask.empty() && options.vertex_mask.size() != size_t(nv))
     throw std::invalid_argument("vertex_mask has " + std::to_string(options.vertex_mask.size()) + " entries for " +
                                 std::to_string(nv) + " vertices");
   mask_ = options.vertex_mask;
   mark_motion(options);
+  if (options.boundary != CollapseOptions::Strict && options.max_boundary_move > 0 && nv > 0) {
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) lo[k] = hi[k] = points_[size_t(k)];
+    for (int64_t v = 0; v < nv; ++v)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], points_[size_t(3 * v + k)]);
+        hi[k] = std::max(hi[k], points_[size_t(3 * v + k)]);
+      }
+    max_boundary_move_ = options.max_boundary_move * std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  }
+}
+
+int32_t ImpMesh::across(int32_t t, int32_t a, int32_t b, int32_t c) const {
+  for (int32_t s : vtets_[size_t(a)]) {
+    if (s == t) continue;
+    const Tet& q = tets_[size_t(s)];
+    const bool hb = q[0] == b || q[1] == b || q[2] == b || q[3] == b;
+    const bool hc = q[0] == c || q[1] == c || q[2] == c || q[3] == c;
+    if (hb && hc) return s;
+  }
+  return -1;
+}
+
+bool ImpMesh::remove_boundary_tet(int32_t t, const std::array<std::array<int32_t, 3>, 2>& gone,
+                                  const std::array<std::array<int32_t, 3>, 2>& exposed) {
+  if (!tris_.empty()) {
+    const auto g0 = tris_.find(face_key(gone[0][0], gone[0][1], gone[0][2]));
+    const auto g1 = tris_.find(face_key(gone[1][0], gone[1][1], gone[1][2]));
+    if ((g0 == tris_.end()) != (g1 == tris_.end())) return false;  // one tagged, one not
+    if (g0 != tris_.end()) {
+      if (mesh_.tri_tags[size_t(g0->second)] != mesh_.tri_tags[size_t(g1->second)]) return false;
+      const int64_t i0 = g0->second, i1 = g1->second;
+      tris_.erase(g0);
+      tris_.erase(tris_.find(face_key(gone[1][0], gone[1][1], gone[1][2])));
+      for (int k = 0; k < 3; ++k) {
+        mesh_.tris[size_t(3 * i0 + k)] = exposed[0][size_t(k)];
+        mesh_.tris[size_t(3 * i1 + k)] = exposed[1][size_t(k)];
+      }
+      tris_.emplace(face_key(exposed[0][0], exposed[0][1], exposed[0][2]), i0);
+      tris_.emplace(face_key(exposed[1][0], exposed[1][1], exposed[1][2]), i1);
+    }
+  }
+  replace({t}, {}, t);
+  return true;
 }
 
 // Interior vertices move freely. On the feature surface (boundary and interfaces) a Face vertex

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
@@ -50,7 +51,15 @@ class ImpMesh {
   bool has_edge(int32_t a, int32_t b) const;
   bool has_face(int32_t a, int32_t b, int32_t c) const;
   bool tagged_edge(int32_t a, int32_t b) const { return tagged_edges_.count(key2(a, b)) != 0; }
-  bool tagged_face(int32_t a, int32_t b, int32_t c) const { return tagged_faces_.count(key3(a, b, c)) != 0; }
+  bool tagged_face(int32_t a, int32_t b, int32_t c) const { return tris_.count(face_key(a, b, c)) != 0; }
+  // The tet other than t with the face (a, b, c), or -1 (a boundary face).
+  int32_t across(int32_t t, int32_t a, int32_t b, int32_t c) const;
+  bool may_change_boundary() const { return max_boundary_move_ > 0; }
+  double max_boundary_move() const { return max_boundary_move_; }
+  // Removes tet t and gives the input's tagged triangles of its faces `gone` (two) to the faces
+  // `exposed` (two), which become boundary faces; false if the tags do not allow it.
+  bool remove_boundary_tet(int32_t t, const std::array<std::array<int32_t, 3>, 2>& gone,
+                           const std::array<std::array<int32_t, 3>, 2>& exposed);
 
   // Replaces the tets `old` by `added` (label and tet fields of `like`).
   void replace(const std::vector<int32_t>& old, const std::vector<Tet>& added, int32_t like);
@@ -82,7 +91,14 @@ class ImpMesh {
 
  private:
   static uint64_t key2(int32_t a, int32_t b);
-  static uint64_t key3(int32_t a, int32_t b, int32_t c);
+  using FaceKey = std::array<int32_t, 3>;
+  static FaceKey face_key(int32_t a, int32_t b, int32_t c);
+  struct FaceHash {
+    size_t operator()(const FaceKey& k) const {
+      return (size_t(uint32_t(k[0])) * 0x9E3779B97F4A7C15ull) ^ (size_t(uint32_t(k[1])) * 0xC2B2AE3D27D4EB4Full) ^
+             size_t(uint32_t(k[2]));
+    }
+  };
   void mark_motion(const ImproveOptions& options);
   void touch_star(int32_t v);
 
@@ -100,7 +116,9 @@ class ImpMesh {
   std::vector<std::vector<int32_t>> vtets_;
   std::vector<uint8_t> motion_, mask_;
   std::vector<tc_d3> normal_;
-  std::unordered_set<uint64_t> tagged_edges_, tagged_faces_;
+  std::unordered_set<uint64_t> tagged_edges_;
+  std::unordered_map<FaceKey, int64_t, FaceHash> tris_;  // the input's tagged triangles -> index
+  double max_boundary_move_ = 0;
 };
 
 // One topological pass over the bad tets (worst first); returns the counts in `stats`.
@@ -112,5 +130,6 @@ void smooth_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& 
 bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b);
 bool try_flip23(ImpMesh& m, int32_t t, int face);
 bool try_smooth(ImpMesh& m, int32_t v);
+bool try_remove_boundary_sliver(ImpMesh& m, int32_t t);
 
 }  // namespace tc::improve_detail

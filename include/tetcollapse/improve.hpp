@@ -12,6 +12,9 @@
 //                                          best triangulation of the edge's ring by Klincsek's
 //                                          dynamic programme)
 //         else a 2-3 flip on t's faces
+//         else, if t has two faces on the outer boundary and is thin, its removal (features
+//                                          and free modes; the boundary moves by at most
+//                                          max_boundary_move)
 //         accepted only if the worst q of the changed tets rises
 //       for v in vertices of bad tets:    -- smoothing pass
 //         move v to raise the worst q of its star (ascent along the worst tets' gradients
@@ -24,8 +27,9 @@
 //
 // The worst quality of the mesh never falls: each operation is accepted only when the worst
 // quality of what it changes rises. Flips change interior faces of one label only, so the
-// boundary, the material interfaces, tagged triangles and vertex numbering are kept; in strict
-// mode no boundary vertex moves, so the boundary stays bit for bit.
+// material interfaces and vertex numbering are kept; the outer boundary changes only by the
+// removal of thin boundary tets (within max_boundary_move, tagged triangles following), and in
+// strict mode not at all: no boundary vertex moves, so the boundary stays bit for bit.
 #pragma once
 
 #include <cstdint>
@@ -50,6 +54,7 @@ struct ImprovePassStats {
   int iteration = 0;
   int64_t edge_removals = 0;  // n -> 2n - 4 (n = 3: the 3-2 flip)
   int64_t flips23 = 0;
+  int64_t boundary_removals = 0;  // thin tets with two boundary faces removed
   int64_t relocated = 0;      // vertices moved
   int64_t collapsed = 0;      // edges collapsed (the collapse step, between two series of passes)
   int64_t bad_tets = 0;       // tets below the threshold at the start of the pass
@@ -76,6 +81,10 @@ struct ImproveOptions {
   // Tets with a dihedral angle below this (or above 180 minus it) are worked on.
   double threshold_deg = 25;
   bool flips = true, smoothing = true;
+  // features and free modes: a bad tet with two faces on the outer boundary may be removed
+  // (its two other faces become boundary: the boundary quad's diagonal flips) when the
+  // boundary moves by at most this share of the bounding-box diagonal; 0: never.
+  double max_boundary_move = 0.001;
   // Collapse of the short edges of the tets below 13 degrees that flips and relocation left
   // (the paper's improvement by collapse), through the sequential method's checks, with the
   // quality guard at its strictest (no collapse lowers the worst mean ratio of what it

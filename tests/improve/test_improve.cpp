@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <random>
 
 #include "geometry.h"
@@ -135,6 +136,50 @@ TEST(ImproveOps, FlipsKeepLabelsApart) {
   m.tet_labels.push_back({"material", {1, 1, 2}});
   ImpMesh im(m, {});
   EXPECT_FALSE(improve_detail::try_edge_removal(im, 0, 1)) << "the faces around the edge include an interface";
+}
+
+// A thin tet (a, b, x1, x2) on top of two others: its faces through (a, b) are on the boundary.
+Mesh roof(double eps) {
+  Mesh m;
+  m.points = {0, 0, eps, 1, 1, eps, 1, 0, 0, 0, 1, 0, 0.5, 0.5, -1};  // a b x1 x2 c
+  for (std::array<int32_t, 4> q : {std::array<int32_t, 4>{0, 1, 2, 3}, {1, 2, 3, 4}, {0, 2, 3, 4}}) {
+    geo::tc_d3 p[4];
+    for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(m.points.data(), q[size_t(k)]);
+    if (geo::tc_tet_volume(p[0], p[1], p[2], p[3]) < 0) std::swap(q[2], q[3]);
+    m.tets.insert(m.tets.end(), q.begin(), q.end());
+  }
+  m.tris = {0, 1, 2, 0, 1, 3};  // the two top faces, tagged alike
+  m.tri_tags = {7, 7};
+  return m;
+}
+
+TEST(ImproveOps, AThinBoundaryTetIsRemovedWithinTheBound) {
+  Mesh m = roof(5e-4);
+  const Mesh before = m;
+  {
+    ImpMesh im(m, {});
+    EXPECT_TRUE(improve_detail::try_remove_boundary_sliver(im, 0)) << "it moves the boundary by 1e-3 < 0.001 x diagonal";
+    im.write_back();
+  }
+  ASSERT_EQ(m.num_tets(), 2);
+  EXPECT_EQ(sface_keys(m).count({1, 2, 3}), 1u);
+  EXPECT_EQ(sface_keys(m).count({0, 2, 3}), 1u);
+  EXPECT_EQ(triangles_off_surface(m).size(), 0u) << "the tagged triangles follow the boundary";
+  const CheckReport cr = check_mesh(m, {}, &before);
+  EXPECT_TRUE(cr.valid) << check_report_text(cr);
+
+  Mesh thick = roof(1e-2);
+  EXPECT_FALSE(improve_detail::try_remove_boundary_sliver(*std::make_unique<ImpMesh>(thick, ImproveOptions{}), 0))
+      << "1e-2 is over the bound";
+  ImproveOptions strict;
+  strict.boundary = CollapseOptions::Strict;
+  Mesh s = roof(5e-4);
+  EXPECT_FALSE(improve_detail::try_remove_boundary_sliver(*std::make_unique<ImpMesh>(s, strict), 0))
+      << "strict: the boundary stays";
+  Mesh tagged = roof(5e-4);
+  tagged.tri_tags = {7, 8};
+  EXPECT_FALSE(improve_detail::try_remove_boundary_sliver(*std::make_unique<ImpMesh>(tagged, ImproveOptions{}), 0))
+      << "two surfaces the input tags apart";
 }
 
 // An octahedron around an interior vertex pushed towards one corner.
