@@ -15,7 +15,7 @@ namespace {
 
 constexpr double kDeg = 180.0 / 3.14159265358979323846;
 constexpr double kMinAngleGain = 0.05;  // degrees
-constexpr double kMinCountGain = 0.02;  // share of the tets below 10 or 13 degrees
+constexpr double kMinCountGain = 0.05;  // share of the tets below 10 or 13 degrees
 
 // The live tets below the threshold, worst first (ties by index: deterministic).
 std::vector<int32_t> bad_tets(const ImpMesh& m, double threshold) {
