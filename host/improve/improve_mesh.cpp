@@ -5,6 +5,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "collapse_guard_geometry.h"
 #include "tetcollapse/error.hpp"
 #include "tetcollapse/topology.hpp"
 
@@ -59,7 +60,6 @@ ImpMesh::ImpMesh(Mesh& mesh, const ImproveOptions& options) : mesh_(mesh), point
     throw std::invalid_argument("vertex_mask has " + std::to_string(options.vertex_mask.size()) + " entries for " +
                                 std::to_string(nv) + " vertices");
   mask_ = options.vertex_mask;
-  mark_motion(options);
   if (options.boundary != CollapseOptions::Strict && options.max_boundary_move > 0 && nv > 0) {
     double lo[3], hi[3];
     for (int k = 0; k < 3; ++k) lo[k] = hi[k] = points_[size_t(k)];
@@ -69,6 +69,120 @@ ImpMesh::ImpMesh(Mesh& mesh, const ImproveOptions& options) : mesh_(mesh), point
         hi[k] = std::max(hi[k], points_[size_t(3 * v + k)]);
       }
     max_boundary_move_ = options.max_boundary_move * std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  }
+  mark_motion(options);
+  if (max_boundary_move_ > 0) build_surface_grid();
+}
+
+bool ImpMesh::on_surface(int32_t t, int32_t a, int32_t b, int32_t c) const {
+  const int32_t o = across(t, a, b, c);
+  return o < 0 || label_[size_t(o)] != label_[size_t(t)];
+}
+
+void ImpMesh::surface_faces_at(int32_t v, std::vector<FaceKey>& out) const {
+  out.clear();
+  for (int32_t t : vtets_[size_t(v)]) {
+    const Tet& q = tets_[size_t(t)];
+    for (const auto& F : geo::TC_TET_FACES) {
+      const int32_t a = q[size_t(F[0])], b = q[size_t(F[1])], c = q[size_t(F[2])];
+      if ((a == v || b == v || c == v) && on_surface(t, a, b, c)) {
+        const FaceKey k = face_key(a, b, c);
+        if (std::find(out.begin(), out.end(), k) == out.end()) out.push_back(k);
+      }
+    }
+  }
+}
+
+template <class Fn>
+void ImpMesh::each_cell(tc_d3 lo, tc_d3 hi, Fn&& fn) {
+  const auto cell = [&](double x, double o) { return int64_t(std::floor((x - o) / cell_)); };
+  const int64_t i0 = cell(lo.x, grid_origin_.x), i1 = cell(hi.x, grid_origin_.x);
+  const int64_t j0 = cell(lo.y, grid_origin_.y), j1 = cell(hi.y, grid_origin_.y);
+  const int64_t k0 = cell(lo.z, grid_origin_.z), k1 = cell(hi.z, grid_origin_.z);
+  for (int64_t i = i0; i <= i1; ++i)
+    for (int64_t j = j0; j <= j1; ++j)
+      for (int64_t k = k0; k <= k1; ++k) fn((i * 2097152 + j) * 2097152 + k);
+}
+
+void ImpMesh::grid_insert(int32_t f) {
+  const FaceKey& k = sfaces_[size_t(f)];
+  tc_d3 lo = point(k[0]), hi = lo;
+  for (int i = 1; i < 3; ++i) {
+    const tc_d3 p = point(k[size_t(i)]);
+    lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+    hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+  }
+  each_cell(lo, hi, [&](int64_t c) { grid_[c].push_back(f); });
+}
+
+void ImpMesh::build_surface_grid() {
+  double total = 0;
+  for (int32_t t = 0; t < num_tet_slots(); ++t) {
+    const Tet& q = tets_[size_t(t)];
+    for (const auto& F : geo::TC_TET_FACES) {
+      const int32_t a = q[size_t(F[0])], b = q[size_t(F[1])], c = q[size_t(F[2])];
+      if (!on_surface(t, a, b, c)) continue;
+      const FaceKey k = face_key(a, b, c);
+      if (sface_index_.emplace(k, int32_t(sfaces_.size())).second) {
+        sfaces_.push_back(k);
+        total += geo::length(point(b) - point(a));
+      }
+    }
+  }
+  if (sfaces_.empty()) return;
+  cell_ = 2 * total / double(sfaces_.size());
+  grid_origin_ = start_.empty() ? tc_d3{0, 0, 0} : start_[0];
+  sface_seen_.assign(sfaces_.size(), 0);
+  for (int32_t f = 0; f < int32_t(sfaces_.size()); ++f) grid_insert(f);
+}
+
+bool ImpMesh::triangle_clear(const FaceKey& a, const tc_d3 (&pa)[3], int32_t v, tc_d3 p,
+                             const FaceKey* ignore, int n_ignore) {
+  auto at = [&](int32_t x) { return x == v ? p : point(x); };
+  const tc_d3 lo{std::min({pa[0].x, pa[1].x, pa[2].x}), std::min({pa[0].y, pa[1].y, pa[2].y}),
+                 std::min({pa[0].z, pa[1].z, pa[2].z})};
+  const tc_d3 hi{std::max({pa[0].x, pa[1].x, pa[2].x}), std::max({pa[0].y, pa[1].y, pa[2].y}),
+                 std::max({pa[0].z, pa[1].z, pa[2].z})};
+  ++sface_query_;
+  bool clear = true;
+  each_cell(lo, hi, [&](int64_t c) {
+    const auto it = grid_.find(c);
+    if (!clear || it == grid_.end()) return;
+    for (int32_t g : it->second) {
+      if (sface_seen_[size_t(g)] == sface_query_) continue;
+      sface_seen_[size_t(g)] = sface_query_;
+      const FaceKey& b = sfaces_[size_t(g)];
+      if (b == a || std::find(ignore, ignore + n_ignore, b) != ignore + n_ignore) continue;
+      const auto live = sface_index_.find(b);
+      if (live == sface_index_.end() || live->second != g) continue;  // gone from the surface
+      const tc_d3 pb[3] = {at(b[0]), at(b[1]), at(b[2])};
+      if (geo::tc_sg_tri_tri(a.data(), pa, b.data(), pb)) {
+        clear = false;
+        return;
+      }
+    }
+  });
+  return clear;
+}
+
+bool ImpMesh::surface_stays_clear(int32_t v, tc_d3 p) {
+  if (sfaces_.empty()) return true;
+  std::vector<FaceKey> fan;
+  surface_faces_at(v, fan);
+  for (const FaceKey& a : fan) {
+    const tc_d3 pa[3] = {a[0] == v ? p : point(a[0]), a[1] == v ? p : point(a[1]), a[2] == v ? p : point(a[2])};
+    if (!triangle_clear(a, pa, v, p, nullptr, 0)) return false;
+  }
+  return true;
+}
+
+void ImpMesh::surface_moved(int32_t v) {
+  if (sfaces_.empty()) return;
+  std::vector<FaceKey> fan;
+  surface_faces_at(v, fan);
+  for (const FaceKey& k : fan) {
+    const auto it = sface_index_.find(k);
+    if (it != sface_index_.end()) grid_insert(it->second);
   }
 }
 
@@ -85,6 +199,24 @@ int32_t ImpMesh::across(int32_t t, int32_t a, int32_t b, int32_t c) const {
 
 bool ImpMesh::remove_boundary_tet(int32_t t, const std::array<std::array<int32_t, 3>, 2>& gone,
                                   const std::array<std::array<int32_t, 3>, 2>& exposed) {
+  // The tets across the exposed faces must not become fins (three or four faces on the
+  // surface), and the exposed faces must not touch the rest of the surface (on thin parts of
+  // a model, or where near-degenerate tets fold it).
+  for (const auto& e : exposed) {
+    const int32_t n = across(t, e[0], e[1], e[2]);
+    if (n < 0) return false;
+    int on = 0;
+    const Tet& q = tets_[size_t(n)];
+    for (const auto& F : geo::TC_TET_FACES)
+      on += on_surface(n, q[size_t(F[0])], q[size_t(F[1])], q[size_t(F[2])]);
+    if (on >= 2) return false;
+    if (!sfaces_.empty()) {
+      const FaceKey k = face_key(e[0], e[1], e[2]);
+      const tc_d3 pe[3] = {point(k[0]), point(k[1]), point(k[2])};
+      const FaceKey ignore[2] = {face_key(gone[0][0], gone[0][1], gone[0][2]), face_key(gone[1][0], gone[1][1], gone[1][2])};
+      if (!triangle_clear(k, pe, -1, pe[0], ignore, 2)) return false;
+    }
+  }
   if (!tris_.empty()) {
     const auto g0 = tris_.find(face_key(gone[0][0], gone[0][1], gone[0][2]));
     const auto g1 = tris_.find(face_key(gone[1][0], gone[1][1], gone[1][2]));
@@ -103,41 +235,83 @@ bool ImpMesh::remove_boundary_tet(int32_t t, const std::array<std::array<int32_t
     }
   }
   replace({t}, {}, t);
+  if (!sfaces_.empty()) {
+    for (const auto& g : gone) sface_index_.erase(face_key(g[0], g[1], g[2]));
+    for (const auto& e : exposed) {
+      const FaceKey k = face_key(e[0], e[1], e[2]);
+      sface_index_[k] = int32_t(sfaces_.size());
+      sfaces_.push_back(k);
+      sface_seen_.push_back(0);
+      grid_insert(int32_t(sfaces_.size()) - 1);
+    }
+  }
   return true;
 }
 
-// Interior vertices move freely. On the feature surface (boundary and interfaces) a Face vertex
-// moves only where its surface triangles are coplanar, and then within that plane, so the
-// surface keeps its shape; curved faces, ridges and corners stay (bounding the error of a
-// move on a curved surface is not done here). In strict mode no surface vertex moves. Vertices
-// of tagged triangles and edges that are not plain Face vertices stay too.
+// Interior vertices move freely. A vertex of the feature surface (boundary and interfaces)
+// moves only within the surface: a vertex inside a patch (no ridge or tagged edge at it, one
+// fan of surface triangles) within its tangent plane, a vertex on a feature line (exactly two
+// ridge or tagged edges) along the line's chord. Where the patch is flat, or the line straight,
+// to rounding, the surface keeps its shape and the move is not bounded; elsewhere (features and
+// free modes) the vertex stays within max_offset of where it started, so that the surface moves
+// by at most max_boundary_move: a move by d within a plane at angle theta to the surface's
+// triangles (a line at angle theta to its edges) leaves the vertex d sin(theta) off them.
+// Corners, pinched vertices and (strict mode) every surface vertex stay.
 void ImpMesh::mark_motion(const ImproveOptions& options) {
+  constexpr double kStraight = 1e-9;  // sin of the angle counted as flat or straight
   const int32_t nv = num_vertices();
   motion_.assign(size_t(nv), kFree);
   normal_.assign(size_t(nv), tc_d3{0, 0, 0});
+  max_offset_.assign(size_t(nv), std::numeric_limits<double>::infinity());
+  start_.resize(size_t(nv));
+  for (int32_t v = 0; v < nv; ++v) start_[size_t(v)] = point(v);
   Topology topo = build_topology(mesh_, TopologyOptions{options.eps_f, options.eps_r, options.use_labels});
+  const bool may_bend = options.boundary != CollapseOptions::Strict && max_boundary_move_ > 0;
   for (int32_t v = 0; v < nv; ++v) {
-    const auto cls = VertexClass(topo.vertex_class[size_t(v)]);
-    if (cls == VertexClass::Interior) continue;
+    if (topo.vertex_class[size_t(v)] == uint8_t(VertexClass::Interior)) continue;
     motion_[size_t(v)] = kFixed;
-    if (cls != VertexClass::Face || options.boundary == CollapseOptions::Strict) continue;
-    const int32_t b = topo.vertex_sfaces_offsets[size_t(v)], e = topo.vertex_sfaces_offsets[size_t(v) + 1];
-    tc_d3 n0 = geo::tc_point(topo.sface_normals.data(), topo.vertex_sfaces[size_t(b)]);
-    bool flat = geo::dot(n0, n0) > 0.5;
-    for (int32_t i = b + 1; i < e && flat; ++i) {
-      tc_d3 n = geo::tc_point(topo.sface_normals.data(), topo.vertex_sfaces[size_t(i)]);
-      flat = 1.0 - geo::dot(n0, n) < 1e-12;
+    if (options.boundary == CollapseOptions::Strict) continue;
+    int32_t line_ends[2], lines = 0, surface_edges = 0;
+    for (int32_t i = topo.vertex_edges_offsets[size_t(v)]; i < topo.vertex_edges_offsets[size_t(v) + 1]; ++i) {
+      const int32_t e = topo.vertex_edges[size_t(i)];
+      const int32_t w = topo.edges[2 * size_t(e)] == v ? topo.edges[2 * size_t(e) + 1] : topo.edges[2 * size_t(e)];
+      surface_edges += topo.edge_boundary[size_t(e)] != 0;
+      if (topo.edge_ridge[size_t(e)] || tagged_edge(v, w)) {
+        if (lines < 2) line_ends[lines] = w;
+        ++lines;
+      }
     }
-    if (flat) {
-      motion_[size_t(v)] = kInPlane;
-      normal_[size_t(v)] = n0;
+    const int32_t fb = topo.vertex_sfaces_offsets[size_t(v)], fe = topo.vertex_sfaces_offsets[size_t(v) + 1];
+    double bend = 0;  // sin of the largest angle between the allowed motion and the surface
+    tc_d3 dir{0, 0, 0};
+    if (lines == 0) {
+      if (surface_edges != fe - fb) continue;  // not one fan (pinched, or a boundary of S)
+      for (int32_t i = fb; i < fe; ++i) dir = dir + geo::tc_point(topo.sface_normals.data(), topo.vertex_sfaces[size_t(i)]);
+      dir = geo::normalize(dir);
+      if (!(geo::dot(dir, dir) > 0.5)) continue;
+      for (int32_t i = fb; i < fe; ++i)
+        bend = std::max(bend, geo::length(geo::cross(dir, geo::tc_point(topo.sface_normals.data(), topo.vertex_sfaces[size_t(i)]))));
+    } else if (lines == 2) {
+      const tc_d3 p = point(v), a = point(line_ends[0]), b = point(line_ends[1]);
+      dir = geo::normalize(b - a);
+      if (!(geo::dot(dir, dir) > 0.5)) continue;
+      bend = std::max(geo::length(geo::cross(dir, geo::normalize(p - a))), geo::length(geo::cross(dir, geo::normalize(b - p))));
+    } else {
+      continue;  // a corner
     }
+    if (bend > kStraight) {
+      if (!may_bend) continue;
+      max_offset_[size_t(v)] = max_boundary_move_ / bend;
+    }
+    motion_[size_t(v)] = lines == 0 ? kInPlane : kAlongLine;
+    normal_[size_t(v)] = dir;
   }
-  // Vertices of tagged triangles off the feature surface, and of tagged edges, stay.
+  // Vertices of tagged triangles off the feature surface, and of tagged edges off it, stay.
   for (int64_t i = 0; i < 3 * mesh_.num_tris(); ++i)
     if (topo.vertex_class[size_t(mesh_.tris[size_t(i)])] == uint8_t(VertexClass::Interior))
       motion_[size_t(mesh_.tris[size_t(i)])] = kFixed;
-  for (int32_t v : mesh_.edges) motion_[size_t(v)] = kFixed;
+  for (int32_t v : mesh_.edges)
+    if (topo.vertex_class[size_t(v)] == uint8_t(VertexClass::Interior)) motion_[size_t(v)] = kFixed;
   for (int32_t v = 0; v < nv; ++v)
     if (!selected(v)) motion_[size_t(v)] = kFixed;
 }

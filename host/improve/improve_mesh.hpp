@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
@@ -19,7 +20,7 @@ namespace tc::improve_detail {
 using geo::tc_d3;
 using Tet = std::array<int32_t, 4>;
 
-enum Motion : uint8_t { kFixed = 0, kFree = 1, kInPlane = 2 };
+enum Motion : uint8_t { kFixed = 0, kFree = 1, kInPlane = 2, kAlongLine = 3 };
 
 class ImpMesh {
  public:
@@ -40,7 +41,18 @@ class ImpMesh {
   double quality(int32_t t) const { return quality_[size_t(t)]; }
   int32_t label(int32_t t) const { return label_[size_t(t)]; }
   Motion motion(int32_t v) const { return Motion(motion_[size_t(v)]); }
-  tc_d3 plane_normal(int32_t v) const { return normal_[size_t(v)]; }
+  // kInPlane: the plane's normal; kAlongLine: the line's direction.
+  tc_d3 motion_direction(int32_t v) const { return normal_[size_t(v)]; }
+  // How far v may get from where it started (infinite but on curved surfaces and lines).
+  bool within_reach(int32_t v, tc_d3 p) const {
+    return geo::length(p - start_[size_t(v)]) <= max_offset_[size_t(v)];
+  }
+  // Whether moving v to p keeps the feature surface free of self-intersections (only needed
+  // where the move changes the surface's shape: off flat patches and straight lines).
+  bool bends_surface(int32_t v) const { return max_offset_[size_t(v)] < std::numeric_limits<double>::infinity(); }
+  bool surface_stays_clear(int32_t v, tc_d3 p);
+  // After v moved: its surface triangles go into the grid cells of their new places.
+  void surface_moved(int32_t v);
 
   // Quality of tet t with vertex v at p (v need not be in t).
   double quality_with(int32_t t, int32_t v, tc_d3 p) const;
@@ -115,7 +127,30 @@ class ImpMesh {
   double cos_threshold_ = 1;
   std::vector<std::vector<int32_t>> vtets_;
   std::vector<uint8_t> motion_, mask_;
-  std::vector<tc_d3> normal_;
+  std::vector<tc_d3> normal_, start_;
+  std::vector<double> max_offset_;
+
+  // The feature surface's triangles (outer boundary and interfaces) in a uniform grid of cells
+  // of about their size, for the intersection test of surface moves. A triangle is listed in
+  // every cell its box has overlapped (stale cells only cost a test).
+  std::vector<FaceKey> sfaces_;
+  std::vector<uint32_t> sface_seen_;
+  uint32_t sface_query_ = 0;
+  std::unordered_map<FaceKey, int32_t, FaceHash> sface_index_;
+  std::unordered_map<int64_t, std::vector<int32_t>> grid_;
+  double cell_ = 0;
+  tc_d3 grid_origin_{0, 0, 0};
+  void build_surface_grid();
+  void grid_insert(int32_t f);
+  template <class Fn>
+  void each_cell(tc_d3 lo, tc_d3 hi, Fn&& fn);
+  // The surface triangles at v (as sorted vertex triples).
+  void surface_faces_at(int32_t v, std::vector<FaceKey>& out) const;
+  bool on_surface(int32_t t, int32_t a, int32_t b, int32_t c) const;
+  // Does triangle a (at pa; vertex v taken at p) keep clear of the surface's other triangles
+  // but `ignore`?
+  bool triangle_clear(const FaceKey& a, const tc_d3 (&pa)[3], int32_t v, tc_d3 p, const FaceKey* ignore,
+                      int n_ignore);
   std::unordered_set<uint64_t> tagged_edges_;
   std::unordered_map<FaceKey, int64_t, FaceHash> tris_;  // the input's tagged triangles -> index
   double max_boundary_move_ = 0;

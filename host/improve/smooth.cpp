@@ -51,8 +51,10 @@ tc_d3 gradient(const ImpMesh& m, int32_t t, int32_t v, tc_d3 p, double h) {
 bool try_smooth(ImpMesh& m, int32_t v) {
   const Motion motion = m.motion(v);
   if (motion == kFixed || m.tets_of(v).empty()) return false;
-  const tc_d3 n = m.plane_normal(v);
-  auto allowed = [&](tc_d3 d) { return motion == kInPlane ? d - n * geo::dot(d, n) : d; };
+  const tc_d3 n = m.motion_direction(v);
+  auto allowed = [&](tc_d3 d) {
+    return motion == kInPlane ? d - n * geo::dot(d, n) : motion == kAlongLine ? n * geo::dot(d, n) : d;
+  };
   tc_d3 p = m.point(v);
   // The scale of the star: its mean edge length at v.
   double scale = 0;
@@ -85,17 +87,23 @@ bool try_smooth(ImpMesh& m, int32_t v) {
     for (int32_t t : m.tets_of(v))
       if (m.quality_with(t, v, p) <= worst + kNearlyWorst)
         directions[1] = directions[1] + geo::normalize(allowed(gradient(m, t, v, p, h)));
+    // The mean of opposed unit gradients cancels to rounding noise, whose direction is
+    // arbitrary (off the allowed plane or line): skip it. Every direction is projected again
+    // after normalising, so rounding does not take a vertex off its plane or line.
+    if (geo::length(directions[1]) < 1e-6) directions[1] = {0, 0, 0};
     bool improved = false;
     for (tc_d3 d : directions) {
+      d = allowed(geo::normalize(d));
       const double len = geo::length(d);
-      if (!(len > 0)) continue;
+      if (!(len > 0.5)) continue;
       d = d / len;
       for (double s = 0.25 * scale, k = 0; k < kHalvings && !improved; ++k, s *= 0.5) {
         const tc_d3 candidate = p + d * s;
+        if (!m.within_reach(v, candidate)) continue;
         const double q = star_min(m, star, v, candidate, current);
         if (!(q > current)) continue;
         const double c = star_max_cos(m, v, candidate);
-        if (m.improves(current, current_cos, q, c)) {
+        if (m.improves(current, current_cos, q, c) && (!m.bends_surface(v) || m.surface_stays_clear(v, candidate))) {
           p = candidate;
           current = q;
           current_cos = c;
@@ -109,6 +117,7 @@ bool try_smooth(ImpMesh& m, int32_t v) {
   }
   if (!moved || current < start + kMinGain) return false;
   m.move(v, p);
+  if (m.bends_surface(v)) m.surface_moved(v);
   return true;
 }
 

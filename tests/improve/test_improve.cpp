@@ -138,11 +138,15 @@ TEST(ImproveOps, FlipsKeepLabelsApart) {
   EXPECT_FALSE(improve_detail::try_edge_removal(im, 0, 1)) << "the faces around the edge include an interface";
 }
 
-// A thin tet (a, b, x1, x2) on top of two others: its faces through (a, b) are on the boundary.
+// A thin tet (a, b, x1, x2) on top of two others (c below), which four more tets (e1..e4)
+// wrap so that they keep one face each on the boundary: its faces through (a, b) are on the
+// boundary.
 Mesh roof(double eps) {
   Mesh m;
-  m.points = {0, 0, eps, 1, 1, eps, 1, 0, 0, 0, 1, 0, 0.5, 0.5, -1};  // a b x1 x2 c
-  for (std::array<int32_t, 4> q : {std::array<int32_t, 4>{0, 1, 2, 3}, {1, 2, 3, 4}, {0, 2, 3, 4}}) {
+  m.points = {0, 0, eps, 1, 1, eps, 1, 0, 0, 0, 1, 0, 0.5, 0.5, -1,  // a b x1 x2 c
+              2, 0.5, -0.3, 0.5, 2, -0.3, 0.5, -1, -0.3, -1, 0.5, -0.3};  // e1 e2 e3 e4
+  for (std::array<int32_t, 4> q : {std::array<int32_t, 4>{0, 1, 2, 3}, {1, 2, 3, 4}, {0, 2, 3, 4}, {1, 2, 4, 5},
+                                   {1, 3, 4, 6}, {0, 2, 4, 7}, {0, 3, 4, 8}}) {
     geo::tc_d3 p[4];
     for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(m.points.data(), q[size_t(k)]);
     if (geo::tc_tet_volume(p[0], p[1], p[2], p[3]) < 0) std::swap(q[2], q[3]);
@@ -161,7 +165,7 @@ TEST(ImproveOps, AThinBoundaryTetIsRemovedWithinTheBound) {
     EXPECT_TRUE(improve_detail::try_remove_boundary_sliver(im, 0)) << "it moves the boundary by 1e-3 < 0.001 x diagonal";
     im.write_back();
   }
-  ASSERT_EQ(m.num_tets(), 2);
+  ASSERT_EQ(m.num_tets(), 6);
   EXPECT_EQ(sface_keys(m).count({1, 2, 3}), 1u);
   EXPECT_EQ(sface_keys(m).count({0, 2, 3}), 1u);
   EXPECT_EQ(triangles_off_surface(m).size(), 0u) << "the tagged triangles follow the boundary";
@@ -260,7 +264,10 @@ TEST(ImprovePhase, BracketGetsValidAndBetter) {
     co.hausdorff = true;
     const CheckReport cr = check_mesh(m, co, &before);
     EXPECT_TRUE(cr.valid) << check_report_text(cr);
-    EXPECT_NEAR(cr.reference.volume_change_rel, 0, 1e-12);
+    EXPECT_NEAR(cr.reference.volume_change_rel, 0, mode == CollapseOptions::Strict ? 1e-12 : 1e-3);
+    // the boundary moves within max_boundary_move (0.001 of the diagonal; the collapse step's
+    // moves along flat faces do not change the shape)
+    EXPECT_LE(cr.reference.hausdorff_rel, mode == CollapseOptions::Strict ? 0.0 : 1.1e-3);
     if (mode == CollapseOptions::Strict) {
       EXPECT_EQ(cr.reference.hausdorff, 0) << "strict: the boundary stays bit for bit";
       const auto keys = sface_keys(before);
