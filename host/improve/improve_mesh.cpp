@@ -234,6 +234,8 @@ bool ImpMesh::remove_boundary_tet(int32_t t, const std::array<std::array<int32_t
       tris_.emplace(face_key(exposed[1][0], exposed[1][1], exposed[1][2]), i1);
     }
   }
+  // Its vertices' surface fans changed: what was flat around them may be no longer.
+  for (int32_t v : tets_[size_t(t)]) motion_[size_t(v)] = kFixed;
   replace({t}, {}, t);
   if (!sfaces_.empty()) {
     for (const auto& g : gone) sface_index_.erase(face_key(g[0], g[1], g[2]));

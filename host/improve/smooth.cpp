@@ -117,7 +117,7 @@ bool try_smooth(ImpMesh& m, int32_t v) {
   }
   if (!moved || current < start + kMinGain) return false;
   m.move(v, p);
-  if (m.bends_surface(v)) m.surface_moved(v);
+  if (motion != kFree) m.surface_moved(v);  // its surface triangles moved: re-list them
   return true;
 }
 
