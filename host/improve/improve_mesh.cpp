@@ -93,17 +93,25 @@ void ImpMesh::surface_faces_at(int32_t v, std::vector<FaceKey>& out) const {
   }
 }
 
-template <class Fn>
-void ImpMesh::each_cell(tc_d3 lo, tc_d3 hi, Fn&& fn) {
+ImpMesh::CellBox ImpMesh::cells_of(tc_d3 lo, tc_d3 hi) const {
   const auto cell = [&](double x, double o) { return int64_t(std::floor((x - o) / cell_)); };
-  const int64_t i0 = cell(lo.x, grid_origin_.x), i1 = cell(hi.x, grid_origin_.x);
-  const int64_t j0 = cell(lo.y, grid_origin_.y), j1 = cell(hi.y, grid_origin_.y);
-  const int64_t k0 = cell(lo.z, grid_origin_.z), k1 = cell(hi.z, grid_origin_.z);
-  for (int64_t i = i0; i <= i1; ++i)
-    for (int64_t j = j0; j <= j1; ++j)
-      for (int64_t k = k0; k <= k1; ++k) fn((i * 2097152 + j) * 2097152 + k);
+  return {cell(lo.x, grid_origin_.x), cell(lo.y, grid_origin_.y), cell(lo.z, grid_origin_.z),
+          cell(hi.x, grid_origin_.x), cell(hi.y, grid_origin_.y), cell(hi.z, grid_origin_.z)};
 }
 
+template <class Fn>
+void ImpMesh::each_cell(const CellBox& b, Fn&& fn) {
+  for (int64_t i = b[0]; i <= b[3]; ++i)
+    for (int64_t j = b[1]; j <= b[4]; ++j)
+      for (int64_t k = b[2]; k <= b[5]; ++k) fn((i * 2097152 + j) * 2097152 + k);
+}
+
+template <class Fn>
+void ImpMesh::each_cell(tc_d3 lo, tc_d3 hi, Fn&& fn) {
+  each_cell(cells_of(lo, hi), fn);
+}
+
+// Lists face f in the cells of its box, and only there (a moved face leaves its old cells).
 void ImpMesh::grid_insert(int32_t f) {
   const FaceKey& k = sfaces_[size_t(f)];
   tc_d3 lo = point(k[0]), hi = lo;
@@ -112,7 +120,18 @@ void ImpMesh::grid_insert(int32_t f) {
     lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
     hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
   }
-  each_cell(lo, hi, [&](int64_t c) { grid_[c].push_back(f); });
+  const CellBox box = cells_of(lo, hi);
+  if (size_t(f) < sface_cells_.size()) {
+    if (sface_cells_[size_t(f)] == box) return;
+    each_cell(sface_cells_[size_t(f)], [&](int64_t c) {
+      auto& list = grid_[c];
+      list.erase(std::remove(list.begin(), list.end(), f), list.end());
+    });
+  } else {
+    sface_cells_.resize(size_t(f) + 1);
+  }
+  sface_cells_[size_t(f)] = box;
+  each_cell(box, [&](int64_t c) { grid_[c].push_back(f); });
 }
 
 void ImpMesh::build_surface_grid() {
@@ -133,6 +152,7 @@ void ImpMesh::build_surface_grid() {
   cell_ = 2 * total / double(sfaces_.size());
   grid_origin_ = start_.empty() ? tc_d3{0, 0, 0} : start_[0];
   sface_seen_.assign(sfaces_.size(), 0);
+  sface_alive_.assign(sfaces_.size(), 1);
   for (int32_t f = 0; f < int32_t(sfaces_.size()); ++f) grid_insert(f);
 }
 
@@ -151,11 +171,18 @@ bool ImpMesh::triangle_clear(const FaceKey& a, const tc_d3 (&pa)[3], int32_t v, 
     for (int32_t g : it->second) {
       if (sface_seen_[size_t(g)] == sface_query_) continue;
       sface_seen_[size_t(g)] = sface_query_;
+      if (!sface_alive_[size_t(g)]) continue;  // gone from the surface
       const FaceKey& b = sfaces_[size_t(g)];
-      if (b == a || std::find(ignore, ignore + n_ignore, b) != ignore + n_ignore) continue;
-      const auto live = sface_index_.find(b);
-      if (live == sface_index_.end() || live->second != g) continue;  // gone from the surface
       const tc_d3 pb[3] = {at(b[0]), at(b[1]), at(b[2])};
+      // boxes apart, by more than the tri-tri test's tolerance (1e-9 of the size): no contact
+      const double bxl = std::min({pb[0].x, pb[1].x, pb[2].x}), bxh = std::max({pb[0].x, pb[1].x, pb[2].x});
+      const double byl = std::min({pb[0].y, pb[1].y, pb[2].y}), byh = std::max({pb[0].y, pb[1].y, pb[2].y});
+      const double bzl = std::min({pb[0].z, pb[1].z, pb[2].z}), bzh = std::max({pb[0].z, pb[1].z, pb[2].z});
+      const double tol = 1e-6 * std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z, bxh - bxl, byh - byl, bzh - bzl});
+      if (bxl > hi.x + tol || bxh < lo.x - tol || byl > hi.y + tol || byh < lo.y - tol || bzl > hi.z + tol ||
+          bzh < lo.z - tol)
+        continue;
+      if (b == a || std::find(ignore, ignore + n_ignore, b) != ignore + n_ignore) continue;
       if (geo::tc_sg_tri_tri(a.data(), pa, b.data(), pb)) {
         clear = false;
         return;
@@ -238,12 +265,18 @@ bool ImpMesh::remove_boundary_tet(int32_t t, const std::array<std::array<int32_t
   for (int32_t v : tets_[size_t(t)]) motion_[size_t(v)] = kFixed;
   replace({t}, {}, t);
   if (!sfaces_.empty()) {
-    for (const auto& g : gone) sface_index_.erase(face_key(g[0], g[1], g[2]));
+    for (const auto& g : gone) {
+      const auto it = sface_index_.find(face_key(g[0], g[1], g[2]));
+      if (it == sface_index_.end()) continue;
+      sface_alive_[size_t(it->second)] = 0;
+      sface_index_.erase(it);
+    }
     for (const auto& e : exposed) {
       const FaceKey k = face_key(e[0], e[1], e[2]);
       sface_index_[k] = int32_t(sfaces_.size());
       sfaces_.push_back(k);
       sface_seen_.push_back(0);
+      sface_alive_.push_back(1);
       grid_insert(int32_t(sfaces_.size()) - 1);
     }
   }

@@ -131,10 +131,11 @@ class ImpMesh {
   std::vector<double> max_offset_;
 
   // The feature surface's triangles (outer boundary and interfaces) in a uniform grid of cells
-  // of about their size, for the intersection test of surface moves. A triangle is listed in
-  // every cell its box has overlapped (stale cells only cost a test).
+  // of about their size, for the intersection test of surface moves: each triangle is listed
+  // in the cells its box overlaps.
   std::vector<FaceKey> sfaces_;
   std::vector<uint32_t> sface_seen_;
+  std::vector<uint8_t> sface_alive_;
   uint32_t sface_query_ = 0;
   std::unordered_map<FaceKey, int32_t, FaceHash> sface_index_;
   std::unordered_map<int64_t, std::vector<int32_t>> grid_;
@@ -142,6 +143,11 @@ class ImpMesh {
   tc_d3 grid_origin_{0, 0, 0};
   void build_surface_grid();
   void grid_insert(int32_t f);
+  using CellBox = std::array<int64_t, 6>;  // lowest and highest cell indices
+  std::vector<CellBox> sface_cells_;       // per surface triangle: the cells it is listed in
+  CellBox cells_of(tc_d3 lo, tc_d3 hi) const;
+  template <class Fn>
+  void each_cell(const CellBox& b, Fn&& fn);
   template <class Fn>
   void each_cell(tc_d3 lo, tc_d3 hi, Fn&& fn);
   // The surface triangles at v (as sorted vertex triples).
