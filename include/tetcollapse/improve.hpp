@@ -79,7 +79,7 @@ struct ImproveOptions {
   bool use_labels = true;  // material interfaces from tet_labels[0] are kept
   int max_iterations = 10;
   // Tets with a dihedral angle below this (or above 180 minus it) are worked on.
-  double threshold_deg = 25;
+  double threshold_deg = 20;
   bool flips = true, smoothing = true;
   // features and free modes: a bad tet with two faces on the outer boundary may be removed
   // (its two other faces become boundary: the boundary quad's diagonal flips) when the
