@@ -96,7 +96,8 @@ void combine(std::vector<uint8_t>& mask, const std::vector<uint8_t>& more) {
   for (size_t i = 0; i < mask.size(); ++i) mask[i] = mask[i] && more[i];
 }
 
-std::string stats_json(const CollapseCli& c, const CollapseReport& r, const ImproveReport* ir, double seconds_total,
+std::string stats_json(const CollapseCli& c, const CollapseReport& r, const ImproveReport* ir,
+                       const QualitySummary& quality_in, const QualitySummary& quality_collapsed, double seconds_total,
                        double seconds_read, double seconds_write, const std::string& check_verdict) {
   JsonWriter w;
   w.begin_object()
@@ -124,6 +125,8 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, const Impr
       .field("seconds_read", seconds_read)
       .field("seconds_write", seconds_write);
   if (!check_verdict.empty()) w.field("check", check_verdict);
+  write_quality(w, "quality_input", quality_in);
+  write_quality(w, "quality_collapsed", quality_collapsed);
   if (ir) write_improve(w, *ir);
   w.key("iterations").begin_array();
   for (const auto& it : r.iterations) {
@@ -345,6 +348,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
                      it.on_host ? "  (host tail)" : "");
       };
 
+    // The quality before and after each phase, for the summary and --stats.
+    const bool report_quality = !c->quiet || !c->stats.empty();
+    QualitySummary quality_in, quality_collapsed;
+    if (report_quality) quality_in = quality_summary(mesh);
     CollapseReport r;
     if (opt.method == CollapseOptions::Sequential) {
       if (!c->quiet) std::cerr << "method: sequential (CPU)\n";
@@ -355,9 +362,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
       r = collapse(mesh, opt, ctx);
     }
     if (!c->sizing_field.empty()) std::swap(mesh.vertex_fields[0], mesh.vertex_fields[sizing_index]);
-    ImproveReport ir;
     // A user's predicate or placement states rules the improvement cannot know: no phase then.
     if (!opt.predicate_cl_source.empty() || !opt.placement_cl_source.empty()) c->no_improve = true;
+    if (report_quality && c->no_improve) quality_collapsed = quality_summary(mesh);
+    ImproveReport ir;
     if (!c->no_improve) {
       ImproveOptions& io = c->improve.opt;
       io.boundary = opt.boundary;
@@ -368,6 +376,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
       if (!c->region.empty()) combine(io.vertex_mask, region_mask(mesh, c->region));
       if (!c->labels.empty()) combine(io.vertex_mask, label_mask(mesh, c->labels));
       ir = run_improve(mesh, c->improve, c->quiet);
+      quality_collapsed = ir.before;
+      // the output's counts (the improvement's collapse step may remove a few more)
+      r.vertices_out = mesh.num_vertices();
+      r.tets_out = mesh.num_tets();
     }
 
     const std::string verdict =
@@ -394,13 +406,14 @@ void register_collapse(CLI::App& app, int& exit_code) {
                    r.tets_in ? 100.0 * (1.0 - double(r.tets_out) / double(r.tets_in)) : 0.0, r.iterations.size(),
                    r.target_length, r.seconds_total, stage[0], stage[1], stage[2], stage[3], stage[4],
                    seconds_read, seconds_write, seconds_total);
+      std::fprintf(stderr, "  quality in:             %s\n  quality after collapse: %s\n", quality_line(quality_in).c_str(),
+                   quality_line(quality_collapsed).c_str());
       if (!c->no_improve)
-        std::fprintf(stderr, "  improve %.3f s\n  quality before: %s\n  quality after:  %s\n", ir.seconds_total,
-                     quality_line(ir.before).c_str(), quality_line(ir.after).c_str());
+        std::fprintf(stderr, "  quality after improve:  %s (%.3f s)\n", quality_line(ir.after).c_str(), ir.seconds_total);
     }
     if (!c->stats.empty())
-      write_report(c->stats, stats_json(*c, r, c->no_improve ? nullptr : &ir, seconds_total, seconds_read,
-                                        seconds_write, verdict));
+      write_report(c->stats, stats_json(*c, r, c->no_improve ? nullptr : &ir, quality_in, quality_collapsed,
+                                        seconds_total, seconds_read, seconds_write, verdict));
     if (exit_code != kCheckFailed) exit_code = kOk;
   });
 }

@@ -58,18 +58,21 @@ QualitySummary quality_summary(const Mesh& mesh) {
   QualitySummary s;
   s.tets = mesh.num_tets();
   if (s.tets == 0) return s;
-  std::vector<double> mins(size_t(s.tets));
+  // By the cosine of each tet's smallest angle: one arc cosine per figure, not six per tet.
+  const double c10 = std::cos(10 / kDeg), c13 = std::cos(13 / kDeg);
+  std::vector<double> cosines(size_t(s.tets));
   for (int64_t t = 0; t < s.tets; ++t) {
     geo::tc_d3 p[4];
     for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(mesh.points.data(), mesh.tets[size_t(4 * t + k)]);
-    const double d = geo::tc_min_dihedral(p[0], p[1], p[2], p[3]) * kDeg;
-    mins[size_t(t)] = d;
-    s.below_10_deg += d < 10;
-    s.below_13_deg += d < 13;
+    const double c = geo::tc_tet_max_dihedral_cos(p[0], p[1], p[2], p[3]);
+    cosines[size_t(t)] = c;
+    s.below_10_deg += c > c10;
+    s.below_13_deg += c > c13;
   }
-  s.min_dihedral_deg = *std::min_element(mins.begin(), mins.end());
-  std::nth_element(mins.begin(), mins.begin() + ptrdiff_t(mins.size() / 2), mins.end());
-  s.median_dihedral_deg = mins[mins.size() / 2];
+  const auto deg = [](double c) { return std::acos(std::max(-1.0, std::min(1.0, c))) * kDeg; };
+  s.min_dihedral_deg = deg(*std::max_element(cosines.begin(), cosines.end()));
+  std::nth_element(cosines.begin(), cosines.begin() + ptrdiff_t(cosines.size() / 2), cosines.end());
+  s.median_dihedral_deg = deg(cosines[cosines.size() / 2]);
   return s;
 }
 
