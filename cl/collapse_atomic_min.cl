@@ -6,8 +6,8 @@
  *   atomic_min_propagate  every admissible edge e = (a, b): atom_min(desc[t], D(e)) for every
  *                         tet t of ring(a) and ring(b)
  *   atomic_min_select     e collapses when desc[t] == D(e) for every t of ring(a) and ring(b);
- *                         writes fin, p1, vaff and counters[2], counters[3] as
- *                         conflict_pass1_finish + conflict_finalize do
+ *                         writes edges_are_final, edges_pass1, verts2collapse and counters[2],
+ *                         counters[3] as conflict_pass1_finish + conflict_finalize do
  *
  * Descriptor D(e) (64 bits): the low k bits hold the edge index, k = the fewest bits holding
  * every index (ne - 1 < 2^k, k >= 1); the high 64 - k bits are the high bits of an
@@ -23,9 +23,9 @@
  * relies on): if a tet contains an end point of selected edges e and f, it is in a ring of
  * both, so it received D(e) and D(f) and holds only one of them: one of e, f was not selected.
  * So no tet holds end points of two selected edges, and (every vertex lies in a tet) no vertex
- * belongs to two selected edges: vaff is written once per vertex. An edge is selected exactly
- * when its descriptor is smaller than that of every other admissible edge with an end point in
- * a tet of ring(a) or ring(b) - the local minima of the conflict graph of pass 2, i.e. the
+ * belongs to two selected edges: verts2collapse is written once per vertex. An edge is selected
+ * exactly when its descriptor is smaller than that of every other admissible edge with an end point
+ * in a tet of ring(a) or ring(b) - the local minima of the conflict graph of pass 2, i.e. the
  * first round of conflict_pass2's greedy fixpoint; with the same order the result is therefore
  * a subset of what the two passes select. The result depends on nothing but the descriptors
  * (min is commutative): deterministic for any work-group size or schedule.
@@ -53,27 +53,27 @@ __kernel void atomic_min_reset(uint nt, __global ulong* desc) {
   desc[t] = ULONG_MAX;
 }
 
-__kernel void atomic_min_propagate(uint ne, __global const int* edges, __global const uint* adm,
-                                   __global const double* cost, __global const uint* vt_off, __global const int* vt,
-                                   uint idx_bits, __global ulong* desc) {
+__kernel void atomic_min_propagate(uint ne, __global const int* edges, __global const uint* edges_are_admissible,
+                                   __global const double* edges2cost, __global const uint* vt_off,
+                                   __global const int* vt, uint idx_bits, __global ulong* desc) {
   uint e = get_global_id(0);
-  if (e >= ne || !adm[e]) return;
-  ulong d = tcc_descriptor(cost[e], e, idx_bits);
+  if (e >= ne || !edges_are_admissible[e]) return;
+  ulong d = tcc_descriptor(edges2cost[e], e, idx_bits);
   for (int s = 0; s < 2; ++s) {
     int x = edges[2 * e + s];
     for (uint j = vt_off[x]; j < vt_off[x + 1]; ++j) atom_min(&desc[vt[j]], d);
   }
 }
 
-__kernel void atomic_min_select(uint ne, __global const int* edges, __global const uint* adm,
-                                __global const double* cost, __global const uint* vt_off, __global const int* vt,
-                                uint idx_bits, __global const ulong* desc, __global uint* fin, __global uint* p1,
-                                __global int* vaff, __global uint* counters) {
+__kernel void atomic_min_select(uint ne, __global const int* edges, __global const uint* edges_are_admissible,
+                                __global const double* edges2cost, __global const uint* vt_off, __global const int* vt,
+                                uint idx_bits, __global const ulong* desc, __global uint* edges_are_final,
+                                __global uint* edges_pass1, __global int* verts2collapse, __global uint* counters) {
   uint e = get_global_id(0);
   if (e >= ne) return;
   uint f = 0u;
-  if (adm[e]) {
-    ulong d = tcc_descriptor(cost[e], e, idx_bits);
+  if (edges_are_admissible[e]) {
+    ulong d = tcc_descriptor(edges2cost[e], e, idx_bits);
     f = 1u;
     for (int s = 0; s < 2 && f; ++s) {
       int x = edges[2 * e + s];
@@ -84,11 +84,11 @@ __kernel void atomic_min_select(uint ne, __global const int* edges, __global con
         }
     }
   }
-  fin[e] = f;
-  p1[e] = f;
+  edges_are_final[e] = f;
+  edges_pass1[e] = f;
   if (f) {
-    vaff[edges[2 * e]] = (int)e;
-    vaff[edges[2 * e + 1]] = (int)e;
+    verts2collapse[edges[2 * e]] = (int)e;
+    verts2collapse[edges[2 * e + 1]] = (int)e;
     atomic_inc(&counters[2]);
     atomic_inc(&counters[3]);
   }

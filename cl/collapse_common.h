@@ -5,6 +5,9 @@
  *   nb_off[v] .. nb_off[v+1]     N(v): the neighbour vertices of v, ascending, in nb[], and
  *                                nb_edge[] the id of the edge (v, nb[k])
  *   edges[2e], edges[2e+1]       edge e = (v0 < v1); edges are sorted lexicographically
+ * A parameter that receives one of the host's per-edge, per-vertex or per-tet buffers has that
+ * buffer's name (edges2cost, verts2collapse, edges_are_final: the State structs of the stages in
+ * host/collapse), since the host sets every argument by its parameter's name (launch.hpp there).
  * The floating-point contraction is switched off so that face normals and their dot products
  * are bit-identical to the host's tc::build_topology (which the tests compare against).
  */
@@ -229,20 +232,20 @@ inline void tcc_survivor_fields(int v, int v0, int v1, uint d, double3 p, __glob
 
 /* Worklists of the conflict rounds (collapse_conflict.cl, collapse_admissible.cl): slot c of
  * the candidate list cand[] keeps, after its first visit, the cheaper rivals that were still
- * undecided (at most TCC_RIVALS, in rivals[c TCC_RIVALS ..]; their count in rcount[c]), so a
- * later visit looks only at those and drops the ones decided OUT meanwhile. rcount[c] is
- * TCC_UNSCANNED before the first visit and TCC_RIVALS + 1 when they did not fit (every visit
- * then scans all rivals). */
+ * undecided (at most TCC_RIVALS, in slots2rivals[c TCC_RIVALS ..]; their count in
+ * slots2rival_count[c]), so a later visit looks only at those and drops the ones decided OUT
+ * meanwhile. slots2rival_count[c] is TCC_UNSCANNED before the first visit and TCC_RIVALS + 1 when
+ * they did not fit (every visit then scans all rivals). */
 #define TCC_RIVALS 16
 #define TCC_UNSCANNED 0xffffffffu
 
 /* Waiting test over the stored rivals: -1 when one is IN, 1 while some are undecided, 0 when
  * all are OUT. Keeps only the undecided ones. */
-inline int tcc_stored_rivals(__global uint* rv, __global uint* rcount, __global const uchar* state) {
+inline int tcc_stored_rivals(__global uint* rv, __global uint* rcount, __global const uchar* edges2state) {
   uint n = *rcount, m = 0;
   for (uint j = 0; j < n; ++j) {
     uint f = rv[j];
-    uchar sf = state[f];
+    uchar sf = edges2state[f];
     if (sf == TCC_IN) return -1;
     if (sf == TCC_UNDECIDED) rv[m++] = f;
   }
@@ -265,7 +268,7 @@ inline int tcc_before(__global const double* cost, int f, int e) {
   return cf < ce || (cf == ce && f < e);
 }
 
-/* Pass 1 claims: slot[x] ends as the first, in (cost, index) order, of the edges that claim
+/* Pass 1 claims: verts2slot[x] ends as the first, in (cost, index) order, of the edges that claim
  * end point x in a round (-1 when none); a compare-and-swap loop, so the result does not depend
  * on the order of the claims. */
 inline void tcc_claim(volatile __global int* slot, int e, __global const double* cost) {
@@ -281,35 +284,35 @@ inline void tcc_claim(volatile __global int* slot, int e, __global const double*
  * pass1_claim, 0 when it waits (appended to next, its next-round slots cleared), 1 when it is
  * first at both end points. *edge receives the edge. */
 inline int tcc_pass1_turn(uint i, int first, __global const uint* list, __global uint* next, __global uint* next_n,
-                          __global const uint* cand, __global const int* edges, __global const int* slot,
-                          __global int* slot_next, __global const uchar* state, int* edge) {
+                          __global const uint* cand, __global const int* edges, __global const int* verts2slot,
+                          __global int* verts2slot_next, __global const uchar* edges2state, int* edge) {
   uint c = first ? i : list[i];
   int e = (int)cand[c];
   *edge = e;
-  if (state[e] != TCC_UNDECIDED) return -1;
+  if (edges2state[e] != TCC_UNDECIDED) return -1;
   int a = edges[2 * e], b = edges[2 * e + 1];
-  if (slot[a] == e && slot[b] == e) return 1;
-  slot_next[a] = -1;
-  slot_next[b] = -1;
+  if (verts2slot[a] == e && verts2slot[b] == e) return 1;
+  verts2slot_next[a] = -1;
+  verts2slot_next[b] = -1;
   next[atomic_inc(next_n)] = c;
   return 0;
 }
 
-/* Pass-2 rivals of e = (a, b): the pass-1 edges recorded (vaff) at a vertex of a tet of
+/* Pass-2 rivals of e = (a, b): the pass-1 edges recorded (verts2collapse) at a vertex of a tet of
  * ring(a) or ring(b), before e. The vertices of the tets of ring(x) are x and N(x) (every edge
  * lies in a tet), so N(a) and N(b) are scanned: each vertex once instead of the 4 corners of
  * every tet of the rings, which repeat them. Returns as tcc_stored_rivals. */
 inline int tcc_pass2_wait(int e, int a, int b, __global const uint* nb_off, __global const int* nb,
-                          __global const int* vaff, __global const double* cost, __global const uchar* state,
-                          __global uint* rv, __global uint* rcount) {
-  if (*rcount <= TCC_RIVALS) return tcc_stored_rivals(rv, rcount, state);
+                          __global const int* verts2collapse, __global const double* cost,
+                          __global const uchar* edges2state, __global uint* rv, __global uint* rcount) {
+  if (*rcount <= TCC_RIVALS) return tcc_stored_rivals(rv, rcount, edges2state);
   uint m = 0;
   for (int s = 0; s < 2; ++s) {
     int x = s == 0 ? a : b;
     for (uint j = nb_off[x]; j < nb_off[x + 1]; ++j) {
-      int f = vaff[nb[j]];
+      int f = verts2collapse[nb[j]];
       if (f < 0 || f == e) continue;
-      uchar sf = state[f];
+      uchar sf = edges2state[f];
       if (sf == TCC_OUT || !tcc_before(cost, f, e)) continue;
       if (sf == TCC_IN) return -1;
       tcc_store_rival(rv, &m, (uint)f); /* both ends of f, or a common neighbour, give f twice */

@@ -72,10 +72,11 @@ inline void tcc_count_neighbours(__global const int* s, uint m, uint v, __global
  * it (nb_count) and its part above v (up_count). */
 __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __global const uint* vt_off,
                                         __global int* vt, __global int* scratch, __global uint* nb_count,
-                                        __global uint* up_count, int sort, int carry, __global const uchar* ndirty,
-                                        __global const int* vold, __global const int* vmap,
-                                        __global const uint* prev_nb_off, __global const int* prev_nb,
-                                        int rename, __global const int* prev_vaff) {
+                                        __global uint* up_count, int sort, int carry,
+                                        __global const uchar* verts_are_dirty, __global const int* verts2prev,
+                                        __global const int* prev_verts2new, __global const uint* prev_nb_off,
+                                        __global const int* prev_nb, int rename,
+                                        __global const int* prev_verts2collapse) {
   uint v = get_global_id(0);
   if (v >= nv) return;
   uint b = vt_off[v], n = vt_off[v + 1] - b;
@@ -95,13 +96,13 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
     }
   }
   __global int* s = scratch + 3 * b;
-  if (carry && !ndirty[v]) {
+  if (carry && !verts_are_dirty[v]) {
     /* ring(v) unchanged (collapse_verdicts.cl): N(v) is the previous one renumbered; none of
      * its vertices was removed and compaction keeps their order, so it stays sorted */
-    int o = vold[v];
+    int o = verts2prev[v];
     uint pb = prev_nb_off[o], m = prev_nb_off[o + 1] - pb, up = 0;
     for (uint i = 0; i < m; ++i) {
-      int u = vmap[prev_nb[pb + i]];
+      int u = prev_verts2new[prev_nb[pb + i]];
       s[i] = u;
       up += u > (int)v ? 1u : 0u;
     }
@@ -109,24 +110,24 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
     up_count[v] = up;
     return;
   }
-  if (carry && rename && prev_vaff[vold[v]] < 0) {
+  if (carry && rename && prev_verts2collapse[verts2prev[v]] < 0) {
     /* v is a neighbour of collapses, not an end point (rename: the rings were carried through
      * the compaction, collapse_update.cl). A collapse of x onto y renames x to y in the tets
      * of ring(v) and removes tets holding both; the link condition leaves every edge (v, w)
      * in some surviving tet, so N(v) is the previous one with each removed x renamed to its
      * survivor. The end points of the collapses (renamed, or kept but possibly equal to a
      * renamed one) are merged into the renumbered others, which stay in order. */
-    int o = vold[v];
+    int o = verts2prev[v];
     uint pb = prev_nb_off[o], pm = prev_nb_off[o + 1] - pb, m = 0;
     int ren[16];
     int nr = 0;
     for (uint i = 0; i < pm && nr <= 16; ++i) {
       int w = prev_nb[pb + i];
-      if (prev_vaff[w] >= 0) {
-        if (nr < 16) ren[nr] = vmap[w];
+      if (prev_verts2collapse[w] >= 0) {
+        if (nr < 16) ren[nr] = prev_verts2new[w];
         ++nr;
       } else {
-        s[m++] = vmap[w];
+        s[m++] = prev_verts2new[w];
       }
     }
     if (nr <= 16) {
@@ -135,24 +136,25 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
       return;
     }
   }
-  if (carry && rename && prev_vaff[vold[v]] >= 0) {
+  if (carry && rename && prev_verts2collapse[verts2prev[v]] >= 0) {
     /* v survives the collapse of u onto it: N(v) = N(u) U N(v) without u and v (the same link
      * condition argument), renumbered. No other vertex of the two lists is an end point of a
      * collapse (no tet holds end points of two final edges), so both renumber in order (the
      * compaction keeps the order of the kept vertices) and a merge of the two keeps N(v)
      * sorted. Otherwise (not expected) the general gather below. */
-    const int o = vold[v];
+    const int o = verts2prev[v];
     const uint ab = prev_nb_off[o], ae = prev_nb_off[o + 1];
     int u = -1, other = 0;
     for (uint i = ab; i < ae; ++i) {
       int w = prev_nb[i];
-      if (prev_vaff[w] < 0) continue;
-      if (vmap[w] == (int)v && u < 0) u = w;
+      if (prev_verts2collapse[w] < 0) continue;
+      if (prev_verts2new[w] == (int)v && u < 0)
+        u = w;
       else other = 1;
     }
     if (u >= 0 && !other) {
       const uint bb = prev_nb_off[u], be = prev_nb_off[u + 1];
-      for (uint j = bb; j < be && !other; ++j) other = prev_nb[j] != o && prev_vaff[prev_nb[j]] >= 0;
+      for (uint j = bb; j < be && !other; ++j) other = prev_nb[j] != o && prev_verts2collapse[prev_nb[j]] >= 0;
       if (!other) {
         /* u in N(v) and v in N(u) renumber to v, out of order: skipped before comparing. At
          * most 3 |ring(v)| entries fit in v's scratch (each tet gives 3 neighbours); more
@@ -164,7 +166,7 @@ __kernel void conn_ring_sort_and_gather(__global const int* tets, uint nv, __glo
           if (j < be && prev_nb[j] == o) ++j;
           if (i >= ae && j >= be) break;
           if (m == cap) break;
-          int x = i < ae ? vmap[prev_nb[i]] : INT_MAX, y = j < be ? vmap[prev_nb[j]] : INT_MAX;
+          int x = i < ae ? prev_verts2new[prev_nb[i]] : INT_MAX, y = j < be ? prev_verts2new[prev_nb[j]] : INT_MAX;
           int z = x < y ? x : y;
           if (x == z) ++i;
           if (y == z) ++j;
@@ -274,19 +276,19 @@ __kernel void conn_write_neighbours(uint nv, __global const uint* vt_off, __glob
  * id gives without a scan. */
 __kernel void conn_lower_edges(uint nv, __global const uint* nb_off, __global const int* nb,
                                __global const uint* edge_off, __global int* nb_edge, int carry,
-                               __global const uchar* ndirty, __global const int* vold,
+                               __global const uchar* verts_are_dirty, __global const int* verts2prev,
                                __global const uint* prev_nb_off, __global const uint* prev_edge_off,
                                __global const int* prev_nb_edge) {
   uint v = get_global_id(0);
   if (v >= nv) return;
   uint b = nb_off[v], m = nb_off[v + 1] - b;
   uint lower = m - (edge_off[v + 1] - edge_off[v]);
-  const int clean = carry && !ndirty[v];
-  const uint pb = clean ? prev_nb_off[vold[v]] : 0u;
+  const int clean = carry && !verts_are_dirty[v];
+  const uint pb = clean ? prev_nb_off[verts2prev[v]] : 0u;
   for (uint i = 0; i < lower; ++i) {
     int u = nb[b + i];
-    if (clean && !ndirty[u]) {
-      nb_edge[b + i] = (int)(edge_off[u] + ((uint)prev_nb_edge[pb + i] - prev_edge_off[vold[u]]));
+    if (clean && !verts_are_dirty[u]) {
+      nb_edge[b + i] = (int)(edge_off[u] + ((uint)prev_nb_edge[pb + i] - prev_edge_off[verts2prev[u]]));
       continue;
     }
     /* position of v among the upper part of N(u) */
@@ -306,13 +308,14 @@ __kernel void conn_lower_edges(uint nv, __global const uint* nb_off, __global co
  * per vertex) by sorting their keys, instead of a ring scan per face. A vertex with more such faces
  * than TCC_MAX_MIN_FACES falls back to the ring scan for its faces. */
 /* Carried tet_nbr for the faces owned by (whose smallest vertex is) a clean vertex v
- * (ndirty[v] == 0): ring(v) is unchanged since the previous iteration (collapse_verdicts.cl),
- * so the tet across the face is a kept tet of ring(v), at its new index tnew[previous index];
- * compaction keeps the order of the vertices of every tet, so the local face numbers are the
- * same. One work item per tet; conn_tet_neighbours then matches the dirty vertices' faces. */
+ * (verts_are_dirty[v] == 0): ring(v) is unchanged since the previous iteration
+ * (collapse_verdicts.cl), so the tet across the face is a kept tet of ring(v), at its new index
+ * prev_tets2new[previous index]; compaction keeps the order of the vertices of every tet, so the
+ * local face numbers are the same. One work item per tet; conn_tet_neighbours then matches the
+ * dirty vertices' faces. */
 __kernel void conn_tet_neighbours_carry(uint nt, __global const int* tets, __global int* tet_nbr,
-                                        __global const uchar* ndirty, __global const int* told,
-                                        __global const uint* tnew, __global const int* prev_tet_nbr) {
+                                        __global const uchar* verts_are_dirty, __global const int* tets2prev,
+                                        __global const uint* prev_tets2new, __global const int* prev_tet_nbr) {
   uint t = get_global_id(0);
   if (t >= nt) return;
   __global const int* q = tets + 4 * t;
@@ -320,9 +323,9 @@ __kernel void conn_tet_neighbours_carry(uint nt, __global const int* tets, __glo
     int owner = -1;
     for (int j = 0; j < 4; ++j)
       if (j != f && (owner < 0 || q[j] < owner)) owner = q[j];
-    if (ndirty[owner]) continue;
-    int o = prev_tet_nbr[4 * told[t] + f];
-    tet_nbr[4 * t + f] = o < 0 ? o : (int)tnew[o];
+    if (verts_are_dirty[owner]) continue;
+    int o = prev_tet_nbr[4 * tets2prev[t] + f];
+    tet_nbr[4 * t + f] = o < 0 ? o : (int)prev_tets2new[o];
   }
 }
 
@@ -473,14 +476,14 @@ inline uchar tcc_edge_flags_of(int a, int b, __global const int* tets, __global 
  * does not own the same way as their owners do).
  * More than TCC_MAX_VERTEX_SFACES S-faces at a vertex (rare: a fan of thin boundary faces) classify it as
  * corner, which only protects it more, and its edges' flags come from ring scans
- * (tcc_edge_flags_of). With carry, a vertex whose ring is unchanged (ndirty == 0) keeps its
- * class and its edges' flags (found in the previous N(v)). */
-__kernel void conn_surface_flags(uint nv, __global const int* tets, __global const uint* vt_off,
-                                 __global const int* vt, __global const int* tet_nbr, __global const int* labels,
-                                 int use_labels, __global const double* pts, double eps_r, double eps_f,
-                                 __global const uint* nb_off, __global const int* nb, __global const uint* edge_off,
-                                 __global const uchar* vflags, __global const uchar* smask, __global uchar* eflags,
-                                 __global uchar* vclass, int carry, __global const uchar* ndirty, __global const int* vold,
+ * (tcc_edge_flags_of). With carry, a vertex whose ring is unchanged (verts_are_dirty == 0) keeps
+ * its class and its edges' flags (found in the previous N(v)). */
+__kernel void conn_surface_flags(uint nv, __global const int* tets, __global const uint* vt_off, __global const int* vt,
+                                 __global const int* tet_nbr, __global const int* labels, int use_labels,
+                                 __global const double* pts, double eps_r, double eps_f, __global const uint* nb_off,
+                                 __global const int* nb, __global const uint* edge_off, __global const uchar* vflags,
+                                 __global const uchar* smask, __global uchar* eflags, __global uchar* vclass, int carry,
+                                 __global const uchar* verts_are_dirty, __global const int* verts2prev,
                                  __global const uint* prev_nb_off, __global const int* prev_nb,
                                  __global const int* prev_nb_edge, __global const uchar* prev_eflags,
                                  __global const uchar* prev_vclass) {
@@ -489,10 +492,10 @@ __kernel void conn_surface_flags(uint nv, __global const int* tets, __global con
   const uint e0 = edge_off[v], up = edge_off[v + 1] - e0;
   __global const int* upper = nb + (nb_off[v + 1] - up); /* N(v) above v, in edge order */
   const int on_s = vflags[v] != 0;
-  if (carry && !ndirty[v]) { /* ring(v), which decides the class and the owned edges' flags, is unchanged */
+  if (carry && !verts_are_dirty[v]) { /* ring(v), which decides the class and the owned edges' flags, is unchanged */
     /* and N(v) is the previous one renumbered in order (conn_ring_sort_and_gather): its part above
-     * v is the previous part above vold[v], entry for entry (as verdict_carry reads it) */
-    const int o = vold[v];
+     * v is the previous part above verts2prev[v], entry for entry (as verdict_carry reads it) */
+    const int o = verts2prev[v];
     vclass[v] = prev_vclass[o];
     __global const int* prev_upper_edge = prev_nb_edge + (prev_nb_off[o + 1] - up);
     for (uint i = 0; i < up; ++i) eflags[e0 + i] = on_s && vflags[upper[i]] ? prev_eflags[prev_upper_edge[i]] : (uchar)0;

@@ -10,8 +10,8 @@
 
 __kernel void cost_and_mark(uint ne, __global const int* edges, __global const double* pts,
                             __global const double* vfield, uint vfield_stride, int has_vfield,
-                            __global const uchar* vmask, int mask_mode, double target, __global double* cost,
-                            __global uint* marked, __global uint* counters) {
+                            __global const uchar* vmask, int mask_mode, double target, __global double* edges2cost,
+                            __global uint* edges_are_marked, __global uint* counters) {
   __local uint group_marked;
   uint e = get_global_id(0);
   uint m = 0u;
@@ -26,11 +26,11 @@ __kernel void cost_and_mark(uint ne, __global const int* edges, __global const d
     double3 d = pb - pa;
     double c = sqrt(tcc_dot(d, d));
 #endif
-    cost[e] = c;
+    edges2cost[e] = c;
     /* mask_mode 0: no mask; 1: both end points in the mask; 2: either */
     int allowed = mask_mode == 0 ? 1 : mask_mode == 1 ? (vmask[a] && vmask[b]) : (vmask[a] || vmask[b]);
     m = (allowed && c < target) ? 1u : 0u;
-    marked[e] = m;
+    edges_are_marked[e] = m;
   }
   tcc_group_count(m, &group_marked, &counters[0]);
 }

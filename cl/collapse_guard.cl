@@ -10,7 +10,7 @@
  * rim of a hole (radius 0.09), collapsed onto its neighbour, made the rim its chord, and the
  * chord cut through the wall of a boss standing in the hole, a thin crescent of void away.)
  *
- * Per iteration, over the collapses chosen by the conflict passes (fin):
+ * Per iteration, over the collapses chosen by the conflict passes (edges_are_final):
  *   sguard_queries    a collapse that changes S (removed vertex x on S, or a survivor y on S
  *                     that moves to the midpoint) is a query: the bounding box of its new
  *                     S triangles (below); the host grids the boxes;
@@ -44,17 +44,17 @@
 
 /* Queries: the chosen collapses that change S, with the box and the number of their new S
  * triangles. */
-__kernel void sguard_queries(uint ne, __global const int* edges, __global const uint* fin, __global const uchar* dir,
-                             __global const double* pts, __global const double* vfield, uint vfield_stride,
-                             __global const int* tets, __global const uint* vt_off,
+__kernel void sguard_queries(uint ne, __global const int* edges, __global const uint* edges_are_final,
+                             __global const uchar* edges2dir, __global const double* pts, __global const double* vfield,
+                             uint vfield_stride, __global const int* tets, __global const uint* vt_off,
                              __global const int* vt, __global const int* tet_nbr, __global const int* labels,
-                             int use_labels, __global const uchar* vflags, __global int* qedge,
-                             __global double* qbox, __global uint* qntri, __global uint* qcount) {
+                             int use_labels, __global const uchar* vflags, __global int* qedge, __global double* qbox,
+                             __global uint* qntri, __global uint* qcount) {
   uint e = get_global_id(0);
-  if (e >= ne || !fin[e]) return;
+  if (e >= ne || !edges_are_final[e]) return;
   int x, y;
   double3 p;
-  int moves_y = tcc_sg_collapse((int)e, edges, dir, pts, vfield, vfield_stride, &x, &y, &p);
+  int moves_y = tcc_sg_collapse((int)e, edges, edges2dir, pts, vfield, vfield_stride, &x, &y, &p);
   if (!vflags[x] && !(moves_y && vflags[y])) return; /* S is not touched */
   double3 lo = (double3)(INFINITY, INFINITY, INFINITY), hi = -lo;
   int id[3];
@@ -92,8 +92,8 @@ __kernel void sguard_queries(uint ne, __global const int* edges, __global const 
 }
 
 /* --- The guard of the matching selection (collapse_matching.cl), whose collapses are applied to
- * the mesh (tets renamed, tdead, tet_nbr glued, survivors placed) and may share tets: it tests
- * the result. Every S face of the result that a collapse changed holds the survivor x of that
+ * the mesh (tets renamed, tets_are_dead, tet_nbr glued, survivors placed) and may share tets: it
+ * tests the result. Every S face of the result that a collapse changed holds the survivor x of that
  * collapse (renamed from the removed vertex y, moved with x, or glued across a removed tet), so
  * a query is a collapse whose survivor is on S, with as new triangles all S faces through x
  * now; the sweep (sguard_surface) is over the S faces of the result (sguard_applied_smask) and
@@ -101,20 +101,19 @@ __kernel void sguard_queries(uint ne, __global const int* edges, __global const 
  * Every pair of faces of the result that was not a pair before has a face of a query, so
  * nothing that crosses is missed. --- */
 
-
 /* The new S triangles of each query, at qoff[q] .. qoff[q + 1] (ids, positions, boxes and
  * planes). */
 __kernel void sguard_tris(uint nq, __global const int* qedge, __global const uint* qoff, __global const int* edges,
-                          __global const uchar* dir, __global const double* pts, __global const double* vfield,
+                          __global const uchar* edges2dir, __global const double* pts, __global const double* vfield,
                           uint vfield_stride, __global const int* tets, __global const uint* vt_off,
                           __global const int* vt, __global const int* tet_nbr, __global const int* labels,
-                          int use_labels, __global int* tid, __global double* tpos,
-                          __global double* tbox, __global double* tplane, __global int* qrep) {
+                          int use_labels, __global int* tid, __global double* tpos, __global double* tbox,
+                          __global double* tplane, __global int* qrep) {
   uint qi = get_global_id(0);
   if (qi >= nq) return;
   int x, y;
   double3 p;
-  int moves_y = tcc_sg_collapse(qedge[qi], edges, dir, pts, vfield, vfield_stride, &x, &y, &p);
+  int moves_y = tcc_sg_collapse(qedge[qi], edges, edges2dir, pts, vfield, vfield_stride, &x, &y, &p);
   qrep[2 * qi] = x;
   qrep[2 * qi + 1] = moves_y ? y : -1;
   uint n = qoff[qi];
@@ -125,7 +124,6 @@ __kernel void sguard_tris(uint nq, __global const int* qedge, __global const uin
     ++n;
   })
 }
-
 
 /* The grid cell of every vertex, packed (i | j << 10 | k << 20; at most 1024 cells per axis): a
  * face's cells per axis run from the smallest to the largest of its vertices' (tcc_sg_cell does
@@ -146,13 +144,12 @@ __kernel void sguard_vertex_cells(uint nv, __global const double* pts, double ox
  * With dedup a cell's scan stops at the first x at or above the face's lowest survivor (the face
  * has x, or the pairs are another query's). */
 __kernel void sguard_surface(uint n, __global const uint* stets, __global const uchar* smask,
-                             __global const uint* vcell, __global const double* pts,
-                             __global const int* tets, __global const int* qrep, __global const double* qbox,
-                             __global const uint* qoff, __global const int* tid, __global const double* tpos,
-                             __global const double* tbox, __global const double* tplane, double ox, double oy, double oz,
-                             double ih, int gx, int gy, int gz, __global const uint* cell_off,
-                             __global const int* cell_q, __global uint* qbad, int dedup, __global const int* qof,
-                             __global const int* tmin) {
+                             __global const uint* vcell, __global const double* pts, __global const int* tets,
+                             __global const int* qrep, __global const double* qbox, __global const uint* qoff,
+                             __global const int* tid, __global const double* tpos, __global const double* tbox,
+                             __global const double* tplane, double ox, double oy, double oz, double ih, int gx, int gy,
+                             int gz, __global const uint* cell_off, __global const int* cell_q, __global uint* qbad,
+                             int dedup, __global const int* verts2query, __global const int* tmin) {
   const uint g = get_global_id(0);
   if (g >= n) return;
   const uint t = stets[g];
@@ -168,7 +165,7 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
     double3 lo = fmin(fmin(fpos[0], fpos[1]), fpos[2]), hi = fmax(fmax(fpos[0], fpos[1]), fpos[2]);
     int has_plane = 0; /* the face's plane, computed at its first triangle test */
     tc_sg_plane fplane;
-    const int flow = dedup ? tcc_sg_first_survivor(fid, qof) : INT_MAX; /* its lowest survivor */
+    const int flow = dedup ? tcc_sg_first_survivor(fid, verts2query) : INT_MAX; /* its lowest survivor */
     uint code = 4u * t + (uint)f; /* names the face for debugging; never 0 */
     code = code < 0x7ffffffeu ? code + 2u : 1u;
     TCC_SG_FOR_CELL_ENTRIES(lo, hi, item, {
@@ -180,7 +177,7 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
       }
       if (!tcc_sg_owner_cell(lo, hi, i0_, j0_, k0_, (uint)item.z, qbox + 6 * qi, ci, cj, ck)) continue;
       tcc_sg_face_query(qi, item.y, fid, fpos, lo, hi, &has_plane, &fplane, code, dedup, qrep, qoff, tid, tpos, tbox,
-                        tplane, qof, tmin, qbad);
+                        tplane, verts2query, tmin, qbad);
     })
   }
 }
@@ -191,7 +188,8 @@ __kernel void sguard_surface(uint n, __global const uint* stets, __global const 
 __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const uint* qoff, __global const int* tid,
                            __global const double* tpos, __global const double* tbox, __global const double* tplane,
                            double ox, double oy, double oz, double ih, int gx, int gy, int gz,
-                           __global const uint* cell_off, __global const int* cell_q, __global uint* qbad, int cross, int dedup, __global const int* qrep, __global const int* qof,
+                           __global const uint* cell_off, __global const int* cell_q, __global uint* qbad, int cross,
+                           int dedup, __global const int* qrep, __global const int* verts2query,
                            __global const int* tmin) {
   uint qa = get_global_id(0);
   if (qa >= nq) return;
@@ -215,7 +213,7 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
       tcc_sg_load_tri(tid, tpos, nb, idb, posb);
       if (!tc_sg_tri_tri_planes(ida, posa, pla, idb, posb, tcc_sg_load_plane(tplane, nb))) continue;
       if (dedup) {
-        tcc_sg_refuse_all(ida, idb, qof, 0x80000000u | qa, qbad);
+        tcc_sg_refuse_all(ida, idb, verts2query, 0x80000000u | qa, qbad);
         continue;
       }
       qbad[qa] = 0x80000000u | qa;
@@ -255,11 +253,12 @@ __kernel void sguard_pairs(uint nq, __global const double* qbox, __global const 
  * so that the edge is not chosen again while its rings do not change. */
 /* A query with a hit is unmarked (selected again without it) and its verdict set (when the
  * verdict buffer is there); counts them. */
-__kernel void sguard_drop(uint nq, __global const int* qedge, __global const uint* qbad, __global uint* marked,
-                          int has_verdict, __global uchar* verdict, __global uint* count) {
+__kernel void sguard_drop(uint nq, __global const int* qedge, __global const uint* qbad,
+                          __global uint* edges_are_marked, int has_verdict, __global uchar* edges2verdict,
+                          __global uint* count) {
   uint q = get_global_id(0);
   if (q >= nq || !qbad[q]) return;
-  marked[qedge[q]] = 0u;
-  if (has_verdict) verdict[qedge[q]] = TCC_REFUSED_SURFACE;
+  edges_are_marked[qedge[q]] = 0u;
+  if (has_verdict) edges2verdict[qedge[q]] = TCC_REFUSED_SURFACE;
   atomic_inc(count);
 }

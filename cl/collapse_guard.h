@@ -8,10 +8,11 @@
 #include "collapse_guard_geometry.h"
 
 /* The collapse of edge e as chosen: x removed, y survives at *p; returns whether y moves. */
-inline int tcc_sg_collapse(int e, __global const int* edges, __global const uchar* dir, __global const double* pts,
-                           __global const double* vfield, uint vfield_stride, int* x, int* y, double3* p) {
+inline int tcc_sg_collapse(int e, __global const int* edges, __global const uchar* edges2dir,
+                           __global const double* pts, __global const double* vfield, uint vfield_stride, int* x,
+                           int* y, double3* p) {
   int v0 = edges[2 * e], v1 = edges[2 * e + 1];
-  uint d = dir[e];
+  uint d = edges2dir[e];
   *x = (d & TCC_DIR_REMOVE_V1) ? v1 : v0;
   *y = (d & TCC_DIR_REMOVE_V1) ? v0 : v1;
   *p = tcc_placement(pts, vfield, vfield_stride, v0, v1, d);
@@ -97,29 +98,27 @@ inline void tcc_sg_store_tri(uint n, const int* id, const double3* pos, __global
   tcc_sg_store_plane(tplane, n, tc_sg_plane_of(pos));
 }
 
-
 /* Each pair of S faces of the result is tested once (sguard_surface and sguard_pairs with
  * `dedup`, the matching selection's runs). Without it, a pair (A, B) is tested for every query
  * q whose survivor x_q is a vertex of A or B: by the sweep of A against q when x_q is in B
  * alone (and of B when in A alone), by sguard_pairs of q when in both; each refuses q on a
- * hit. With it, only for the query whose survivor has the lowest id of those (qof: the query of
- * each survivor of the run, -1 for other vertices; tmin: per triangle, the lowest survivor among
- * its vertices), and a hit refuses all of them (tcc_sg_refuse_all): the same refusals, fewer
+ * hit. With it, only for the query whose survivor has the lowest id of those (verts2query: the
+ * query of each survivor of the run, -1 for other vertices; tmin: per triangle, the lowest survivor
+ * among its vertices), and a hit refuses all of them (tcc_sg_refuse_all): the same refusals, fewer
  * pairs (most S faces of the result hold a survivor, so most pairs would be tested twice). */
-inline int tcc_sg_first_survivor(const int* id, __global const int* qof) {
+inline int tcc_sg_first_survivor(const int* id, __global const int* verts2query) {
   int m = INT_MAX;
   for (int k = 0; k < 3; ++k)
-    if (qof[id[k]] >= 0) m = min(m, id[k]);
+    if (verts2query[id[k]] >= 0) m = min(m, id[k]);
   return m;
 }
-inline void tcc_sg_refuse_all(const int* ia, const int* ib, __global const int* qof, uint code,
+inline void tcc_sg_refuse_all(const int* ia, const int* ib, __global const int* verts2query, uint code,
                               volatile __global uint* qbad) {
   for (int k = 0; k < 6; ++k) {
-    const int q = qof[k < 3 ? ia[k] : ib[k - 3]];
+    const int q = verts2query[k < 3 ? ia[k] : ib[k - 3]];
     if (q >= 0) atomic_max(qbad + q, code); /* the largest code whatever the order */
   }
 }
-
 
 inline void tcc_sg_load_tri(__global const int* tid, __global const double* tpos, uint n, int* id, double3* pos) {
   for (int k = 0; k < 3; ++k) {
@@ -214,7 +213,7 @@ inline void tcc_sg_face_query(uint qi, int rx, const int* fid, const double3* fp
                               int* has_plane, tc_sg_plane* fplane, uint code, int dedup, __global const int* qrep,
                               __global const uint* qoff, __global const int* tid, __global const double* tpos,
                               __global const double* tbox, __global const double* tplane,
-                              __global const int* qof, __global const int* tmin, __global uint* qbad) {
+                              __global const int* verts2query, __global const int* tmin, __global uint* qbad) {
   const int ry = qrep[2 * qi + 1];
   if (fid[0] == rx || fid[1] == rx || fid[2] == rx || fid[0] == ry || fid[1] == ry || fid[2] == ry) return;
   for (uint r = qoff[qi]; r < qoff[qi + 1]; ++r) {
@@ -231,9 +230,8 @@ inline void tcc_sg_face_query(uint qi, int rx, const int* fid, const double3* fp
       qbad[qi] = code;
       return;
     }
-    tcc_sg_refuse_all(id, fid, qof, code, qbad); /* and on: the face's pairs with other triangles */
+    tcc_sg_refuse_all(id, fid, verts2query, code, qbad); /* and on: the face's pairs with other triangles */
   }
 }
-
 
 #endif

@@ -11,11 +11,11 @@
 /* The faces each tet of the result owns on S (tcc_owned_sface over tet_nbr as glued): smask and
  * owns_s as conn_vertex_flags_faces writes them for a connectivity; 0 for the removed tets. */
 __kernel void sguard_applied_smask(uint nt, __global const int* tet_nbr, __global const int* labels, int use_labels,
-                                   __global const uchar* tdead, __global uint* owns_s, __global uchar* smask) {
+                                   __global const uchar* tets_are_dead, __global uint* owns_s, __global uchar* smask) {
   uint t = get_global_id(0);
   if (t >= nt) return;
   uint mask = 0;
-  for (int f = 0; f < 4 && !tdead[t]; ++f) {
+  for (int f = 0; f < 4 && !tets_are_dead[t]; ++f) {
     uint on_s;
     if (tcc_owned_sface(tet_nbr, labels, use_labels, (int)t, f, &on_s)) mask |= 1u << f;
   }
@@ -27,19 +27,19 @@ __kernel void sguard_applied_smask(uint nt, __global const int* tet_nbr, __globa
  * faces through x of the tets of ring(x) U ring(y) that are left (the two rings share only the
  * removed tets). The body (the variadic rest) sees the tet t_ and the face f_
  * (sguard_applied_queries counts them, sguard_applied_tris writes them: one selection for both). */
-#define TCC_SG_FOR_APPLIED_FACES(x, y, ...)                                                             \
-  for (int side_ = 0; side_ < 2; ++side_) {                                                              \
-    int z_ = side_ == 0 ? (x) : (y);                                                                     \
-    for (uint i_ = vt_off[z_]; i_ < vt_off[z_ + 1]; ++i_) {                                              \
-      int t_ = vt[i_];                                                                                   \
-      uint m_ = smask[t_];                                                                               \
-      if (tdead[t_] || !m_) continue;                                                                    \
-      int l_ = tcc_local(tets, t_, (x));                                                                 \
-      for (int f_ = 0; f_ < 4; ++f_) {                                                                   \
-        if (f_ == l_ || !(m_ & (1u << f_))) continue;                                                    \
-        __VA_ARGS__                                                                                      \
-      }                                                                                                  \
-    }                                                                                                    \
+#define TCC_SG_FOR_APPLIED_FACES(x, y, ...)                 \
+  for (int side_ = 0; side_ < 2; ++side_) {                 \
+    int z_ = side_ == 0 ? (x) : (y);                        \
+    for (uint i_ = vt_off[z_]; i_ < vt_off[z_ + 1]; ++i_) { \
+      int t_ = vt[i_];                                      \
+      uint m_ = smask[t_];                                  \
+      if (tets_are_dead[t_] || !m_) continue;               \
+      int l_ = tcc_local(tets, t_, (x));                    \
+      for (int f_ = 0; f_ < 4; ++f_) {                      \
+        if (f_ == l_ || !(m_ & (1u << f_))) continue;       \
+        __VA_ARGS__                                         \
+      }                                                     \
+    }                                                       \
   }
 /* The same with each face's vertices: the body sees id[3] and pos[3]. */
 #define TCC_SG_FOR_APPLIED_TRIS(x, y, id, pos, ...)                                                     \
@@ -52,24 +52,25 @@ __kernel void sguard_applied_smask(uint nt, __global const int* tet_nbr, __globa
   })
 
 /* The applied collapse of edge e: x survives, y was removed. */
-inline void tcc_sg_applied(int e, __global const int* edges, __global const uchar* dir, int* x, int* y) {
-  uint d = dir[e];
+inline void tcc_sg_applied(int e, __global const int* edges, __global const uchar* edges2dir, int* x, int* y) {
+  uint d = edges2dir[e];
   *x = (d & TCC_DIR_REMOVE_V1) ? edges[2 * e] : edges[2 * e + 1];
   *y = (d & TCC_DIR_REMOVE_V1) ? edges[2 * e + 1] : edges[2 * e];
 }
 
 /* Queries of the matching selection: the taken collapses whose survivor is on S, with the number
  * of the S faces through it now (sguard_applied_tris writes them and the box). */
-__kernel void sguard_applied_queries(uint ne, __global const int* edges, __global const uint* fin,
-                                     __global const uchar* dir, __global const int* tets,
-                                     __global const uint* vt_off, __global const int* vt, __global const uchar* tdead,
-                                     __global const uchar* smask, __global const uchar* vflags, __global int* qedge,
-                                     __global uint* qntri, __global uint* qcount, int only_flagged,
-                                     __global const uchar* requery, __global int* qof) {
+__kernel void sguard_applied_queries(uint ne, __global const int* edges, __global const uint* edges_are_final,
+                                     __global const uchar* edges2dir, __global const int* tets,
+                                     __global const uint* vt_off, __global const int* vt,
+                                     __global const uchar* tets_are_dead, __global const uchar* smask,
+                                     __global const uchar* vflags, __global int* qedge, __global uint* qntri,
+                                     __global uint* qcount, int only_flagged, __global const uchar* requery,
+                                     __global int* verts2query) {
   uint e = get_global_id(0);
-  if (e >= ne || !fin[e] || (only_flagged && !requery[e])) return;
+  if (e >= ne || !edges_are_final[e] || (only_flagged && !requery[e])) return;
   int x, y;
-  tcc_sg_applied((int)e, edges, dir, &x, &y);
+  tcc_sg_applied((int)e, edges, edges2dir, &x, &y);
   if (!vflags[x] && !vflags[y]) return; /* S is not touched */
   uint n = 0; /* without their points */
   TCC_SG_FOR_APPLIED_FACES(x, y, { ++n; })
@@ -77,24 +78,23 @@ __kernel void sguard_applied_queries(uint ne, __global const int* edges, __globa
   uint slot = atomic_inc(qcount);
   qedge[slot] = (int)e;
   qntri[slot] = n;
-  qof[x] = (int)slot; /* a vertex survives one collapse at most */
+  verts2query[x] = (int)slot; /* a vertex survives one collapse at most */
 }
-
 
 /* The S faces through the survivor of each query of sguard_applied_queries, at qoff[q] ..
  * qoff[q + 1], and the query's box; qrep: the survivor (the faces through it are the query's
  * own). */
 __kernel void sguard_applied_tris(uint nq, __global const int* qedge, __global const uint* qoff,
-                                  __global const int* edges, __global const uchar* dir, __global const double* pts,
-                                  __global const int* tets, __global const uint* vt_off, __global const int* vt,
-                                  __global const uchar* tdead, __global const uchar* smask, __global int* tid,
-                                  __global double* tpos, __global double* tbox, __global double* tplane,
-                                  __global int* qrep, __global const int* qof, __global int* tmin,
-                                  __global double* qbox) {
+                                  __global const int* edges, __global const uchar* edges2dir,
+                                  __global const double* pts, __global const int* tets, __global const uint* vt_off,
+                                  __global const int* vt, __global const uchar* tets_are_dead,
+                                  __global const uchar* smask, __global int* tid, __global double* tpos,
+                                  __global double* tbox, __global double* tplane, __global int* qrep,
+                                  __global const int* verts2query, __global int* tmin, __global double* qbox) {
   uint qi = get_global_id(0);
   if (qi >= nq) return;
   int x, y;
-  tcc_sg_applied(qedge[qi], edges, dir, &x, &y);
+  tcc_sg_applied(qedge[qi], edges, edges2dir, &x, &y);
   qrep[2 * qi] = x;
   qrep[2 * qi + 1] = -1;
   uint n = qoff[qi];
@@ -103,7 +103,7 @@ __kernel void sguard_applied_tris(uint nq, __global const int* qedge, __global c
   double3 lo = (double3)(INFINITY, INFINITY, INFINITY), hi = -lo;
   TCC_SG_FOR_APPLIED_TRIS(x, y, id, pos, {
     tcc_sg_store_tri(n, id, pos, tid, tpos, tbox, tplane);
-    tmin[n] = tcc_sg_first_survivor(id, qof);
+    tmin[n] = tcc_sg_first_survivor(id, verts2query);
     ++n;
     for (int k = 0; k < 3; ++k) {
       lo = fmin(lo, pos[k]);
@@ -113,8 +113,6 @@ __kernel void sguard_applied_tris(uint nq, __global const int* qedge, __global c
   __global double* b = qbox + 6 * qi;
   b[0] = lo.x, b[1] = lo.y, b[2] = lo.z, b[3] = hi.x, b[4] = hi.y, b[5] = hi.z;
 }
-
-
 
 /* The refused queries' edges (qbad), flagged and listed, for the matching selection's undo. */
 __kernel void sguard_refused_list(uint nq, __global const int* qedge, __global const uint* qbad,
@@ -133,8 +131,9 @@ __kernel void sguard_refused_list(uint nq, __global const int* qedge, __global c
  * (its new triangles') then meets that box: the next run needs only those queries
  * (sguard_requery flags them, sguard_applied_queries with only_flagged). */
 __kernel void sguard_undone_boxes(uint n, __global const uint* undone, __global const int* edges,
-                                  __global const uchar* dir, __global const uint* nb_off, __global const int* nb,
-                                  __global const int* vaff, __global const double* pts, __global double* boxes) {
+                                  __global const uchar* edges2dir, __global const uint* nb_off, __global const int* nb,
+                                  __global const int* verts2collapse, __global const double* pts,
+                                  __global double* boxes) {
   uint i = get_global_id(0);
   if (i >= n) return;
   const int g = (int)undone[i];
@@ -143,9 +142,9 @@ __kernel void sguard_undone_boxes(uint n, __global const uint* undone, __global 
     const int x = edges[2 * g + s];
     for (uint j = nb_off[x]; j <= nb_off[x + 1]; ++j) { /* N(x), then x */
       int z = j == nb_off[x + 1] ? x : nb[j];
-      const int h = vaff[z];
+      const int h = verts2collapse[z];
       if (h >= 0) { /* an end point of a collapse still taken: where its survivor is */
-        const uint d = dir[h];
+        const uint d = edges2dir[h];
         z = (d & TCC_DIR_REMOVE_V1) ? edges[2 * h] : edges[2 * h + 1];
       }
       const double3 p = tc_point(pts, z);

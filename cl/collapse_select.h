@@ -13,27 +13,27 @@
 /* The mesh a test reads. Every selection but the matching one tests edges on the mesh of the
  * iteration's start (the connectivity as built). The matching selection (collapse_matching.cl)
  * applies its collapses as it takes them: tets are renamed in place, the tets a collapse removes
- * are flagged in tdead[] and tet_nbr is glued across them, and a survivor moves in pts[]. A
+ * are flagged in tets_are_dead[] and tet_nbr is glued across them, and a survivor moves in pts[]. A
  * test of an edge whose star such a collapse changed runs "live" (live = 1): ring(a) and
  * ring(b), which gained no tet (a and b are no end point of a collapse taken), are read without
  * their removed tets, and what the connectivity gives of the star (N(a), N(b), the S-edges,
  * the S flags and classes of a and b, the tets' qualities) is computed from the rings, tet_nbr
  * and the labels as they are now. With live = 0 (a constant at every call site, so the compiler
- * drops the live code) tdead is not read. */
-#define TCC_DEAD(t) (live && tdead[t])
-#define TCC_NO_DEAD ((__global const uchar*)0) /* tdead of the tests that are never live */
+ * drops the live code) tets_are_dead is not read. */
+#define TCC_DEAD(t) (live && tets_are_dead[t])
+#define TCC_NO_DEAD ((__global const uchar*)0) /* tets_are_dead of the tests that are never live */
 
 /* The star the shared tests read (cl/collapse_checks.h): the connectivity of the iteration (ring,
  * tet_nbr), its S flags (vflags, eflags) and points, and, live, the removed tets. */
-#define TCS_LINK_PARAMS                                                                                   \
+#define TCS_LINK_PARAMS                                                                                       \
   __global const int *tets, __global const uint *vt_off, __global const int *vt, __global const int *tet_nbr, \
       __global const int *labels, int use_labels, __global const uchar *vflags, __global const uchar *eflags, \
-      int live, __global const uchar *tdead
-#define TCS_LINK_ARGS tets, vt_off, vt, tet_nbr, labels, use_labels, vflags, eflags, live, tdead
-#define TCS_VOL_PARAMS                                                                                      \
+      int live, __global const uchar *tets_are_dead
+#define TCS_LINK_ARGS tets, vt_off, vt, tet_nbr, labels, use_labels, vflags, eflags, live, tets_are_dead
+#define TCS_VOL_PARAMS                                                                                       \
   __global const int *tets, __global const uint *vt_off, __global const int *vt, __global const double *pts, \
-      __global const double *tet_quality, int live, __global const uchar *tdead
-#define TCS_VOL_ARGS tets, vt_off, vt, pts, tet_quality, live, tdead
+      __global const double *tets2quality, int live, __global const uchar *tets_are_dead
+#define TCS_VOL_ARGS tets, vt_off, vt, pts, tets2quality, live, tets_are_dead
 #define TCS_RING_BEGIN(x) vt_off[x]
 #define TCS_RING_END(x) vt_off[(x) + 1]
 #define TCS_RING_TET(i) vt[i]
@@ -48,8 +48,8 @@
 #define TCS_SEDGE_SKIP(c) (!live && !(vflags[c] & (TCC_BOUNDARY | TCC_INTERFACE)))
 #define TCS_SEDGE(x, c, e) (live ? tcc_ring_sedge(TCS_LINK_ARGS, (x), (c)) : (uint)eflags[e])
 #define TCS_POINT(v) tc_point(pts, (v))
-/* tet_quality holds the qualities of the iteration's start */
-#define TCS_OLD_QUALITY(t, p0, p1, p2, p3) (live ? tc_tet_quality(p0, p1, p2, p3) : tet_quality[t])
+/* tets2quality holds the qualities of the iteration's start */
+#define TCS_OLD_QUALITY(t, p0, p1, p2, p3) (live ? tc_tet_quality(p0, p1, p2, p3) : tets2quality[t])
 
 /* The link condition and the volume test themselves: shared with the sequential CPU method. */
 #include "collapse_checks.h"
@@ -59,12 +59,12 @@
 
 /* The volume test (and the quality guard) of the edge (a, b), a < b, which passed Q with the
  * direction bits dir: TCC_OK, TCC_REFUSED_VOLUME or TCC_REFUSED_QUALITY. Live (see the top):
- * without the removed tets, and the qualities before computed here (tet_quality holds those of
+ * without the removed tets, and the qualities before computed here (tets2quality holds those of
  * the iteration's start). */
 inline uchar tcc_volume_test(int a, int b, int dir, __global const int* tets, __global const uint* vt_off,
                              __global const int* vt, __global const double* pts, __global const double* vfield,
-                             uint vfield_stride, double eps_v, double q_min, __global const double* tet_quality,
-                             int live, __global const uchar* tdead) {
+                             uint vfield_stride, double eps_v, double q_min, __global const double* tets2quality,
+                             int live, __global const uchar* tets_are_dead) {
   double3 p = tcc_placement(pts, vfield, vfield_stride, a, b, (uint)dir);
 #ifdef TCC_USER_PLACEMENT
   /* a user placement may be no point at all (inf, nan: e.g. a division by a zero field
@@ -77,11 +77,11 @@ inline uchar tcc_volume_test(int a, int b, int dir, __global const int* tets, __
 /* Live: N(a) n N(b) from the tets of the rings into cn (at most TCC_MAX_LINK); returns its size,
  * or -1 when a list does not fit. */
 inline int tcc_live_common(int a, int b, __global const int* tets, __global const uint* vt_off, __global const int* vt,
-                           __global const uchar* tdead, int* cn) {
+                           __global const uchar* tets_are_dead, int* cn) {
   int na[TCC_MAX_LINK], nna = 0, ncn = 0;
   for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
     int t = vt[i];
-    if (tdead[t]) continue;
+    if (tets_are_dead[t]) continue;
     __global const int* q = tets + 4 * t;
     for (int k = 0; k < 4; ++k) {
       int v = q[k];
@@ -92,7 +92,7 @@ inline int tcc_live_common(int a, int b, __global const int* tets, __global cons
   }
   for (uint i = vt_off[b]; i < vt_off[b + 1]; ++i) {
     int t = vt[i];
-    if (tdead[t]) continue;
+    if (tets_are_dead[t]) continue;
     __global const int* q = tets + 4 * t;
     for (int k = 0; k < 4; ++k) {
       int v = q[k]; /* a is not in na */
@@ -121,7 +121,7 @@ inline int tcc_live_link_common(TCS_LINK_PARAMS, int a, int b, const int* pc, co
   uint bits[8] = {0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u};
   for (uint i = vt_off[a]; i < vt_off[a + 1]; ++i) {
     const int t = vt[i];
-    if (tdead[t]) continue;
+    if (tets_are_dead[t]) continue;
     const int4 q = vload4(t, tets);
     bits[(q.x >> 5) & 7] |= 1u << (q.x & 31);
     bits[(q.y >> 5) & 7] |= 1u << (q.y & 31);
@@ -130,7 +130,7 @@ inline int tcc_live_link_common(TCS_LINK_PARAMS, int a, int b, const int* pc, co
   }
   for (uint i = vt_off[b]; i < vt_off[b + 1]; ++i) {
     const int t = vt[i];
-    if (tdead[t]) continue;
+    if (tets_are_dead[t]) continue;
     const int4 q4 = vload4(t, tets);
     if ((q4.x == a) | (q4.y == a) | (q4.z == a) | (q4.w == a)) continue; /* a tet of the edge: lk(ab) */
     const int q[4] = {q4.x, q4.y, q4.z, q4.w};
@@ -160,7 +160,7 @@ inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global con
                            __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
                            __global const uint* nb_off, __global const int* nb, __global const int* nb_edge,
                            __global const int* labels, int use_labels, __global const uchar* vflags,
-                           __global const uchar* eflags, int live, __global const uchar* tdead) {
+                           __global const uchar* eflags, int live, __global const uchar* tets_are_dead) {
   /* cn: the common neighbours of a and b, with the edges (a, cn[k]) and (b, cn[k]) (one more
    * slot: the merge writes at ncn before it knows whether it keeps the entry); (pc, pd): the
    * edges of lk(ab), one per tet of the edge */
@@ -190,7 +190,7 @@ inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global con
     const uint ring = vt_off[a + 1] - vt_off[a];
     ncn = ring <= TCC_LIVE_LINK_RING && 3 * ring <= TCC_MAX_LINK
               ? tcc_live_link_common(TCS_LINK_ARGS, a, b, pc, pd, np, p8, d8, cn)
-              : tcc_live_common(a, b, tets, vt_off, vt, tdead, cn);
+              : tcc_live_common(a, b, tets, vt_off, vt, tets_are_dead, cn);
     if (ncn < 0) return TCC_REFUSED_LINK;
   }
   return tcc_link_holds(TCS_LINK_ARGS, a, b, fa, fb, fe, cn, cea, ceb, ncn, pc, pd, np, p8, d8) ? TCC_OK
@@ -201,12 +201,12 @@ inline uchar tcc_link_test(int a, int b, uint fa, uint fb, uint fe, __global con
  * the first refusal. */
 inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int dir, __global const int* tets,
                                  __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
-                                 __global const uint* nb_off,
-                                 __global const int* nb, __global const int* nb_edge, __global const int* labels,
-                                 int use_labels, __global const double* pts, __global const double* vfield,
-                                 uint vfield_stride, __global const uchar* vflags, __global const uchar* eflags,
-                                 double eps_v, double q_min, __global const double* tet_quality) {
-  uchar r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tet_quality, 0,
+                                 __global const uint* nb_off, __global const int* nb, __global const int* nb_edge,
+                                 __global const int* labels, int use_labels, __global const double* pts,
+                                 __global const double* vfield, uint vfield_stride, __global const uchar* vflags,
+                                 __global const uchar* eflags, double eps_v, double q_min,
+                                 __global const double* tets2quality) {
+  uchar r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tets2quality, 0,
                             TCC_NO_DEAD);
   if (r != TCC_OK) return r;
   return tcc_link_test(a, b, fa, fb, fe, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, vflags,
@@ -215,17 +215,16 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
 
 /* The arguments of the lazy filter's test (tcc_lazy_decide), passed down unchanged by the
  * kernels that decide turns: mesh, connectivity, flags, mode, thresholds, and the outputs. */
-#define TCC_TEST_PARAMS                                                                                     \
-  __global const int *tets, __global const uint *vt_off, __global const int *vt, __global const int *tet_nbr, \
-      __global const uint *nb_off, __global const int *nb, __global const int *nb_edge,                       \
-      __global const int *labels, int use_labels, __global const double *pts, __global const double *vfield,  \
-      uint vfield_stride, __global const uchar *vflags, __global const uchar *vclass,                         \
-      __global const uchar *eflags, int mode, int paper_rule, double eps_v,                                   \
-      double q_min, __global const double *tet_quality, __global uchar *edge_dir, __global uchar *reason,     \
-      __global uint *counters, __global uchar *verdict
-#define TCC_TEST_ARGS                                                                                       \
-  tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vfield, vfield_stride, vflags,     \
-      vclass, eflags, mode, paper_rule, eps_v, q_min, tet_quality, edge_dir, reason, counters, verdict
+#define TCC_TEST_PARAMS                                                                                             \
+  __global const int *tets, __global const uint *vt_off, __global const int *vt, __global const int *tet_nbr,       \
+      __global const uint *nb_off, __global const int *nb, __global const int *nb_edge, __global const int *labels, \
+      int use_labels, __global const double *pts, __global const double *vfield, uint vfield_stride,                \
+      __global const uchar *vflags, __global const uchar *vclass, __global const uchar *eflags, int mode,           \
+      int paper_rule, double eps_v, double q_min, __global const double *tets2quality, __global uchar *edges2dir,   \
+      __global uchar *edges2reason, __global uint *counters, __global uchar *edges2verdict
+#define TCC_TEST_ARGS                                                                                             \
+  tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vfield, vfield_stride, vflags, vclass, \
+      eflags, mode, paper_rule, eps_v, q_min, tets2quality, edges2dir, edges2reason, counters, edges2verdict
 
 /* Q's direction bits of the candidate e = (a, b), with the user's placement (tcc_user_dir). */
 inline int tcc_lazy_dir(int e, int a, int b, TCC_TEST_PARAMS) {
@@ -235,102 +234,109 @@ inline int tcc_lazy_dir(int e, int a, int b, TCC_TEST_PARAMS) {
 
 /* The volume test alone (the cheaper part, and the one that refuses most edges) of e = (a, b)
  * in direction dir, unless a verdict is kept (carried from an earlier iteration: the rings of
- * a and b are unchanged since): a new test is counted in counters[4] and kept in verdict[],
+ * a and b are unchanged since): a new test is counted in counters[4] and kept in edges2verdict[],
  * as TCC_VOLUME_OK when it passes (the link condition is then still to run). Returns whether
  * the edge is not refused. */
 inline int tcc_lazy_volume(int e, int a, int b, int dir, TCC_TEST_PARAMS) {
-  uchar r = verdict[e];
+  uchar r = edges2verdict[e];
   if (r == TCC_VERDICT_UNKNOWN) {
-    r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tet_quality, 0,
+    r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tets2quality, 0,
                         TCC_NO_DEAD);
     if (r == TCC_OK) r = TCC_VOLUME_OK;
-    verdict[e] = r;
+    edges2verdict[e] = r;
     atomic_inc(&counters[4]);
   }
   return r == TCC_OK || r == TCC_VOLUME_OK;
 }
 
 /* The verdict of the link and volume tests of e = (a, b) in direction dir: the volume test
- * (tcc_lazy_volume), then the link condition where it passed, the result kept in verdict[]. */
+ * (tcc_lazy_volume), then the link condition where it passed, the result kept in
+ * edges2verdict[]. */
 inline uchar tcc_lazy_verdict(int e, int a, int b, int dir, TCC_TEST_PARAMS) {
-  if (tcc_lazy_volume(e, a, b, dir, TCC_TEST_ARGS) && verdict[e] == TCC_VOLUME_OK)
-    verdict[e] = tcc_link_test(a, b, vflags[a], vflags[b], eflags[e], tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge,
-                               labels, use_labels, vflags, eflags, 0, TCC_NO_DEAD);
-  return verdict[e];
+  if (tcc_lazy_volume(e, a, b, dir, TCC_TEST_ARGS) && edges2verdict[e] == TCC_VOLUME_OK)
+    edges2verdict[e] = tcc_link_test(a, b, vflags[a], vflags[b], eflags[e], tets, vt_off, vt, tet_nbr, nb_off, nb,
+                                     nb_edge, labels, use_labels, vflags, eflags, 0, TCC_NO_DEAD);
+  return edges2verdict[e];
 }
 
-/* slot[v] anew; with slotp (the matching selection), slotp[v] = the slot's priority (INFINITY for
- * none), which its scans compare without loading the edge's. */
+/* verts2slot[v] anew; with verts2slot_priority (the matching selection), verts2slot_priority[v] =
+ * the slot's priority (INFINITY for none), which its scans compare without loading the edge's. */
 inline void tcc_p1_recompute(int v, __global const uint* nb_off, __global const int* nb_edge,
-                             __global const uchar* state, __global const double* cost, __global int* slot,
-                             __global double* slotp) {
-  int m = slot[v];
-  if (m >= 0 && state[m] == TCC_UNDECIDED) return; /* decisions only remove edges: still first */
+                             __global const uchar* edges2state, __global const double* cost, __global int* verts2slot,
+                             __global double* verts2slot_priority) {
+  int m = verts2slot[v];
+  if (m >= 0 && edges2state[m] == TCC_UNDECIDED) return; /* decisions only remove edges: still first */
   m = -1;
   for (uint j = nb_off[v]; j < nb_off[v + 1]; ++j) {
     int g = nb_edge[j];
-    if (state[g] == TCC_UNDECIDED && (m < 0 || tcc_before(cost, g, m))) m = g;
+    if (edges2state[g] == TCC_UNDECIDED && (m < 0 || tcc_before(cost, g, m))) m = g;
   }
-  slot[v] = m;
-  if (slotp) slotp[v] = m >= 0 ? cost[m] : INFINITY;
+  verts2slot[v] = m;
+  if (verts2slot_priority) verts2slot_priority[v] = m >= 0 ? cost[m] : INFINITY;
 }
 
-/* Appends e to a turn list (tlist, its length *tn) unless it is there already: queued[e] holds
- * the stamp of the last list e went to. Returns whether it appended. */
-inline int tcc_queue_once(int e, volatile __global uint* queued, uint stamp, __global uint* tlist, __global uint* tn) {
-  if (atomic_xchg(queued + e, stamp) == stamp) return 0;
+/* Appends e to a turn list (tlist, its length *tn) unless it is there already: edges2queued[e]
+ * holds the stamp of the last list e went to. Returns whether it appended. */
+inline int tcc_queue_once(int e, volatile __global uint* edges2queued, uint stamp, __global uint* tlist,
+                          __global uint* tn) {
+  if (atomic_xchg(edges2queued + e, stamp) == stamp) return 0;
   tlist[atomic_inc(tn)] = (uint)e;
   return 1;
 }
 
 /* Waiting lists of the greedy and matching selections (StageParams::waiting_lists): an edge e
- * whose blocker, an edge before it, is slot[z] for a z within reach waits on z's list (whead[z],
- * then wnext) instead of going to every next turn list until the blocker decides. slot[z]
- * changes only when its edge decides, and then z is listed (tcc_refused_ends, match_apply,
- * greedy_block), so tcc_p1_turn wakes the list in the vertex part of the round in which the
- * blocker decided: e is in the next turn list, the first in which it would have found its
- * blocker decided. The same rounds and decisions, fewer visits (without the lists most
- * turn-list entries of the matching selection only find their blocker undecided). The lists are
- * written in the decisions and read in the vertex part, after them; a woken edge is on no list
- * and is visited before it waits again, so it is on one list at most. */
-inline void tcc_wait_on(int e, int z, __global int* whead, __global int* wnext) {
-  wnext[e] = atomic_xchg(whead + z, e);
+ * whose blocker, an edge before it, is verts2slot[z] for a z within reach waits on z's list
+ * (verts2waiting[z], then edges2next_waiting) instead of going to every next turn list until the
+ * blocker decides. verts2slot[z] changes only when its edge decides, and then z is listed
+ * (tcc_refused_ends, match_apply, greedy_block), so tcc_p1_turn wakes the list in the vertex part
+ * of the round in which the blocker decided: e is in the next turn list, the first in which it
+ * would have found its blocker decided. The same rounds and decisions, fewer visits (without the
+ * lists most turn-list entries of the matching selection only find their blocker undecided). The
+ * lists are written in the decisions and read in the vertex part, after them; a woken edge is on
+ * no list and is visited before it waits again, so it is on one list at most. */
+inline void tcc_wait_on(int e, int z, __global int* verts2waiting, __global int* edges2next_waiting) {
+  edges2next_waiting[e] = atomic_xchg(verts2waiting + z, e);
 }
 
-/* The edges waiting for the slot of v, if any (whead: 0 for the selections without waiting
- * lists), to the next turn list, each once. */
-inline void tcc_wake(int v, __global int* whead, __global const int* wnext, __global uint* tlist, __global uint* tn,
-                     volatile __global uint* queued, uint round) {
-  if (!whead) return;
-  int w = whead[v];
-  whead[v] = -1;
-  for (; w >= 0; w = wnext[w]) tcc_queue_once(w, queued, round, tlist, tn);
+/* The edges waiting for the slot of v, if any (verts2waiting: 0 for the selections without
+ * waiting lists), to the next turn list, each once. */
+inline void tcc_wake(int v, __global int* verts2waiting, __global const int* edges2next_waiting, __global uint* tlist,
+                     __global uint* tn, volatile __global uint* edges2queued, uint round) {
+  if (!verts2waiting) return;
+  int w = verts2waiting[v];
+  verts2waiting[v] = -1;
+  for (; w >= 0; w = edges2next_waiting[w]) tcc_queue_once(w, edges2queued, round, tlist, tn);
 }
 
-inline void tcc_p1_turn(int v, __global const int* edges, __global const int* slot, __global uint* tlist,
-                        __global uint* tn, volatile __global uint* queued, uint round, __global const uchar* verdict,
-                        __global uint* untested, __global int* whead, __global const int* wnext) {
-  tcc_wake(v, whead, wnext, tlist, tn, queued, round);
-  int m = slot[v];
-  if (m < 0 || slot[edges[2 * m]] != m || slot[edges[2 * m + 1]] != m) return;
+inline void tcc_p1_turn(int v, __global const int* edges, __global const int* verts2slot, __global uint* tlist,
+                        __global uint* tn, volatile __global uint* edges2queued, uint round,
+                        __global const uchar* edges2verdict, __global uint* untested, __global int* verts2waiting,
+                        __global const int* edges2next_waiting) {
+  tcc_wake(v, verts2waiting, edges2next_waiting, tlist, tn, edges2queued, round);
+  int m = verts2slot[v];
+  if (m < 0 || verts2slot[edges[2 * m]] != m || verts2slot[edges[2 * m + 1]] != m) return;
   /* not when listed from its other end point */
-  if (tcc_queue_once(m, queued, round, tlist, tn) && verdict[m] == TCC_VERDICT_UNKNOWN) atomic_inc(untested);
+  if (tcc_queue_once(m, edges2queued, round, tlist, tn) && edges2verdict[m] == TCC_VERDICT_UNKNOWN)
+    atomic_inc(untested);
 }
 
 /* The vertex part of a round run in one work-group (lazy_p1_loop, greedy_loop): the slots of
  * the nd listed vertices anew, then the edges now first at both end points to the next turn
  * list; a barrier after each. */
 inline void tcc_p1_vertex_part(uint nd, __global const uint* dlist, __global const uint* nb_off,
-                               __global const int* nb_edge, __global const uchar* state,
-                               __global const double* order, __global int* slot, __global const int* edges,
-                               __global uint* tnext, __global uint* cnext, volatile __global uint* queued, uint round,
-                               __global const uchar* verdict, __global uint* untested, __global double* slotp,
-                               __global int* whead, __global const int* wnext) {
+                               __global const int* nb_edge, __global const uchar* edges2state,
+                               __global const double* order, __global int* verts2slot, __global const int* edges,
+                               __global uint* tnext, __global uint* cnext, volatile __global uint* edges2queued,
+                               uint round, __global const uchar* edges2verdict, __global uint* untested,
+                               __global double* verts2slot_priority, __global int* verts2waiting,
+                               __global const int* edges2next_waiting) {
   const uint lid = get_local_id(0), ls = get_local_size(0);
-  for (uint i = lid; i < nd; i += ls) tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, state, order, slot, slotp);
+  for (uint i = lid; i < nd; i += ls)
+    tcc_p1_recompute((int)dlist[i], nb_off, nb_edge, edges2state, order, verts2slot, verts2slot_priority);
   barrier(CLK_GLOBAL_MEM_FENCE);
   for (uint i = lid; i < nd; i += ls)
-    tcc_p1_turn((int)dlist[i], edges, slot, tnext, cnext, queued, round + 1, verdict, untested, whead, wnext);
+    tcc_p1_turn((int)dlist[i], edges, verts2slot, tnext, cnext, edges2queued, round + 1, edges2verdict, untested,
+                verts2waiting, edges2next_waiting);
   barrier(CLK_GLOBAL_MEM_FENCE);
 }
 
@@ -363,17 +369,18 @@ inline int tcc_loop_next(uint* n, int* cur, uint* round, uint max_n, __global ui
  * fetched: five items ahead the edge's end points, four ahead their entries of vt_off, three ahead
  * the rings' lists (two lines each), two ahead the rings' tets, one ahead their points (the lists
  * and the offsets get steps of their own: loaded in the step of what they index, they stalled this
- * function). In match_decide (tdead non-null) also, two items ahead, tdead of each tet and, at an
- * end point on S (vflags), its row of tet_nbr, which a live test reads (whether it is live is known
- * only after the blocker scan, so for every item). With the quality guard (q_min > 0), two items
- * ahead each tet's quality at the iteration's start. Each of these loads pays on a CPU device
- * (measured in bench/README.md). Prefetches change no result: they write
+ * function). In match_decide (tets_are_dead non-null) also, two items ahead, tets_are_dead of each
+ * tet and, at an end point on S (vflags), its row of tet_nbr, which a live test reads (whether it
+ * is live is known only after the blocker scan, so for every item). With the quality guard
+ * (q_min > 0), two items ahead each tet's quality at the iteration's start. Each of these loads
+ * pays on a CPU device (measured in bench/README.md). Prefetches change no result: they write
  * nothing, and every load here reads what the items' own work may read, in a launch that does
  * not write it. */
 inline void tcc_prefetch_test(uint i, uint n, __global const uint* tlist, __global const int* edges,
                               __global const uint* vt_off, __global const int* vt, __global const int* tets,
-                              __global const double* pts, __global const uchar* tdead, __global const int* tet_nbr,
-                              __global const uchar* vflags, double q_min, __global const double* tet_quality) {
+                              __global const double* pts, __global const uchar* tets_are_dead,
+                              __global const int* tet_nbr, __global const uchar* vflags, double q_min,
+                              __global const double* tets2quality) {
   if (i + 5 < n) __builtin_prefetch(edges + 2 * tlist[i + 5]);
   if (i + 4 < n) {
     int e4 = (int)tlist[i + 4];
@@ -391,13 +398,13 @@ inline void tcc_prefetch_test(uint i, uint n, __global const uint* tlist, __glob
     int e2 = (int)tlist[i + 2];
     for (int s = 0; s < 2; ++s) {
       int x = edges[2 * e2 + s];
-      const int on_s = tdead && vflags[x];
+      const int on_s = tets_are_dead && vflags[x];
       for (uint k = vt_off[x]; k < vt_off[x + 1]; ++k) {
         const int t = vt[k];
         __builtin_prefetch(tets + 4 * t);
-        if (tdead) __builtin_prefetch(tdead + t);
+        if (tets_are_dead) __builtin_prefetch(tets_are_dead + t);
         if (on_s) __builtin_prefetch(tet_nbr + 4 * t);
-        if (q_min > 0.0) __builtin_prefetch(tet_quality + t);
+        if (q_min > 0.0) __builtin_prefetch(tets2quality + t);
       }
     }
   }
@@ -425,31 +432,34 @@ inline void tcc_prefetch_test(uint i, uint n, __global const uint* tlist, __glob
  * entries of it taken, ran no faster on two cores than on one). */
 inline uint tcc_spread_index(void) { return (uint)(get_local_id(0) * get_num_groups(0) + get_group_id(0)); }
 
-inline void tcc_greedy_list_vertex(int v, volatile __global uint* vstamp, uint round, __global uint* dlist,
+inline void tcc_greedy_list_vertex(int v, volatile __global uint* verts2listed, uint round, __global uint* dlist,
                                    __global uint* dn) {
-  if (atomic_xchg(vstamp + v, round) != round) dlist[atomic_inc(dn)] = (uint)v;
+  if (atomic_xchg(verts2listed + v, round) != round) dlist[atomic_inc(dn)] = (uint)v;
 }
 
 /* The tails of the greedy and matching decisions: a refused edge (a, b) lists both end points,
  * whose slots need their next edge; a waiting edge e goes to the next turn list once. */
-inline void tcc_refused_ends(int a, int b, volatile __global uint* vstamp, uint round, __global uint* dlist,
+inline void tcc_refused_ends(int a, int b, volatile __global uint* verts2listed, uint round, __global uint* dlist,
                              __global uint* dn) {
-  tcc_greedy_list_vertex(a, vstamp, round, dlist, dn);
-  tcc_greedy_list_vertex(b, vstamp, round, dlist, dn);
+  tcc_greedy_list_vertex(a, verts2listed, round, dlist, dn);
+  tcc_greedy_list_vertex(b, verts2listed, round, dlist, dn);
 }
-inline void tcc_requeue(int e, volatile __global uint* queued, uint round, __global uint* tnext, __global uint* tn) {
-  tcc_queue_once(e, queued, round + 1, tnext, tn);
+inline void tcc_requeue(int e, volatile __global uint* edges2queued, uint round, __global uint* tnext,
+                        __global uint* tn) {
+  tcc_queue_once(e, edges2queued, round + 1, tnext, tn);
 }
 
 /* The waiting edge e of the greedy and matching selections (tcc_greedy_decide, tcc_match_decide),
- * whose blocker is slot[fz] (fz -1: the blocker found at an earlier visit, still undecided): on
- * fz's waiting list, woken when slot[fz] decides (tcc_wake), or without waiting lists (whead 0)
- * in the next turn list. With the lists fz is not expected to be -1 (an edge is on a list until
- * its blocker decides); the turn list is then the correct fallback. */
-inline void tcc_wait(int e, int fz, __global int* whead, __global int* wnext, volatile __global uint* queued,
-                     uint round, __global uint* tnext, __global uint* tn) {
-  if (whead && fz >= 0) tcc_wait_on(e, fz, whead, wnext);
-  else tcc_requeue(e, queued, round, tnext, tn);
+ * whose blocker is verts2slot[fz] (fz -1: the blocker found at an earlier visit, still undecided):
+ * on fz's waiting list, woken when verts2slot[fz] decides (tcc_wake), or without waiting lists
+ * (verts2waiting 0) in the next turn list. With the lists fz is not expected to be -1 (an edge is
+ * on a list until its blocker decides); the turn list is then the correct fallback. */
+inline void tcc_wait(int e, int fz, __global int* verts2waiting, __global int* edges2next_waiting,
+                     volatile __global uint* edges2queued, uint round, __global uint* tnext, __global uint* tn) {
+  if (verts2waiting && fz >= 0)
+    tcc_wait_on(e, fz, verts2waiting, edges2next_waiting);
+  else
+    tcc_requeue(e, edges2queued, round, tnext, tn);
 }
 
 #endif

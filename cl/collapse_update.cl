@@ -13,37 +13,39 @@
  * The matching selection (collapse_matching.cl) glues tet_nbr as it applies its collapses, so
  * with in_place tet_nbr_update only renumbers.
  * Inputs are those of collapse_compact.cl before the swap: previous tets, rings (vt_off, vt,
- * ascending), tet_nbr, vaff and edge_dir of the final edges, keep flags and new indices. */
+ * ascending), tet_nbr, verts2collapse and edges2dir of the final edges, keep flags and new
+ * indices. */
 #include "collapse_common.h"
 
 /* The vertex removed onto kept vertex v, or -1. */
-inline int tcc_removed_onto(__global const int* vaff, __global const int* edges, int v) {
-  int e = vaff[v];
+inline int tcc_removed_onto(__global const int* verts2collapse, __global const int* edges, int v) {
+  int e = verts2collapse[v];
   if (e < 0) return -1;
   return edges[2 * e] == v ? edges[2 * e + 1] : edges[2 * e];
 }
 
 __kernel void ring_update_count(uint nv_prev, __global const uint* vkeep, __global const uint* vnew,
-                                __global const int* vaff, __global const int* edges, __global const uint* vt_off,
-                                __global const int* vt, __global const uint* tkeep, __global uint* count) {
+                                __global const int* verts2collapse, __global const int* edges,
+                                __global const uint* vt_off, __global const int* vt, __global const uint* tkeep,
+                                __global uint* count) {
   uint v = get_global_id(0);
   if (v >= nv_prev || !vkeep[v]) return;
   uint n = 0;
   for (uint i = vt_off[v]; i < vt_off[v + 1]; ++i) n += tkeep[vt[i]];
-  int u = tcc_removed_onto(vaff, edges, (int)v);
+  int u = tcc_removed_onto(verts2collapse, edges, (int)v);
   if (u >= 0)
     for (uint i = vt_off[u]; i < vt_off[u + 1]; ++i) n += tkeep[vt[i]];
   count[vnew[v]] = n;
 }
 
 __kernel void ring_update_write(uint nv_prev, __global const uint* vkeep, __global const uint* vnew,
-                                __global const int* vaff, __global const int* edges, __global const uint* vt_off,
-                                __global const int* vt, __global const uint* tkeep, __global const uint* tnew,
-                                __global const uint* new_vt_off, __global int* new_vt) {
+                                __global const int* verts2collapse, __global const int* edges,
+                                __global const uint* vt_off, __global const int* vt, __global const uint* tkeep,
+                                __global const uint* tnew, __global const uint* new_vt_off, __global int* new_vt) {
   uint v = get_global_id(0);
   if (v >= nv_prev || !vkeep[v]) return;
   __global int* out = new_vt + new_vt_off[vnew[v]];
-  int u = tcc_removed_onto(vaff, edges, (int)v);
+  int u = tcc_removed_onto(verts2collapse, edges, (int)v);
   uint i = vt_off[v], ie = vt_off[v + 1];
   uint j = u >= 0 ? vt_off[u] : 0u, je = u >= 0 ? vt_off[u + 1] : 0u;
   uint m = 0;
@@ -56,7 +58,7 @@ __kernel void ring_update_write(uint nv_prev, __global const uint* vkeep, __glob
 }
 
 __kernel void tet_nbr_update(uint nt_prev, __global const int* tets, __global const uint* tkeep,
-                             __global const uint* tnew, __global const int* vaff, __global const int* edges,
+                             __global const uint* tnew, __global const int* verts2collapse, __global const int* edges,
                              __global const int* tet_nbr, __global int* new_tet_nbr, int in_place) {
   uint t = get_global_id(0);
   if (t >= nt_prev || !tkeep[t]) return;
@@ -70,7 +72,7 @@ __kernel void tet_nbr_update(uint nt_prev, __global const int* tets, __global co
       /* x = (u, s, c, d) was dropped by the final edge of its vertices; t holds one of u, s */
       __global const int* q = tets + 4 * x;
       int e = -1;
-      for (int k = 0; k < 4 && e < 0; ++k) e = vaff[q[k]];
+      for (int k = 0; k < 4 && e < 0; ++k) e = verts2collapse[q[k]];
       int a = edges[2 * e], b = edges[2 * e + 1];
       int mine = tcc_has(tets, (int)t, a) ? a : b;
       int y = tet_nbr[4 * x + tcc_local(tets, x, mine)];

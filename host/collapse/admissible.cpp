@@ -18,7 +18,7 @@ const cl::Buffer& tet_qualities(Context& ctx, DeviceMesh& dm, const Connectivity
   if (q.quality_generation == c.generation && q.tets2quality.size() == dm.nt) return q.tets2quality.buffer();
   const cl_int only_missing = q.quality_carried && q.tets2quality.size() == dm.nt ? 1 : 0;
   ensure(q.tets2quality, ctx, dm.nt);
-  run(ctx, "collapse_admissible.cl", "tet_quality", dm.nt, arg("nt", dm.nt), arg("tets", dm.tets), arg("pts", dm.points), arg("quality", q.tets2quality), arg("only_missing", only_missing));
+  run(ctx, "collapse_admissible.cl", "tet_quality", dm.nt, arg("nt", dm.nt), arg("tets", dm.tets), arg("pts", dm.points), arg("tets2quality", q.tets2quality), arg("only_missing", only_missing));
   q.quality_carried = false;
   q.quality_generation = c.generation;
   return q.tets2quality.buffer();
@@ -30,7 +30,7 @@ uint32_t admissible(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
   ensure(s.result.edges2dir, ctx, c.ne);
   ensure(s.result.edges2reason, ctx, c.ne);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
-  run_stage(ctx, p, "collapse_admissible.cl", "admissible", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("marked", s.cost.edges_are_marked), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("labels", dm.primary_labels()), arg("use_labels", use_labels), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("vflags", c.vflags), arg("vclass", c.vclass), arg("eflags", c.eflags), arg("mode", p.mode), arg("paper_rule", p.paper_rule ? 1 : 0), arg("eps_v", p.eps_v), arg("q_min", p.min_quality), arg("tet_quality", tet_qualities(ctx, dm, c, s.quality, p)), arg("adm", s.result.edges_are_admissible), arg("edge_dir", s.result.edges2dir), arg("reason", s.result.edges2reason), arg("counters", s.cost.counters));
+  run_stage(ctx, p, "collapse_admissible.cl", "admissible", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("edges_are_marked", s.cost.edges_are_marked), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("labels", dm.primary_labels()), arg("use_labels", use_labels), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("vflags", c.vflags), arg("vclass", c.vclass), arg("eflags", c.eflags), arg("mode", p.mode), arg("paper_rule", p.paper_rule ? 1 : 0), arg("eps_v", p.eps_v), arg("q_min", p.min_quality), arg("tets2quality", tet_qualities(ctx, dm, c, s.quality, p)), arg("edges_are_admissible", s.result.edges_are_admissible), arg("edges2dir", s.result.edges2dir), arg("edges2reason", s.result.edges2reason), arg("counters", s.cost.counters));
   return read_counter(s.cost, 1);
 }
 

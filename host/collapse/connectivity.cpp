@@ -46,14 +46,14 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   const cl::Buffer& vm = cy ? s->compact.prev_verts2new.buffer() : c.count.buffer();
   const cl::Buffer& pno = cy ? s->carry.prev_nb_off.buffer() : c.count.buffer();
   const cl::Buffer& pnb = cy ? s->carry.prev_nb.buffer() : c.count.buffer();
-  run(ctx, F, "conn_ring_sort_and_gather", nv, arg("tets", dm.tets), arg("nv", nv), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("scratch", c.scratch), arg("nb_count", c.count), arg("up_count", c.up_count), arg("sort", cl_int(sorted ? 0 : 1)), arg("carry", ci), arg("ndirty", nd), arg("vold", vo), arg("vmap", vm), arg("prev_nb_off", pno), arg("prev_nb", pnb), arg("rename", cl_int(updated ? 1 : 0)), arg("prev_vaff", updated ? s->result.verts2collapse.buffer() : c.count.buffer()));
+  run(ctx, F, "conn_ring_sort_and_gather", nv, arg("tets", dm.tets), arg("nv", nv), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("scratch", c.scratch), arg("nb_count", c.count), arg("up_count", c.up_count), arg("sort", cl_int(sorted ? 0 : 1)), arg("carry", ci), arg("verts_are_dirty", nd), arg("verts2prev", vo), arg("prev_verts2new", vm), arg("prev_nb_off", pno), arg("prev_nb", pnb), arg("rename", cl_int(updated ? 1 : 0)), arg("prev_verts2collapse", updated ? s->result.verts2collapse.buffer() : c.count.buffer()));
   uint32_t nnb = scan_offsets(ctx, c.count, c.nb_off, nv);
   c.ne = scan_offsets(ctx, c.up_count, c.edge_off, nv);
   ensure(c.nb, ctx, nnb);
   ensure(c.nb_edge, ctx, nnb);
   ensure(c.edges, ctx, size_t(c.ne) * 2);
   run(ctx, F, "conn_write_neighbours", nv, arg("nv", nv), arg("vt_off", c.vt_off), arg("scratch", c.scratch), arg("nb_off", c.nb_off), arg("edge_off", c.edge_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("edges", c.edges));
-  run(ctx, F, "conn_lower_edges", nv, arg("nv", nv), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("edge_off", c.edge_off), arg("nb_edge", c.nb_edge), arg("carry", ci), arg("ndirty", nd), arg("vold", vo), arg("prev_nb_off", pno), arg("prev_edge_off", cy ? s->carry.prev_edge_off.buffer() : c.count.buffer()), arg("prev_nb_edge", cy ? s->carry.prev_nb_edge.buffer() : c.count.buffer()));
+  run(ctx, F, "conn_lower_edges", nv, arg("nv", nv), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("edge_off", c.edge_off), arg("nb_edge", c.nb_edge), arg("carry", ci), arg("verts_are_dirty", nd), arg("verts2prev", vo), arg("prev_nb_off", pno), arg("prev_edge_off", cy ? s->carry.prev_edge_off.buffer() : c.count.buffer()), arg("prev_nb_edge", cy ? s->carry.prev_nb_edge.buffer() : c.count.buffer()));
   ensure(c.eflags, ctx, c.ne);
   ensure(c.vflags, ctx, nv);
   ensure(c.vclass, ctx, nv);
@@ -69,7 +69,7 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   if (updated) {
     // c.tet_nbr taken over above
   } else if (cy) {
-    run(ctx, F, "conn_tet_neighbours_carry", nt, arg("nt", nt), arg("tets", dm.tets), arg("tet_nbr", c.tet_nbr), arg("ndirty", nd), arg("told", to), arg("tnew", tn), arg("prev_tet_nbr", pt));
+    run(ctx, F, "conn_tet_neighbours_carry", nt, arg("nt", nt), arg("tets", dm.tets), arg("tet_nbr", c.tet_nbr), arg("verts_are_dirty", nd), arg("tets2prev", to), arg("prev_tets2new", tn), arg("prev_tet_nbr", pt));
     // the full matching only for the dirty vertices
     ensure(c.dirty_list, ctx, nv);
     const uint32_t nd_count = dev::compact_indices(ctx, s->carry.verts_are_dirty_words, c.dirty_list, nv);
@@ -84,7 +84,7 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   c.generation = ++generations;
   run(ctx, F, "conn_vertex_flags_faces", nt, arg("nt", nt), arg("tets", dm.tets), arg("tet_nbr", c.tet_nbr), arg("labels", dm.primary_labels()), arg("use_labels", use_labels), arg("bits", c.up_count), arg("owns_s", c.owns_s), arg("smask", c.smask));
   run(ctx, F, "conn_vertex_flags", nv, arg("nv", nv), arg("bits", c.up_count), arg("vflags", c.vflags));
-  run(ctx, F, "conn_surface_flags", nv, arg("nv", nv), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("labels", dm.primary_labels()), arg("use_labels", use_labels), arg("pts", dm.points), arg("eps_r", p.eps_r), arg("eps_f", p.eps_f), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("edge_off", c.edge_off), arg("vflags", c.vflags), arg("smask", c.smask), arg("eflags", c.eflags), arg("vclass", c.vclass), arg("carry", ci), arg("ndirty", nd), arg("vold", vo), arg("prev_nb_off", pno), arg("prev_nb", pnb), arg("prev_nb_edge", pne), arg("prev_eflags", pef), arg("prev_vclass", pvc));
+  run(ctx, F, "conn_surface_flags", nv, arg("nv", nv), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("labels", dm.primary_labels()), arg("use_labels", use_labels), arg("pts", dm.points), arg("eps_r", p.eps_r), arg("eps_f", p.eps_f), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("edge_off", c.edge_off), arg("vflags", c.vflags), arg("smask", c.smask), arg("eflags", c.eflags), arg("vclass", c.vclass), arg("carry", ci), arg("verts_are_dirty", nd), arg("verts2prev", vo), arg("prev_nb_off", pno), arg("prev_nb", pnb), arg("prev_nb_edge", pne), arg("prev_eflags", pef), arg("prev_vclass", pvc));
 }
 
 }  // namespace tc::collapse_detail

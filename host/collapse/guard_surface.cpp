@@ -65,7 +65,7 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
   qcount.fill(0u);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
   const cl::Buffer& labels = dm.labels[0].buffer();
-  launch(ctx, p, "sguard_queries", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("fin", s.result.edges_are_final), arg("dir", s.result.edges2dir), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("labels", labels), arg("use_labels", use_labels), arg("vflags", c.vflags), arg("qedge", qedge), arg("qbox", qbox), arg("qntri", qntri), arg("qcount", qcount));
+  launch(ctx, p, "sguard_queries", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("edges_are_final", s.result.edges_are_final), arg("edges2dir", s.result.edges2dir), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("labels", labels), arg("use_labels", use_labels), arg("vflags", c.vflags), arg("qedge", qedge), arg("qbox", qbox), arg("qntri", qntri), arg("qcount", qcount));
   uint32_t nq = 0;
   qcount.download(&nq, 1);
   last_queries = nq;
@@ -73,14 +73,14 @@ uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
 
   // the new triangles of each query, stored once (offsets by a scan of their counts)
   reserve_triangles(ctx, nq, query_offsets(ctx, nq));
-  launch(ctx, p, "sguard_tris", nq, arg("nq", nq), arg("qedge", qedge), arg("qoff", qoff), arg("edges", c.edges), arg("dir", s.result.edges2dir), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("labels", labels), arg("use_labels", use_labels), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("qrep", qrep));
+  launch(ctx, p, "sguard_tris", nq, arg("nq", nq), arg("qedge", qedge), arg("qoff", qoff), arg("edges", c.edges), arg("edges2dir", s.result.edges2dir), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("labels", labels), arg("use_labels", use_labels), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("qrep", qrep));
   // the tets owning an S face (conn_vertex_flags_faces), listed once per connectivity
   if (stets_generation != c.generation) {
     ensure_nonempty(stets, ctx, dm.nt);
     n_stets = dev::compact_indices(ctx, c.owns_s, stets, dm.nt);
     stets_generation = c.generation;
   }
-  ensure_nonempty(qof, ctx, 1);  // passed, not read (each pair once is for run_applied)
+  ensure_nonempty(verts2query, ctx, 1);  // passed, not read (each pair once is for run_applied)
   ensure_nonempty(tmin, ctx, 1);
   return test_queries(ctx, dm, c, s, p, chosen, nq, c.smask, stets, n_stets, false);
 }
@@ -94,7 +94,7 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   ensure_nonempty(applied_owns_s, ctx, dm.nt);
   ensure_nonempty(applied_smask, ctx, dm.nt);
   const cl_int use_labels = dm.has_labels && p.use_labels ? 1 : 0;
-  launch(ctx, p, "sguard_applied_smask", dm.nt, arg("nt", dm.nt), arg("tet_nbr", c.tet_nbr), arg("labels", dm.labels[0]), arg("use_labels", use_labels), arg("tdead", s.result.tets_are_dead), arg("owns_s", applied_owns_s), arg("smask", applied_smask));
+  launch(ctx, p, "sguard_applied_smask", dm.nt, arg("nt", dm.nt), arg("tet_nbr", c.tet_nbr), arg("labels", dm.labels[0]), arg("use_labels", use_labels), arg("tets_are_dead", s.result.tets_are_dead), arg("owns_s", applied_owns_s), arg("smask", applied_smask));
   ensure_nonempty(qedge, ctx, chosen);
   ensure_nonempty(qbox, ctx, size_t(chosen) * 6);
   ensure_nonempty(qntri, ctx, chosen);
@@ -103,9 +103,9 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   const bool only = only_requery;
   only_requery = false;
   if (only) ensure_nonempty(requery, ctx, c.ne);  // (filled by restrict_to_undone)
-  ensure_nonempty(qof, ctx, dm.nv);
-  qof.fill(-1);
-  launch(ctx, p, "sguard_applied_queries", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("fin", s.result.edges_are_final), arg("dir", s.result.edges2dir), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tdead", s.result.tets_are_dead), arg("smask", applied_smask), arg("vflags", c.vflags), arg("qedge", qedge), arg("qntri", qntri), arg("qcount", qcount), arg("only_flagged", cl_int(only ? 1 : 0)), arg("requery", only ? requery.buffer() : applied_smask.buffer()), arg("qof", qof));
+  ensure_nonempty(verts2query, ctx, dm.nv);
+  verts2query.fill(-1);
+  launch(ctx, p, "sguard_applied_queries", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("edges_are_final", s.result.edges_are_final), arg("edges2dir", s.result.edges2dir), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tets_are_dead", s.result.tets_are_dead), arg("smask", applied_smask), arg("vflags", c.vflags), arg("qedge", qedge), arg("qntri", qntri), arg("qcount", qcount), arg("only_flagged", cl_int(only ? 1 : 0)), arg("requery", only ? requery.buffer() : applied_smask.buffer()), arg("verts2query", verts2query));
   uint32_t nq = 0;
   qcount.download(&nq, 1);
   last_queries = nq;
@@ -113,7 +113,7 @@ uint32_t SurfaceGuard::run_applied(Context& ctx, DeviceMesh& dm, Connectivity& c
   const uint32_t ntri = query_offsets(ctx, nq);
   reserve_triangles(ctx, nq, ntri);
   ensure_nonempty(tmin, ctx, ntri);
-  launch(ctx, p, "sguard_applied_tris", nq, arg("nq", nq), arg("qedge", qedge), arg("qoff", qoff), arg("edges", c.edges), arg("dir", s.result.edges2dir), arg("pts", dm.points), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tdead", s.result.tets_are_dead), arg("smask", applied_smask), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("qrep", qrep), arg("qof", qof), arg("tmin", tmin), arg("qbox", qbox));
+  launch(ctx, p, "sguard_applied_tris", nq, arg("nq", nq), arg("qedge", qedge), arg("qoff", qoff), arg("edges", c.edges), arg("edges2dir", s.result.edges2dir), arg("pts", dm.points), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tets_are_dead", s.result.tets_are_dead), arg("smask", applied_smask), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("qrep", qrep), arg("verts2query", verts2query), arg("tmin", tmin), arg("qbox", qbox));
   ensure_nonempty(applied_stets, ctx, dm.nt);
   const uint32_t n_applied = dev::compact_indices(ctx, applied_owns_s, applied_stets, dm.nt);
   return test_queries(ctx, dm, c, s, p, chosen, nq, applied_smask, applied_stets, n_applied, each_pair_once);
@@ -127,7 +127,7 @@ void SurfaceGuard::restrict_to_undone(Context& ctx, DeviceMesh& dm, Connectivity
   ensure_nonempty(undone_list, ctx, nu);
   undone_list.upload(undone.data(), nu);
   ensure_nonempty(undone_boxes, ctx, size_t(nu) * 6);
-  launch(ctx, p, "sguard_undone_boxes", nu, arg("n", nu), arg("undone", undone_list), arg("edges", c.edges), arg("dir", s.result.edges2dir), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("vaff", s.result.verts2collapse), arg("pts", dm.points), arg("boxes", undone_boxes));
+  launch(ctx, p, "sguard_undone_boxes", nu, arg("n", nu), arg("undone", undone_list), arg("edges", c.edges), arg("edges2dir", s.result.edges2dir), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("verts2collapse", s.result.verts2collapse), arg("pts", dm.points), arg("boxes", undone_boxes));
   ensure_nonempty(requery, ctx, c.ne);
   requery.fill(0);
   launch(ctx, p, "sguard_requery", last_queries, arg("nq", last_queries), arg("qedge", qedge), arg("qbox", qbox), arg("nu", nu), arg("boxes", undone_boxes), arg("requery", requery));
@@ -237,11 +237,11 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
   last_run_each_pair_once = each_once;
   ensure_nonempty(vcell, ctx, dm.nv);
   launch(ctx, p, "sguard_vertex_cells", dm.nv, arg("nv", dm.nv), arg("pts", dm.points), arg("ox", cl_double(lo[0])), arg("oy", cl_double(lo[1])), arg("oz", cl_double(lo[2])), arg("ih", cl_double(ih)), arg("gx", cl_int(g[0])), arg("gy", cl_int(g[1])), arg("gz", cl_int(g[2])), arg("vcell", vcell));
-  launch(ctx, p, "sguard_surface", n_sweep, arg("n", n_sweep), arg("stets", sweep_tets), arg("smask", smask), arg("vcell", vcell), arg("pts", dm.points), arg("tets", dm.tets), arg("qrep", qrep), arg("qbox", qbox), arg("qoff", qoff), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("ox", cl_double(lo[0])), arg("oy", cl_double(lo[1])), arg("oz", cl_double(lo[2])), arg("ih", cl_double(ih)), arg("gx", cl_int(g[0])), arg("gy", cl_int(g[1])), arg("gz", cl_int(g[2])), arg("cell_off", cell_off), arg("cell_q", cell_q), arg("qbad", qbad), arg("dedup", dedup), arg("qof", qof), arg("tmin", tmin));
-  launch(ctx, p, "sguard_pairs", nq, arg("nq", nq), arg("qbox", qbox), arg("qoff", qoff), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("ox", cl_double(lo[0])), arg("oy", cl_double(lo[1])), arg("oz", cl_double(lo[2])), arg("ih", cl_double(ih)), arg("gx", cl_int(g[0])), arg("gy", cl_int(g[1])), arg("gz", cl_int(g[2])), arg("cell_off", cell_off), arg("cell_q", cell_q), arg("qbad", qbad), arg("cross", cl_int(s.result.in_place ? 0 : 1)), arg("dedup", dedup), arg("qrep", qrep), arg("qof", qof), arg("tmin", tmin));
+  launch(ctx, p, "sguard_surface", n_sweep, arg("n", n_sweep), arg("stets", sweep_tets), arg("smask", smask), arg("vcell", vcell), arg("pts", dm.points), arg("tets", dm.tets), arg("qrep", qrep), arg("qbox", qbox), arg("qoff", qoff), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("ox", cl_double(lo[0])), arg("oy", cl_double(lo[1])), arg("oz", cl_double(lo[2])), arg("ih", cl_double(ih)), arg("gx", cl_int(g[0])), arg("gy", cl_int(g[1])), arg("gz", cl_int(g[2])), arg("cell_off", cell_off), arg("cell_q", cell_q), arg("qbad", qbad), arg("dedup", dedup), arg("verts2query", verts2query), arg("tmin", tmin));
+  launch(ctx, p, "sguard_pairs", nq, arg("nq", nq), arg("qbox", qbox), arg("qoff", qoff), arg("tid", tid), arg("tpos", tpos), arg("tbox", tbox), arg("tplane", tplane), arg("ox", cl_double(lo[0])), arg("oy", cl_double(lo[1])), arg("oz", cl_double(lo[2])), arg("ih", cl_double(ih)), arg("gx", cl_int(g[0])), arg("gy", cl_int(g[1])), arg("gz", cl_int(g[2])), arg("cell_off", cell_off), arg("cell_q", cell_q), arg("qbad", qbad), arg("cross", cl_int(s.result.in_place ? 0 : 1)), arg("dedup", dedup), arg("qrep", qrep), arg("verts2query", verts2query), arg("tmin", tmin));
   qcount.fill(0u);
   const bool has_verdict = !s.result.in_place && s.carry.edges2verdict.size() >= c.ne && s.carry.edges2verdict.buffer()();
-  launch(ctx, p, "sguard_drop", nq, arg("nq", nq), arg("qedge", qedge), arg("qbad", qbad), arg("marked", s.cost.edges_are_marked), arg("has_verdict", cl_int(has_verdict ? 1 : 0)), arg("verdict", has_verdict ? s.carry.edges2verdict.buffer() : qbad.buffer()), arg("count", qcount));
+  launch(ctx, p, "sguard_drop", nq, arg("nq", nq), arg("qedge", qedge), arg("qbad", qbad), arg("edges_are_marked", s.cost.edges_are_marked), arg("has_verdict", cl_int(has_verdict ? 1 : 0)), arg("edges2verdict", has_verdict ? s.carry.edges2verdict.buffer() : qbad.buffer()), arg("count", qcount));
   uint32_t refused = 0;
   qcount.download(&refused, 1);
   if (kProfile) std::fprintf(stderr, "  surface guard: %u collapses chosen, %u change S, %u refused\n", chosen, nq, refused);

@@ -22,7 +22,7 @@ struct SurfaceGuard {
   DeviceBuffer<int32_t> qrep;                // per query: x, and y when it moves (else -1)
   // run_applied: per vertex, the query whose survivor it is (-1: none); per triangle, the lowest
   // survivor among its vertices (each pair of S faces tested once: cl/collapse_guard.cl)
-  DeviceBuffer<int32_t> qof, tmin;
+  DeviceBuffer<int32_t> verts2query, tmin;
   DeviceBuffer<double> qbox, tpos, tbox, tplane;  // per query: box; per new triangle: positions, box, plane
   DeviceBuffer<uint32_t> qntri, qoff, qcount, qbad, cell_off;
   DeviceBuffer<int32_t> cell_q;  // per grid entry, by cell (cell_off): query, qrep's x, its low cell packed, 0
@@ -68,7 +68,7 @@ struct SurfaceGuard {
   void reserve_triangles(Context& ctx, uint32_t nq, uint32_t ntri);
   // The queries' triangles (tid, ...) against the S faces the n_sweep tets of sweep_tets own
   // (smask) and against each other, through a grid; the queries with a hit are refused. each_once:
-  // each pair once (run_applied, with qof and tmin filled).
+  // each pair once (run_applied, with verts2query and tmin filled).
   uint32_t test_queries(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                         uint32_t chosen, uint32_t nq, DeviceBuffer<uint8_t>& smask, DeviceBuffer<uint32_t>& sweep_tets,
                         uint32_t n_sweep, bool each_once);

@@ -43,8 +43,8 @@ uint32_t conflicts_atomic_min(Context& ctx, DeviceMesh& dm, Connectivity& c, Edg
     collapse_detail::run(ctx, F, name, n, args...);
   };
   run("atomic_min_reset", nt, arg("nt", nt), arg("desc", desc));
-  run("atomic_min_propagate", ne, arg("ne", ne), arg("edges", c.edges), arg("adm", s.result.edges_are_admissible), arg("cost", s.cost.edges2cost), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("idx_bits", k), arg("desc", desc));
-  run("atomic_min_select", ne, arg("ne", ne), arg("edges", c.edges), arg("adm", s.result.edges_are_admissible), arg("cost", s.cost.edges2cost), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("idx_bits", k), arg("desc", desc), arg("fin", s.result.edges_are_final), arg("p1", s.result.edges_pass1), arg("vaff", s.result.verts2collapse), arg("counters", s.cost.counters));
+  run("atomic_min_propagate", ne, arg("ne", ne), arg("edges", c.edges), arg("edges_are_admissible", s.result.edges_are_admissible), arg("edges2cost", s.cost.edges2cost), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("idx_bits", k), arg("desc", desc));
+  run("atomic_min_select", ne, arg("ne", ne), arg("edges", c.edges), arg("edges_are_admissible", s.result.edges_are_admissible), arg("edges2cost", s.cost.edges2cost), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("idx_bits", k), arg("desc", desc), arg("edges_are_final", s.result.edges_are_final), arg("edges_pass1", s.result.edges_pass1), arg("verts2collapse", s.result.verts2collapse), arg("counters", s.cost.counters));
   uint32_t n = 0;
   s.cost.counters.download(&n, 1, 3);
   return n;

@@ -20,9 +20,9 @@ void vertex_part(Context& ctx, EdgeState& s, const Connectivity& c, Kernel& reco
                  bool waiting) {
   uint32_t nd = 0;
   s.lazy.list_counts.download(&nd, 1, 2);
-  recompute.set(arg("n", nd), arg("dlist", s.lazy.vertex_list), arg("nb_off", c.nb_off), arg("nb_edge", c.nb_edge), arg("state", s.result.edges2state), arg("cost", order), arg("slot", s.lazy.verts2slot[0]), arg("slotp", slotp ? slotp->buffer() : order.buffer()), arg("with_slotp", cl_int(slotp ? 1 : 0)));
+  recompute.set(arg("n", nd), arg("dlist", s.lazy.vertex_list), arg("nb_off", c.nb_off), arg("nb_edge", c.nb_edge), arg("edges2state", s.result.edges2state), arg("edges2order", order), arg("verts2slot", s.lazy.verts2slot[0]), arg("verts2slot_priority", slotp ? slotp->buffer() : order.buffer()), arg("with_slotp", cl_int(slotp ? 1 : 0)));
   recompute.launch(ctx, nd);
-  turns.set(arg("n", nd), arg("dlist", s.lazy.vertex_list), arg("edges", c.edges), arg("slot", s.lazy.verts2slot[0]), arg("tlist", s.lazy.turn_lists[1 - cur]), arg("cnt", s.lazy.list_counts), arg("which", cl_uint(1 - cur)), arg("queued", s.lazy.edges2queued), arg("round", round + 1), arg("verdict", s.carry.edges2verdict), arg("waiting", cl_int(waiting ? 1 : 0)), arg("whead", waiting ? s.lazy.verts2waiting.buffer() : s.lazy.verts2slot[0].buffer()), arg("wnext", waiting ? s.lazy.edges2next_waiting.buffer() : s.lazy.verts2slot[0].buffer()));
+  turns.set(arg("n", nd), arg("dlist", s.lazy.vertex_list), arg("edges", c.edges), arg("verts2slot", s.lazy.verts2slot[0]), arg("tlist", s.lazy.turn_lists[1 - cur]), arg("cnt", s.lazy.list_counts), arg("which", cl_uint(1 - cur)), arg("edges2queued", s.lazy.edges2queued), arg("round", round + 1), arg("edges2verdict", s.carry.edges2verdict), arg("waiting", cl_int(waiting ? 1 : 0)), arg("verts2waiting", waiting ? s.lazy.verts2waiting.buffer() : s.lazy.verts2slot[0].buffer()), arg("edges2next_waiting", waiting ? s.lazy.edges2next_waiting.buffer() : s.lazy.verts2slot[0].buffer()));
   turns.launch(ctx, nd);
 }
 
@@ -49,7 +49,7 @@ void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, con
   s.carry.verdict_ready = false;
   ensure(s.lazy.verts2slot[0], ctx, dm.nv);
   s.lazy.verts2slot[0].fill(-1);
-  run_stage(ctx, p, A, "lazy_init", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("marked", s.cost.edges_are_marked), arg("vflags", c.vflags), arg("vclass", c.vclass), arg("eflags", c.eflags), arg("mode", mode), arg("paper_rule", paper_rule), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("state", s.result.edges2state), arg("edge_dir", s.result.edges2dir), arg("reason", s.result.edges2reason), arg("cand", s.lazy.edges_are_candidates), arg("counters", s.cost.counters), arg("restrict_clean", cl_int(restrict_clean ? 1 : 0)), arg("vdirty", restrict_clean ? s.carry.prev_verts_are_dirty.buffer() : c.vflags.buffer()), arg("verdict", s.carry.edges2verdict), arg("cost", order), arg("slot", s.lazy.verts2slot[0]), arg("keep_refused", cl_int(keep_refused ? 1 : 0)));
+  run_stage(ctx, p, A, "lazy_init", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("edges_are_marked", s.cost.edges_are_marked), arg("vflags", c.vflags), arg("vclass", c.vclass), arg("eflags", c.eflags), arg("mode", mode), arg("paper_rule", paper_rule), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("edges2state", s.result.edges2state), arg("edges2dir", s.result.edges2dir), arg("edges2reason", s.result.edges2reason), arg("edges_are_candidates", s.lazy.edges_are_candidates), arg("counters", s.cost.counters), arg("restrict_clean", cl_int(restrict_clean ? 1 : 0)), arg("prev_verts_are_dirty", restrict_clean ? s.carry.prev_verts_are_dirty.buffer() : c.vflags.buffer()), arg("edges2verdict", s.carry.edges2verdict), arg("edges2order", order), arg("verts2slot", s.lazy.verts2slot[0]), arg("keep_refused", cl_int(keep_refused ? 1 : 0)));
   const cl::Buffer& quality = tet_qualities(ctx, dm, c, s.quality, p);
   for (Kernel* k : tests)
     k->set(arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr),
@@ -57,8 +57,8 @@ void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, con
            arg("use_labels", use_labels), arg("pts", dm.points), arg("vfield", dm.vfields),
            arg("vfield_stride", dm.vfield_comps), arg("vflags", c.vflags), arg("vclass", c.vclass),
            arg("eflags", c.eflags), arg("mode", mode), arg("paper_rule", paper_rule), arg("eps_v", p.eps_v),
-           arg("q_min", p.min_quality), arg("tet_quality", quality), arg("edge_dir", s.result.edges2dir), arg("reason", s.result.edges2reason),
-           arg("counters", s.cost.counters), arg("verdict", s.carry.edges2verdict));
+           arg("q_min", p.min_quality), arg("tets2quality", quality), arg("edges2dir", s.result.edges2dir), arg("edges2reason", s.result.edges2reason),
+           arg("counters", s.cost.counters), arg("edges2verdict", s.carry.edges2verdict));
 }
 
 // The priority of the greedy and matching selections: greedy_priority with levels > 0, else the
@@ -66,7 +66,7 @@ void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, con
 const DeviceBuffer<double>& selection_priority(Context& ctx, Connectivity& c, EdgeState& s, const StageParams& p) {
   if (!(p.priority_levels > 0)) return s.cost.edges2cost;
   ensure(s.lazy.edges2priority, ctx, c.ne);
-  run(ctx, "collapse_admissible.cl", "greedy_priority", c.ne, arg("ne", c.ne), arg("cost", s.cost.edges2cost), arg("marked", s.cost.edges_are_marked), arg("target", p.target), arg("levels", p.priority_levels), arg("prio", s.lazy.edges2priority));
+  run(ctx, "collapse_admissible.cl", "greedy_priority", c.ne, arg("ne", c.ne), arg("edges2cost", s.cost.edges2cost), arg("edges_are_marked", s.cost.edges_are_marked), arg("target", p.target), arg("levels", p.priority_levels), arg("edges2priority", s.lazy.edges2priority));
   return s.lazy.edges2priority;
 }
 
@@ -94,7 +94,7 @@ void selection_buffers(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
 uint32_t selection_rounds(Context& ctx, Connectivity& c, EdgeState& s, const StageParams& p, const char* name,
                           const RoundFn& one_round, const RoundFn& loop, uint32_t& passed_q, uint32_t& tested) {
   const std::string A = "collapse_admissible.cl";
-  run(ctx, A, "lazy_p1_first_turns", c.ne, arg("ne", c.ne), arg("cand", s.lazy.edges_are_candidates), arg("edges", c.edges), arg("slot", s.lazy.verts2slot[0]), arg("tlist", s.lazy.turn_lists[0]), arg("cnt", s.lazy.list_counts), arg("verdict", s.carry.edges2verdict));
+  run(ctx, A, "lazy_p1_first_turns", c.ne, arg("ne", c.ne), arg("edges_are_candidates", s.lazy.edges_are_candidates), arg("edges", c.edges), arg("verts2slot", s.lazy.verts2slot[0]), arg("tlist", s.lazy.turn_lists[0]), arg("cnt", s.lazy.list_counts), arg("edges2verdict", s.carry.edges2verdict));
   uint32_t nt = 0;
   s.lazy.list_counts.download(&nt, 1);
   int cur = 0;  // the turn list of this round
@@ -117,7 +117,7 @@ uint32_t selection_rounds(Context& ctx, Connectivity& c, EdgeState& s, const Sta
     }
     profile_line(ctx, name, nt, t0, one_group ? " (one work-group)" : "");
   }
-  run(ctx, A, "greedy_finish", c.ne, arg("ne", c.ne), arg("state", s.result.edges2state), arg("p1", s.result.edges_pass1), arg("fin", s.result.edges_are_final), arg("counters", s.cost.counters));
+  run(ctx, A, "greedy_finish", c.ne, arg("ne", c.ne), arg("edges2state", s.result.edges2state), arg("edges_pass1", s.result.edges_pass1), arg("edges_are_final", s.result.edges_are_final), arg("counters", s.cost.counters));
   uint32_t cnt[6];
   s.cost.counters.download(cnt, 6);
   passed_q = cnt[5];

@@ -28,23 +28,23 @@ uint32_t matching_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeS
   ensure(m.edges2round, ctx, c.ne);
   s.result.tets_are_dead.fill(0);
   for (Kernel* k : {&decide, &apply, &loop})
-    k->set(arg("eps_r", p.eps_r), arg("eps_f", p.eps_f), arg("tdead", s.result.tets_are_dead));
+    k->set(arg("eps_r", p.eps_r), arg("eps_f", p.eps_f), arg("tets_are_dead", s.result.tets_are_dead));
   selection_buffers(ctx, dm, c, s);
   ensure(m.edges_early_tested, ctx, c.ne);
   m.edges_early_tested.fill(p.match_early_tests ? 0 : 1);  // 1: the early test counts as done
   ensure(m.verts2slot_priority, ctx, dm.nv);
-  run(ctx, A, "slot_priority", dm.nv, arg("nv", dm.nv), arg("slot", s.lazy.verts2slot[0]), arg("prio", prio), arg("slotp", m.verts2slot_priority));
+  run(ctx, A, "slot_priority", dm.nv, arg("nv", dm.nv), arg("verts2slot", s.lazy.verts2slot[0]), arg("edges2priority", prio), arg("verts2slot_priority", m.verts2slot_priority));
   const cl_int W = p.waiting_lists ? 1 : 0;
   Kernel recompute = kernel(ctx, A, "lazy_p1_recompute"), turns = kernel(ctx, A, "lazy_p1_turns");
   auto one_round = [&](uint32_t nt, int cur, cl_uint round) {
-    decide.set(arg("n", nt), arg("cur", cl_uint(cur)), arg("tlist", s.lazy.turn_lists[cur]), arg("tnext", s.lazy.turn_lists[1 - cur]), arg("cnt", s.lazy.list_counts), arg("edges", c.edges), arg("prio", prio), arg("slot", s.lazy.verts2slot[0]), arg("slotp", m.verts2slot_priority), arg("blocker", s.lazy.edges2blocker), arg("spec", m.edges_early_tested), arg("dround", m.edges2round), arg("queued", s.lazy.edges2queued), arg("round", round), arg("inlist", s.lazy.round_taken), arg("vstamp", s.lazy.verts2listed), arg("dlist", s.lazy.vertex_list), arg("state", s.result.edges2state), arg("vaff", s.result.verts2collapse), arg("waiting", W), arg("whead", s.lazy.verts2waiting), arg("wnext", s.lazy.edges2next_waiting));
+    decide.set(arg("n", nt), arg("cur", cl_uint(cur)), arg("tlist", s.lazy.turn_lists[cur]), arg("tnext", s.lazy.turn_lists[1 - cur]), arg("cnt", s.lazy.list_counts), arg("edges", c.edges), arg("edges2priority", prio), arg("verts2slot", s.lazy.verts2slot[0]), arg("verts2slot_priority", m.verts2slot_priority), arg("edges2blocker", s.lazy.edges2blocker), arg("edges_early_tested", m.edges_early_tested), arg("edges2round", m.edges2round), arg("edges2queued", s.lazy.edges2queued), arg("round", round), arg("inlist", s.lazy.round_taken), arg("verts2listed", s.lazy.verts2listed), arg("dlist", s.lazy.vertex_list), arg("edges2state", s.result.edges2state), arg("verts2collapse", s.result.verts2collapse), arg("waiting", W), arg("verts2waiting", s.lazy.verts2waiting), arg("edges2next_waiting", s.lazy.edges2next_waiting));
     decide.launch(ctx, nt);
-    apply.set(arg("inlist", s.lazy.round_taken), arg("cnt", s.lazy.list_counts), arg("edges", c.edges), arg("slot", s.lazy.verts2slot[0]), arg("vstamp", s.lazy.verts2listed), arg("round", round), arg("dlist", s.lazy.vertex_list), arg("state", s.result.edges2state), arg("vaff", s.result.verts2collapse), arg("tkill", m.tets2killer));
+    apply.set(arg("inlist", s.lazy.round_taken), arg("cnt", s.lazy.list_counts), arg("edges", c.edges), arg("verts2slot", s.lazy.verts2slot[0]), arg("verts2listed", s.lazy.verts2listed), arg("round", round), arg("dlist", s.lazy.vertex_list), arg("edges2state", s.result.edges2state), arg("verts2collapse", s.result.verts2collapse), arg("tets2killer", m.tets2killer));
     apply.launch(ctx, nt);  // over the round's taken edges (cnt[4] <= nt)
     vertex_part(ctx, s, c, recompute, turns, prio, cur, round, &m.verts2slot_priority, p.waiting_lists);
   };
   auto in_one_group = [&](uint32_t nt, int cur, cl_uint round) {
-    loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.lazy.turn_lists[0]), arg("t1", s.lazy.turn_lists[1]), arg("cnt", s.lazy.list_counts), arg("edges", c.edges), arg("prio", prio), arg("slot", s.lazy.verts2slot[0]), arg("slotp", m.verts2slot_priority), arg("blocker", s.lazy.edges2blocker), arg("spec", m.edges_early_tested), arg("dround", m.edges2round), arg("queued", s.lazy.edges2queued), arg("inlist", s.lazy.round_taken), arg("vstamp", s.lazy.verts2listed), arg("dlist", s.lazy.vertex_list), arg("state", s.result.edges2state), arg("vaff", s.result.verts2collapse), arg("tkill", m.tets2killer), arg("max_n", p.greedy_loop_exit), arg("resume", s.lazy.loop_resume), arg("waiting", W), arg("whead", s.lazy.verts2waiting), arg("wnext", s.lazy.edges2next_waiting));
+    loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.lazy.turn_lists[0]), arg("t1", s.lazy.turn_lists[1]), arg("cnt", s.lazy.list_counts), arg("edges", c.edges), arg("edges2priority", prio), arg("verts2slot", s.lazy.verts2slot[0]), arg("verts2slot_priority", m.verts2slot_priority), arg("edges2blocker", s.lazy.edges2blocker), arg("edges_early_tested", m.edges_early_tested), arg("edges2round", m.edges2round), arg("edges2queued", s.lazy.edges2queued), arg("inlist", s.lazy.round_taken), arg("verts2listed", s.lazy.verts2listed), arg("dlist", s.lazy.vertex_list), arg("edges2state", s.result.edges2state), arg("verts2collapse", s.result.verts2collapse), arg("tets2killer", m.tets2killer), arg("max_n", p.greedy_loop_exit), arg("resume", s.lazy.loop_resume), arg("waiting", W), arg("verts2waiting", s.lazy.verts2waiting), arg("edges2next_waiting", s.lazy.edges2next_waiting));
     loop.launch_one_group(ctx);
   };
   return selection_rounds(ctx, c, s, p, "match_round", one_round, in_one_group, passed_q, tested);
@@ -99,9 +99,9 @@ uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
     // (the list's new part starts at done: marked through an offset sub-range of work[0])
     std::vector<uint32_t> fresh = s.lazy.turn_lists[0].download_range(done, n - done);
     s.lazy.turn_lists[1].upload(fresh.data(), fresh.size());
-    run(ctx, M, "match_undo_reach", fresh.size(), arg("n", fresh.size()), arg("list", s.lazy.turn_lists[1]), arg("edges", c.edges), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("dround", m.edges2round), arg("reachmin", m.verts2first_round));
+    run(ctx, M, "match_undo_reach", fresh.size(), arg("n", fresh.size()), arg("list", s.lazy.turn_lists[1]), arg("edges", c.edges), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("edges2round", m.edges2round), arg("verts2first_round", m.verts2first_round));
     done = n;
-    run(ctx, M, "match_undo_grow", taken, arg("n", taken), arg("taken", s.lazy.candidate_list), arg("edges", c.edges), arg("dround", m.edges2round), arg("reachmin", m.verts2first_round), arg("undo", m.edges_to_undo), arg("list", s.lazy.turn_lists[0]), arg("count", s.lazy.list_counts));
+    run(ctx, M, "match_undo_grow", taken, arg("n", taken), arg("taken", s.lazy.candidate_list), arg("edges", c.edges), arg("edges2round", m.edges2round), arg("verts2first_round", m.verts2first_round), arg("edges_to_undo", m.edges_to_undo), arg("list", s.lazy.turn_lists[0]), arg("count", s.lazy.list_counts));
     s.lazy.list_counts.download(&n, 1);
   }
   // undone in the reverse order of their rounds (then of their index: any order within a round)
@@ -120,7 +120,7 @@ uint32_t matching_undo(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState&
   for (uint32_t i = 0; i < n; ++i) sorted[i] = order[idx[i]];
   s.lazy.turn_lists[1].upload(sorted.data(), n);
   if (undone) *undone = sorted;
-  run(ctx, M, "match_undo", 1, arg("n", n), arg("order", s.lazy.turn_lists[1]), arg("refused", m.edges_are_refused), arg("edges", c.edges), arg("edge_dir", s.result.edges2dir), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("tdead", s.result.tets_are_dead), arg("tkill", m.tets2killer), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("pts0", m.points_before), arg("vfield0", m.vfields_before), arg("vaff", s.result.verts2collapse), arg("state", s.result.edges2state), arg("fin", s.result.edges_are_final), arg("reason", s.result.edges2reason));
+  run(ctx, M, "match_undo", 1, arg("n", n), arg("order", s.lazy.turn_lists[1]), arg("edges_are_refused", m.edges_are_refused), arg("edges", c.edges), arg("edges2dir", s.result.edges2dir), arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr), arg("tets_are_dead", s.result.tets_are_dead), arg("tets2killer", m.tets2killer), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("pts0", m.points_before), arg("vfield0", m.vfields_before), arg("verts2collapse", s.result.verts2collapse), arg("edges2state", s.result.edges2state), arg("edges_are_final", s.result.edges_are_final), arg("edges2reason", s.result.edges2reason));
   return n;
 }
 

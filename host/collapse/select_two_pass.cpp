@@ -68,9 +68,9 @@ void pass1_rounds(Context& ctx, Kernel& decide, EdgeState& s, const Connectivity
   s.lazy.verts2slot[1].fill(-1);
   Kernel claim = kernel(ctx, "collapse_conflict.cl", "pass1_claim");
   auto round = [&](uint32_t m, cl_int first, int cur) {
-    claim.set(arg("n", m), arg("first", first), arg("list", s.lazy.turn_lists[cur]), arg("cand", s.lazy.candidate_list), arg("edges", c.edges), arg("cost", s.cost.edges2cost), arg("vaff", s.result.verts2collapse), arg("slot", s.lazy.verts2slot[cur]), arg("state", s.result.edges2state));
+    claim.set(arg("n", m), arg("first", first), arg("list", s.lazy.turn_lists[cur]), arg("cand", s.lazy.candidate_list), arg("edges", c.edges), arg("edges2cost", s.cost.edges2cost), arg("verts2collapse", s.result.verts2collapse), arg("verts2slot", s.lazy.verts2slot[cur]), arg("edges2state", s.result.edges2state));
     claim.launch(ctx, m);
-    decide.set(arg("n", m), arg("first", first), arg("list", s.lazy.turn_lists[cur]), arg("next", s.lazy.turn_lists[1 - cur]), arg("next_n", s.lazy.list_counts), arg("cand", s.lazy.candidate_list), arg("edges", c.edges), arg("slot", s.lazy.verts2slot[cur]), arg("slot_next", s.lazy.verts2slot[1 - cur]), arg("state", s.result.edges2state), arg("vaff", s.result.verts2collapse));
+    decide.set(arg("n", m), arg("first", first), arg("list", s.lazy.turn_lists[cur]), arg("next", s.lazy.turn_lists[1 - cur]), arg("next_n", s.lazy.list_counts), arg("cand", s.lazy.candidate_list), arg("edges", c.edges), arg("verts2slot", s.lazy.verts2slot[cur]), arg("verts2slot_next", s.lazy.verts2slot[1 - cur]), arg("edges2state", s.result.edges2state), arg("verts2collapse", s.result.verts2collapse));
     decide.launch(ctx, m);
   };
   rounds(ctx, s, n, what, round);
@@ -98,7 +98,7 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, Kernel& d
   s.lazy.edges2queued.fill(0xffffffffu);
   s.lazy.list_counts.fill(0);
   if (n == 0) return;
-  run(ctx, A, "lazy_p1_first_turns", n, arg("ne", n), arg("cand", s.lazy.edges_are_candidates), arg("edges", c.edges), arg("slot", s.lazy.verts2slot[0]), arg("tlist", s.lazy.turn_lists[0]), arg("cnt", s.lazy.list_counts), arg("verdict", s.carry.edges2verdict));
+  run(ctx, A, "lazy_p1_first_turns", n, arg("ne", n), arg("edges_are_candidates", s.lazy.edges_are_candidates), arg("edges", c.edges), arg("verts2slot", s.lazy.verts2slot[0]), arg("tlist", s.lazy.turn_lists[0]), arg("cnt", s.lazy.list_counts), arg("edges2verdict", s.carry.edges2verdict));
   uint32_t cnt[4];
   s.lazy.list_counts.download(cnt, 4);
   uint32_t nt = cnt[0], nu = cnt[3];
@@ -111,7 +111,7 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, Kernel& d
     const bool one_group = nu <= p.loop_tests && nt <= p.loop_turns;
     if (one_group) {
       s.lazy.loop_resume.fill(0);
-      loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.lazy.turn_lists[0]), arg("t1", s.lazy.turn_lists[1]), arg("cnt", s.lazy.list_counts), arg("dlist", s.lazy.vertex_list), arg("queued", s.lazy.edges2queued), arg("edges", c.edges), arg("cost", s.cost.edges2cost), arg("slot", s.lazy.verts2slot[0]), arg("state", s.result.edges2state), arg("vaff", s.result.verts2collapse), arg("max_tests", cl_uint(p.loop_exit_tests)), arg("resume", s.lazy.loop_resume));
+      loop.set(arg("n", nt), arg("cur", cl_int(cur)), arg("round", round), arg("t0", s.lazy.turn_lists[0]), arg("t1", s.lazy.turn_lists[1]), arg("cnt", s.lazy.list_counts), arg("dlist", s.lazy.vertex_list), arg("edges2queued", s.lazy.edges2queued), arg("edges", c.edges), arg("edges2cost", s.cost.edges2cost), arg("verts2slot", s.lazy.verts2slot[0]), arg("edges2state", s.result.edges2state), arg("verts2collapse", s.result.verts2collapse), arg("max_tests", cl_uint(p.loop_exit_tests)), arg("resume", s.lazy.loop_resume));
       loop.launch_one_group(ctx);
       uint32_t r[3];
       s.lazy.loop_resume.download(r, 3);
@@ -120,7 +120,7 @@ void lazy_p1_rounds(Context& ctx, EdgeState& s, const Connectivity& c, Kernel& d
       cur = int(r[1]);
       round = r[2];
     } else {
-      decide.set(arg("n", nt), arg("tlist", s.lazy.turn_lists[cur]), arg("edges", c.edges), arg("state", s.result.edges2state), arg("vaff", s.result.verts2collapse), arg("slot", s.lazy.verts2slot[0]), arg("dlist", s.lazy.vertex_list), arg("cnt", s.lazy.list_counts));
+      decide.set(arg("n", nt), arg("tlist", s.lazy.turn_lists[cur]), arg("edges", c.edges), arg("edges2state", s.result.edges2state), arg("verts2collapse", s.result.verts2collapse), arg("verts2slot", s.lazy.verts2slot[0]), arg("dlist", s.lazy.vertex_list), arg("cnt", s.lazy.list_counts));
       decide.launch(ctx, nt);
       vertex_part(ctx, s, c, recompute, turns, s.cost.edges2cost, cur, round);
       s.lazy.list_counts.download(cnt, 4);
@@ -140,12 +140,12 @@ uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
   ensure(s.result.edges2state, ctx, c.ne);
   ensure(s.result.verts2collapse, ctx, dm.nv);
   s.result.verts2collapse.fill(-1);
-  run(ctx, F, "conflict_init", c.ne, arg("ne", c.ne), arg("adm", s.result.edges_are_admissible), arg("state", s.result.edges2state));
+  run(ctx, F, "conflict_init", c.ne, arg("ne", c.ne), arg("edges_are_admissible", s.result.edges_are_admissible), arg("edges2state", s.result.edges2state));
   ensure(s.lazy.candidate_list, ctx, c.ne);
   const uint32_t n = dev::compact_indices(ctx, s.result.edges_are_admissible, s.lazy.candidate_list, c.ne);
   Kernel decide = kernel(ctx, F, "conflict_pass1_decide");
   pass1_rounds(ctx, decide, s, c, dm.nv, n, "conflict_pass1_decide");
-  run(ctx, F, "conflict_pass1_finish", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("state", s.result.edges2state), arg("p1", s.result.edges_pass1), arg("vaff", s.result.verts2collapse), arg("counters", s.cost.counters));
+  run(ctx, F, "conflict_pass1_finish", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("edges2state", s.result.edges2state), arg("edges_pass1", s.result.edges_pass1), arg("verts2collapse", s.result.verts2collapse), arg("counters", s.cost.counters));
   return read_counter(s.cost, 2);
 }
 
@@ -156,7 +156,7 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
   Kernel decide = stage_kernel(ctx, p, A, "lazy_p1_decide"), loop = stage_kernel(ctx, p, A, "lazy_p1_loop");
   lazy_start(ctx, dm, c, s, p, s.cost.edges2cost, {&decide, &loop}, false, restrict_clean);
   lazy_p1_rounds(ctx, s, c, decide, loop, p);
-  run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("state", s.result.edges2state), arg("p1", s.result.edges_pass1), arg("vaff", s.result.verts2collapse), arg("counters", s.cost.counters));
+  run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("edges2state", s.result.edges2state), arg("edges_pass1", s.result.edges_pass1), arg("verts2collapse", s.result.verts2collapse), arg("counters", s.cost.counters));
   uint32_t cnt[6];
   s.cost.counters.download(cnt, 6);
   passed_q = cnt[5];
@@ -167,24 +167,24 @@ uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, Ed
 uint32_t conflict_pass2(Context& ctx, DeviceMesh&, Connectivity& c, EdgeState& s, TwoPassState& t, uint32_t loop_size) {
   const std::string F = "collapse_conflict.cl";
   ensure(s.result.edges_are_final, ctx, c.ne);
-  run(ctx, F, "conflict_pass2_init", c.ne, arg("ne", c.ne), arg("p1", s.result.edges_pass1), arg("state", s.result.edges2state));
+  run(ctx, F, "conflict_pass2_init", c.ne, arg("ne", c.ne), arg("edges_pass1", s.result.edges_pass1), arg("edges2state", s.result.edges2state));
   const uint32_t n = prepare_candidates(ctx, s, t, s.result.edges_pass1, c.ne);
   Kernel round = kernel(ctx, F, "conflict_pass2_round"), loop = kernel(ctx, F, "conflict_pass2_loop");
-  round.set(arg("edges", c.edges), arg("cost", s.cost.edges2cost), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("vaff", s.result.verts2collapse), arg("state", s.result.edges2state));
-  loop.set(arg("edges", c.edges), arg("cost", s.cost.edges2cost), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("vaff", s.result.verts2collapse), arg("state", s.result.edges2state));
+  round.set(arg("edges", c.edges), arg("edges2cost", s.cost.edges2cost), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("verts2collapse", s.result.verts2collapse), arg("edges2state", s.result.edges2state));
+  loop.set(arg("edges", c.edges), arg("edges2cost", s.cost.edges2cost), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("verts2collapse", s.result.verts2collapse), arg("edges2state", s.result.edges2state));
   // the last rounds (at most loop_size candidates left) in one work-group
   auto tail = [&](uint32_t m, cl_int first, int cur) {
-    loop.set(arg("n", m), arg("first", first), arg("cur", cl_int(cur)), arg("l0", s.lazy.turn_lists[0]), arg("l1", s.lazy.turn_lists[1]), arg("next_n", s.lazy.list_counts), arg("cand", s.lazy.candidate_list), arg("rivals", t.slots2rivals), arg("rcount", t.slots2rival_count));
+    loop.set(arg("n", m), arg("first", first), arg("cur", cl_int(cur)), arg("l0", s.lazy.turn_lists[0]), arg("l1", s.lazy.turn_lists[1]), arg("next_n", s.lazy.list_counts), arg("cand", s.lazy.candidate_list), arg("slots2rivals", t.slots2rivals), arg("slots2rival_count", t.slots2rival_count));
     loop.launch_one_group(ctx);
   };
   rounds(
       ctx, s, n, "conflict_pass2_round",
       [&](uint32_t m, cl_int first, int cur) {
-        round.set(arg("n", m), arg("first", first), arg("list", s.lazy.turn_lists[cur]), arg("next", s.lazy.turn_lists[1 - cur]), arg("next_n", s.lazy.list_counts), arg("cand", s.lazy.candidate_list), arg("rivals", t.slots2rivals), arg("rcount", t.slots2rival_count));
+        round.set(arg("n", m), arg("first", first), arg("list", s.lazy.turn_lists[cur]), arg("next", s.lazy.turn_lists[1 - cur]), arg("next_n", s.lazy.list_counts), arg("cand", s.lazy.candidate_list), arg("slots2rivals", t.slots2rivals), arg("slots2rival_count", t.slots2rival_count));
         round.launch(ctx, m);
       },
       &tail, loop_size);
-  run(ctx, F, "conflict_finalize", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("p1", s.result.edges_pass1), arg("state", s.result.edges2state), arg("fin", s.result.edges_are_final), arg("vaff", s.result.verts2collapse), arg("counters", s.cost.counters));
+  run(ctx, F, "conflict_finalize", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("edges_pass1", s.result.edges_pass1), arg("edges2state", s.result.edges2state), arg("edges_are_final", s.result.edges_are_final), arg("verts2collapse", s.result.verts2collapse), arg("counters", s.cost.counters));
   return read_counter(s.cost, 3);
 }
 
@@ -198,8 +198,8 @@ uint32_t next_selection_round(Context& ctx, DeviceMesh& dm, Connectivity& c, Edg
   uint32_t passed_q = 0;
   lazy_admissible_pass1(ctx, dm, c, s, p, passed_q, tested, true);  // edges with clean end points only
   const uint32_t total = conflict_pass2(ctx, dm, c, s, t);  // counters[3] counts both rounds
-  run(ctx, "collapse_verdicts.cl", "merge_rounds_edges", c.ne, arg("ne", c.ne), arg("fin1", t.rounds_final), arg("dir1", t.rounds_dir), arg("fin", s.result.edges_are_final), arg("dir", s.result.edges2dir));
-  run(ctx, "collapse_verdicts.cl", "merge_rounds_vertices", dm.nv, arg("nv", dm.nv), arg("vaff1", t.rounds_verts2collapse), arg("vaff", s.result.verts2collapse));
+  run(ctx, "collapse_verdicts.cl", "merge_rounds_edges", c.ne, arg("ne", c.ne), arg("rounds_final", t.rounds_final), arg("rounds_dir", t.rounds_dir), arg("edges_are_final", s.result.edges_are_final), arg("edges2dir", s.result.edges2dir));
+  run(ctx, "collapse_verdicts.cl", "merge_rounds_vertices", dm.nv, arg("nv", dm.nv), arg("rounds_verts2collapse", t.rounds_verts2collapse), arg("verts2collapse", s.result.verts2collapse));
   return total;
 }
 
