@@ -19,6 +19,8 @@ results files:
     peers_bracket,  bench/results/peers_bracket.json, peers_robot514k.json  (bench/peers.py; its table)
     peers_robot514k
     shared_meshes   bench/results/shared_meshes.json                    (bench/shared_meshes.py; its table)
+    quality_peers   bench/results/quality_peers.json                    (bench/quality_peers.py; its table)
+    improve_slivers bench/results/improve_slivers.json                  (bench/improve_slivers.py; its table)
     robustness      bench/robustness/results.json                       (scripts/robustness.py)
     io, primitives, bench/results/io.json, primitives.json, connectivity.json, checker.json,
     connectivity,   boundary_rule.json
@@ -191,6 +193,18 @@ def shared_meshes_block():
     return shared_meshes.table(res["runs"], res["meta"], rel(path)), path
 
 
+def recorded_block(name, module):
+    """A results file written by a script that records its command, commit and device."""
+    mod = __import__(module)
+    path = os.path.join(RESULTS, f"{name}.json")
+    if not os.path.exists(path):
+        return None, f"no {rel(path)}"
+    doc = load(path)
+    head = (f"Recorded: `{rel(path)}` by `{doc['command']}` at commit {doc['commit']} on "
+            f"{doc.get('device') or 'the default device'}.")
+    return head + "\n\n" + mod.table(doc), path
+
+
 def robustness_block():
     path = os.path.join(HERE, "robustness", "results.json")
     if not os.path.exists(path):
@@ -324,6 +338,8 @@ BLOCKS = {
     "peers_bracket": lambda: peers_block("bracket"),
     "peers_robot514k": lambda: peers_block("robot514k"),
     "shared_meshes": shared_meshes_block,
+    "quality_peers": lambda: recorded_block("quality_peers", "quality_peers"),
+    "improve_slivers": lambda: recorded_block("improve_slivers", "improve_slivers"),
     "robustness": robustness_block,
     "io": io_block,
     "primitives": primitives_block,

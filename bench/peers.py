@@ -7,11 +7,17 @@
 
 Runs, on mesh M with the uniform target edge length L, in this order:
   tetcollapse           tetcollapse M OUT --target-length L            (default options, quality guard 0.1)
-  tetcollapse_q0        ... --min-quality 0                            (the paper: no quality guard)
+  tetcollapse_noimprove ... --no-improve                             (the collapse alone)
+  tetcollapse_q0        ... --min-quality 0 --no-improve               (the paper: no quality guard, no
+                                                                        improvement phase)
   mmg3d_hsiz            mmg3d_O3 IN.mesh -hsiz L                        (MMG3D, surface remeshed too)
   mmg3d_hsiz_nosurf     mmg3d_O3 IN.mesh -hsiz L -nosurf                (MMG3D, surface kept)
   mmg3d_hmin            mmg3d_O3 IN.mesh -hmin L                        (MMG3D, size from the input's edges,
   mmg3d_hmin_nosurf     mmg3d_O3 IN.mesh -hmin L -nosurf                 at least L: coarsening only)
+  mmg3d_hmin_hausd      mmg3d_O3 IN.mesh -hmin L -hausd H               (H = 0.001 x the bounding-box diagonal:
+                                                                        MMG's default -hausd 0.01 is in mesh
+                                                                        units, and refines the curved surfaces of
+                                                                        a mesh hundreds of units large)
   cgal_remesh           bench_peer_cgal M OUT.mesh L                    (CGAL tetrahedral_isotropic_remeshing,
                                                                         boundary protected)
   tetgen_rR             tetgen -rRm IN  (IN.node/.ele/.face, IN.mtr = L at every node)
@@ -48,7 +54,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-ALL_PEERS = ["tetcollapse", "tetcollapse_q0", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "mmg3d_hmin", "mmg3d_hmin_nosurf",
+ALL_PEERS = ["tetcollapse", "tetcollapse_noimprove", "tetcollapse_q0", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "mmg3d_hmin", "mmg3d_hmin_nosurf", "mmg3d_hmin_hausd",
              "cgal_remesh", "tetgen_rR", "tetgen_rR_keepbnd"]
 
 
@@ -134,6 +140,7 @@ def check_output(tc, out, mesh, work, timeout, hausdorff):
         "max_dihedral_deg": q.get("max_dihedral_deg", {}).get("max"),
         "median_dihedral_deg": q.get("median_dihedral_deg"),
         "tets_below_10_deg": q.get("tets_below_10_deg"),
+        "tets_below_13_deg": q.get("tets_below_13_deg"),
         "mean_ratio_min": q.get("mean_ratio", {}).get("min"),
         "valid": r["valid"],
         "check_errors": [f["code"] for f in r.get("findings", []) if f["severity"] == "error"],
@@ -206,6 +213,8 @@ def main():
 
     info = json.loads(run([tc, "info", mesh, "--json"], a.timeout)[1])
     tets_in = info["tets"]
+    box = info["bounding_box"]
+    diagonal = sum((box["max"][k] - box["min"][k]) ** 2 for k in range(3)) ** 0.5
     inputs = {}  # converted copies of the input, made on first use
 
     def converted(ext):
@@ -223,16 +232,19 @@ def main():
     def setup(peer, d):
         """Returns (command, output file, how to get seconds_algorithm from one run) or raises
         PeerFailed for a peer that is not installed."""
-        if peer in ("tetcollapse", "tetcollapse_q0"):
+        if peer.startswith("tetcollapse"):
             out = os.path.join(d, "out.mesh")
             stats = os.path.join(d, "stats.json")
             cmd = [tc, mesh, out, "--target-length", repr(L), "--stats", stats, "--quiet"]
             if peer == "tetcollapse_q0":
-                cmd += ["--min-quality", "0"]
+                cmd += ["--min-quality", "0", "--no-improve"]
+            if peer == "tetcollapse_noimprove":
+                cmd += ["--no-improve"]
 
-            def alg(stdout, stderr):
+            def alg(stdout, stderr):  # the collapse and the improvement, without I/O
                 with open(stats) as f:
-                    return json.load(f)["seconds_collapse"]
+                    st = json.load(f)
+                return st["seconds_collapse"] + st.get("improve", {}).get("seconds", 0)
             return cmd, out, alg
         if peer.startswith("mmg3d"):
             if not mmg:
@@ -247,6 +259,8 @@ def main():
             cmd += ["-hmin", repr(L)] if "_hmin" in peer else ["-hsiz", repr(L)]
             if peer.endswith("nosurf"):
                 cmd.append("-nosurf")
+            if peer.endswith("hausd"):
+                cmd += ["-hausd", repr(0.001 * diagonal)]
 
             def alg(stdout, stderr):
                 # "MMG3DLIB: ELAPSED TIME  1.23s": the library call (analysis + remeshing), no file I/O
