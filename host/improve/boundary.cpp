@@ -20,6 +20,20 @@ bool contains(const Tet& q, int32_t x) { return q[0] == x || q[1] == x || q[2] =
 
 }  // namespace
 
+// The height of a quad, relative to its diagonal, below which it counts as flat.
+constexpr double kFlat = 1e-12;
+
+// How far the boundary moves when the quad (a, x1, b, x2) changes its diagonal from (a, b) to
+// (x1, x2): the larger distance of a and b from the other diagonal's triangles' planes.
+double boundary_quad_height(const ImpMesh& m, int32_t a, int32_t b, int32_t x1, int32_t x2) {
+  const tc_d3 pa = m.point(a), pb = m.point(b), p1 = m.point(x1), p2 = m.point(x2);
+  return std::max(distance_to_plane(pa, pb, p1, p2), distance_to_plane(pb, pa, p1, p2));
+}
+
+bool flat_quad(const ImpMesh& m, int32_t a, int32_t b, int32_t x1, int32_t x2) {
+  return boundary_quad_height(m, a, b, x1, x2) <= kFlat * geo::length(m.point(b) - m.point(a));
+}
+
 bool try_remove_boundary_sliver(ImpMesh& m, int32_t t) {
   if (!m.may_change_boundary()) return false;
   const Tet q = m.tet(t);
@@ -48,10 +62,9 @@ bool try_remove_boundary_sliver(ImpMesh& m, int32_t t) {
     for (int32_t y : r)
       if (y != x1 && y != x2 && m.across(s, x1, x2, y) < 0) return false;
   }
-  const tc_d3 pa = m.point(a), pb = m.point(b), p1 = m.point(x1), p2 = m.point(x2);
-  if (std::max(distance_to_plane(pa, pb, p1, p2), distance_to_plane(pb, pa, p1, p2)) > m.max_boundary_move())
-    return false;
-  return m.remove_boundary_tet(t, {{{a, b, x2}, {a, b, x1}}}, {{{b, x1, x2}, {a, x1, x2}}});
+  if (boundary_quad_height(m, a, b, x1, x2) > m.max_boundary_move()) return false;
+  return m.replace_on_boundary({t}, {}, {{{a, b, x2}, {a, b, x1}}}, {{{b, x1, x2}, {a, x1, x2}}},
+                               flat_quad(m, a, b, x1, x2));
 }
 
 }  // namespace tc::improve_detail

@@ -33,11 +33,15 @@ void others(const Tet& q, int32_t a, int32_t b, int32_t& c, int32_t& d) {
 
 }  // namespace
 
-// The ring of the edge (a, b): r[0..n) with (a, b, r[i], r[i+1]) the tets around it. Only a
-// closed ring of tets of one label qualifies: then no boundary or interface face contains the
-// edge, and the faces the operation keeps (a r_i r_i+1, b r_i r_i+1) are exactly the ring's
-// outside. The new tets pair each triangle (r_i, r_j, r_k), i < j < k, of a triangulation of
-// the ring with a and with b: (r_i, r_j, r_k, b) and (r_k, r_j, r_i, a) are then positive.
+// The ring of the edge (a, b): r[0..m) with (a, b, r[i], r[i+1]) the tets around it, of one
+// label. A closed ring (m tets) means no boundary or interface face contains the edge, and the
+// faces the operation keeps (a r_i r_i+1, b r_i r_i+1) are exactly the ring's outside. An open
+// ring (m - 1 tets, from the face (a, b, r_0) to (a, b, r_m-1)) is an edge of the boundary.
+// The new tets pair each triangle (r_i, r_j, r_k), i < j < k, of a triangulation of the
+// polygon r_0..r_m-1 with a and with b: (r_i, r_j, r_k, b) and (r_k, r_j, r_i, a) are then
+// positive. On the boundary, the polygon's closing edge (r_0, r_m-1) becomes the diagonal of the
+// boundary quad (a, r_0, b, r_m-1) in place of (a, b): the boundary 2-2 flip for two tets, and
+// its generalisation for more.
 bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b) {
   if (m.tagged_edge(a, b) || !m.selected(a) || !m.selected(b)) return false;
   std::vector<int32_t> ring_tets;
@@ -45,8 +49,8 @@ bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b) {
     const Tet& q = m.tet(t);
     if (q[0] == b || q[1] == b || q[2] == b || q[3] == b) ring_tets.push_back(t);
   }
-  const int n = int(ring_tets.size());
-  if (n < 3 || n > kMaxRing) return false;
+  const int n = int(ring_tets.size());  // tets
+  if (n < 2 || n > kMaxRing) return false;
   int32_t from[kMaxRing] = {}, to[kMaxRing] = {};
   double old_min = std::numeric_limits<double>::infinity(), old_cos = -1;
   for (int i = 0; i < n; ++i) {
@@ -55,24 +59,43 @@ bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b) {
     old_min = std::min(old_min, m.quality(ring_tets[size_t(i)]));
     old_cos = std::max(old_cos, m.max_cos(ring_tets[size_t(i)]));
   }
-  int32_t r[kMaxRing] = {};
-  r[0] = from[0];
-  for (int i = 1; i < n; ++i) {
-    const int32_t prev = r[i - 1];
+  // The start: a vertex no arc enters (an open ring), else the first arc's.
+  int start = 0;
+  for (int i = 0; i < n; ++i) {
+    bool entered = false;
+    for (int k = 0; k < n; ++k) entered = entered || to[k] == from[i];
+    if (!entered) start = i;
+  }
+  int32_t r[kMaxRing + 1] = {};
+  r[0] = from[start];
+  int len = 1;
+  for (int step = 0; step < n; ++step) {
     int j = 0;
-    while (j < n && from[j] != prev) ++j;
-    if (j == n) return false;  // an open ring: the edge is on the boundary
-    r[i] = to[j];
+    while (j < n && from[j] != r[len - 1]) ++j;
+    if (j == n) return false;  // not one chain
+    r[len++] = to[j];
+  }
+  const bool closed = r[len - 1] == r[0];
+  if (closed) --len;
+  for (int i = 0; i < len; ++i)
     for (int k = 0; k < i; ++k)
-      if (r[k] == r[i]) return false;  // a shorter cycle: not a simple ring
+      if (r[k] == r[i]) return false;  // not a simple ring or chain
+  const int mm = len;                  // polygon vertices: n closed, n + 1 open
+  if (closed ? n < 3 : !m.may_change_boundary() || mm > kMaxRing) return false;
+  for (int i = 0; i < mm; ++i) {  // a face of the old tets that the input tags must stay
+    const bool outer = !closed && (i == 0 || i == mm - 1);  // these two: replace_on_boundary
+    if ((!outer && m.tagged_face(a, b, r[i])) || !m.selected(r[i])) return false;
   }
-  {
-    int j = 0;
-    while (j < n && from[j] != r[n - 1]) ++j;
-    if (j == n || to[j] != r[0]) return false;
+  if (!closed) {
+    // both faces at the edge on the outer boundary, the new diagonal not an edge yet
+    if (m.across(ring_tets[size_t(start)], a, b, r[0]) >= 0) return false;
+    int last = 0;
+    while (last < n && to[last] != r[mm - 1]) ++last;
+    if (m.across(ring_tets[size_t(last)], a, b, r[mm - 1]) >= 0 || m.has_edge(r[0], r[mm - 1])) return false;
+    // Only flat quads: flipping a bent one would pin its vertices (their planes or lines no
+    // longer hold), which costs more relocations than the flip gains.
+    if (!flat_quad(m, a, b, r[0], r[mm - 1])) return false;
   }
-  for (int i = 0; i < n; ++i)  // a face of the old tets that the input tags must stay
-    if (m.tagged_face(a, b, r[i]) || !m.selected(r[i])) return false;
 
   // Klincsek's dynamic programme: best[i][j] is the best worst quality of a triangulation of
   // the sub-polygon r_i..r_j; a chord that is already an edge of the mesh is not allowed.
@@ -80,17 +103,17 @@ bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b) {
   double best[kMaxRing][kMaxRing];
   int split[kMaxRing][kMaxRing];
   auto chord_ok = [&](int i, int j) {
-    return j - i == 1 || (i == 0 && j == n - 1) || !m.has_edge(r[i], r[j]);
+    return j - i == 1 || (i == 0 && j == mm - 1) || !m.has_edge(r[i], r[j]);
   };
   auto triangle = [&](int i, int j, int k) {
     if (m.tagged_face(r[i], r[j], r[k]) || m.has_face(r[i], r[j], r[k])) return kNone;
     return std::min(m.quality_of({r[i], r[j], r[k], b}), m.quality_of({r[k], r[j], r[i], a}));
   };
-  for (int len = 1; len < n; ++len)
-    for (int i = 0; i + len < n; ++i) {
-      const int j = i + len;
+  for (int l = 1; l < mm; ++l)
+    for (int i = 0; i + l < mm; ++i) {
+      const int j = i + l;
       split[i][j] = -1;
-      if (len == 1) {
+      if (l == 1) {
         best[i][j] = std::numeric_limits<double>::infinity();
         continue;
       }
@@ -104,11 +127,11 @@ bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b) {
         }
       }
     }
-  if (!(best[0][n - 1] > old_min) || split[0][n - 1] < 0) return false;
+  if (!(best[0][mm - 1] > old_min) || split[0][mm - 1] < 0) return false;
   std::vector<Tet> added;
   int stack[2 * kMaxRing][2], top = 0;
   stack[top][0] = 0;
-  stack[top++][1] = n - 1;
+  stack[top++][1] = mm - 1;
   while (top > 0) {
     --top;
     const int i = stack[top][0], j = stack[top][1];
@@ -123,9 +146,14 @@ bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b) {
   }
   double new_cos = -1;
   for (const Tet& q : added) new_cos = std::max(new_cos, m.max_cos_of(q));
-  if (!m.improves(old_min, old_cos, best[0][n - 1], new_cos)) return false;
-  m.replace(ring_tets, added, ring_tets[0]);
-  return true;
+  if (!m.improves(old_min, old_cos, best[0][mm - 1], new_cos)) return false;
+  if (closed) {
+    m.replace(ring_tets, added, ring_tets[0]);
+    return true;
+  }
+  const int32_t r0 = r[0], rl = r[mm - 1];
+  return m.replace_on_boundary(ring_tets, added, {{{a, b, r0}, {a, b, rl}}}, {{{a, r0, rl}, {b, r0, rl}}},
+                               flat_quad(m, a, b, r0, rl));
 }
 
 // The 2-3 flip: tets t = (face u v w, apex p) and its neighbour o across that face (apex q)

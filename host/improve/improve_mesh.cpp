@@ -224,19 +224,22 @@ int32_t ImpMesh::across(int32_t t, int32_t a, int32_t b, int32_t c) const {
   return -1;
 }
 
-bool ImpMesh::remove_boundary_tet(int32_t t, const std::array<std::array<int32_t, 3>, 2>& gone,
-                                  const std::array<std::array<int32_t, 3>, 2>& exposed) {
-  // The tets across the exposed faces must not become fins (three or four faces on the
-  // surface), and the exposed faces must not touch the rest of the surface (on thin parts of
-  // a model, or where near-degenerate tets fold it).
+bool ImpMesh::replace_on_boundary(const std::vector<int32_t>& old, const std::vector<Tet>& added,
+                                  const std::array<std::array<int32_t, 3>, 2>& gone,
+                                  const std::array<std::array<int32_t, 3>, 2>& exposed, bool flat) {
+  // A removal: the tets across the exposed faces must not become fins (three or four faces on
+  // the surface). Either way the exposed faces must not touch the rest of the surface (on thin
+  // parts of a model, or where near-degenerate tets fold it).
   for (const auto& e : exposed) {
-    const int32_t n = across(t, e[0], e[1], e[2]);
-    if (n < 0) return false;
-    int on = 0;
-    const Tet& q = tets_[size_t(n)];
-    for (const auto& F : geo::TC_TET_FACES)
-      on += on_surface(n, q[size_t(F[0])], q[size_t(F[1])], q[size_t(F[2])]);
-    if (on >= 2) return false;
+    if (added.empty()) {
+      const int32_t n = across(old[0], e[0], e[1], e[2]);
+      if (n < 0) return false;
+      int on = 0;
+      const Tet& q = tets_[size_t(n)];
+      for (const auto& F : geo::TC_TET_FACES)
+        on += on_surface(n, q[size_t(F[0])], q[size_t(F[1])], q[size_t(F[2])]);
+      if (on >= 2) return false;
+    }
     if (!sfaces_.empty()) {
       const FaceKey k = face_key(e[0], e[1], e[2]);
       const tc_d3 pe[3] = {point(k[0]), point(k[1]), point(k[2])};
@@ -261,9 +264,12 @@ bool ImpMesh::remove_boundary_tet(int32_t t, const std::array<std::array<int32_t
       tris_.emplace(face_key(exposed[1][0], exposed[1][1], exposed[1][2]), i1);
     }
   }
-  // Its vertices' surface fans changed: what was flat around them may be no longer.
-  for (int32_t v : tets_[size_t(t)]) motion_[size_t(v)] = kFixed;
-  replace({t}, {}, t);
+  // The vertices' surface fans changed: unless in one plane, what was flat around them may be
+  // no longer.
+  if (!flat)
+    for (int32_t t : old)
+      for (int32_t v : tets_[size_t(t)]) motion_[size_t(v)] = kFixed;
+  replace(old, added, old[0]);
   if (!sfaces_.empty()) {
     for (const auto& g : gone) {
       const auto it = sface_index_.find(face_key(g[0], g[1], g[2]));

@@ -68,10 +68,15 @@ class ImpMesh {
   int32_t across(int32_t t, int32_t a, int32_t b, int32_t c) const;
   bool may_change_boundary() const { return max_boundary_move_ > 0; }
   double max_boundary_move() const { return max_boundary_move_; }
-  // Removes tet t and gives the input's tagged triangles of its faces `gone` (two) to the faces
-  // `exposed` (two), which become boundary faces; false if the tags do not allow it.
-  bool remove_boundary_tet(int32_t t, const std::array<std::array<int32_t, 3>, 2>& gone,
-                           const std::array<std::array<int32_t, 3>, 2>& exposed);
+  // Replaces the tets `old` by `added` where that changes the boundary: its faces `gone` (two)
+  // give way to `exposed` (two), which take over the input's tags of `gone`. False (nothing
+  // done) if the tags do not allow it, if an exposed face would touch the rest of the surface,
+  // or (a removal: `added` empty) if a tet across an exposed face would become a fin.
+  // `flat`: the four vertices of the two pairs of faces lie in one plane (to rounding), so the
+  // surface keeps its shape and its vertices may go on moving as they did.
+  bool replace_on_boundary(const std::vector<int32_t>& old, const std::vector<Tet>& added,
+                           const std::array<std::array<int32_t, 3>, 2>& gone,
+                           const std::array<std::array<int32_t, 3>, 2>& exposed, bool flat);
 
   // Replaces the tets `old` by `added` (label and tet fields of `like`).
   void replace(const std::vector<int32_t>& old, const std::vector<Tet>& added, int32_t like);
@@ -172,5 +177,7 @@ bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b);
 bool try_flip23(ImpMesh& m, int32_t t, int face);
 bool try_smooth(ImpMesh& m, int32_t v);
 bool try_remove_boundary_sliver(ImpMesh& m, int32_t t);
+double boundary_quad_height(const ImpMesh& m, int32_t a, int32_t b, int32_t x1, int32_t x2);
+bool flat_quad(const ImpMesh& m, int32_t a, int32_t b, int32_t x1, int32_t x2);
 
 }  // namespace tc::improve_detail
