@@ -22,9 +22,9 @@ void add_improve_options(CLI::App& cmd, ImproveCli& c) {
       ->check(CLI::Range(0.0, 60.0));
   cmd.add_flag("--no-flips", c.no_flips, "Improvement: no edge removal or 2-3 flips");
   cmd.add_option("--max-boundary-move", c.opt.max_boundary_move,
-                 "Improvement, features and free modes: a thin tet with two faces on the outer boundary\n"
-                 "may be removed when the boundary moves by at most this share of the bounding-box\n"
-                 "diagonal (0: never)")
+                 "Improvement, features and free modes: how far the boundary may move, as a share of the\n"
+                 "bounding-box diagonal: relocations off flat patches and straight lines, and the removal of\n"
+                 "thin tets with two boundary faces, stay within it (0: neither)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--no-smoothing", c.no_smoothing, "Improvement: no vertex relocation");
@@ -102,14 +102,18 @@ void register_improve(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand(
       "improve",
-      "Raise the worst element quality of a mesh without coarsening it: edge removal (3-2 and\n"
-      "n -> 2n-4 flips), 2-3 flips and vertex relocation, each accepted only when the worst\n"
-      "quality of what it changes rises. Boundary and interfaces are kept (see --boundary)");
+      "Raise the worst element quality of a mesh: edge removal (3-2, 4-4, n -> 2n-4 flips), 2-3\n"
+      "flips, flips of flat boundary quads, vertex relocation, removal of thin boundary tets and a\n"
+      "collapse of short edges of the tets still below 13 degrees, each accepted only when the worst\n"
+      "quality of what it changes rises; the worst dihedral angle never falls. Interfaces are kept;\n"
+      "the boundary as --boundary says");
   cmd->add_option("IN", o->in, "Input mesh")->required();
   cmd->add_option("OUT", o->out, "Output mesh (written to a temporary file and renamed)")->required();
   cmd->add_option("--boundary", o->boundary,
-                  "strict: no boundary vertex moves (the boundary stays bit for bit); features (default)\n"
-                  "and free: a vertex of a flat boundary patch may move within its plane")
+                  "strict: no boundary vertex moves and no boundary face changes (bit for bit); features\n"
+                  "(default) and free: surface vertices move within their surface (freely on flat patches\n"
+                  "and straight feature lines, elsewhere within --max-boundary-move), flat boundary quads\n"
+                  "flip their diagonal, thin boundary tets may go")
       ->check(CLI::IsMember({"strict", "features", "free"}));
   cmd->add_flag("--no-labels", o->no_labels, "Do not treat material interfaces as boundary (flips still keep labels)");
   cmd->add_option("--eps-f", o->improve.opt.eps_f, "Face-vertex threshold on 1 - dot of normals")->capture_default_str();
