@@ -181,6 +181,20 @@ TEST(ImproveOps, AThinBoundaryTetIsRemovedWithinTheBound) {
       << "two surfaces the input tags apart";
 }
 
+TEST(ImproveOps, TheSurfaceGuardSeesAMoveThroughTheSurface) {
+  Mesh m = cube_tets(3);
+  int32_t v = -1;  // a vertex inside the face z = 0
+  for (int64_t i = 0; i < m.num_vertices(); ++i)
+    if (m.points[3 * i] > 0 && m.points[3 * i] < 1 && m.points[3 * i + 1] > 0 && m.points[3 * i + 1] < 1 &&
+        m.points[3 * i + 2] == 0)
+      v = int32_t(i);
+  ASSERT_GE(v, 0);
+  ImpMesh im(m, {});
+  const geo::tc_d3 p = im.point(v);
+  EXPECT_TRUE(im.surface_stays_clear(v, {p.x + 0.01, p.y, p.z})) << "a small move within the face";
+  EXPECT_FALSE(im.surface_stays_clear(v, {p.x, p.y, 1.5})) << "its triangles would cross the top face";
+}
+
 // An octahedron around an interior vertex pushed towards one corner.
 TEST(ImproveOps, SmoothingCentresAnInteriorVertex) {
   Mesh m;
