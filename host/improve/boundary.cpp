@@ -16,8 +16,6 @@ double distance_to_plane(tc_d3 p, tc_d3 a, tc_d3 b, tc_d3 c) {
   return n > 0 ? std::fabs(geo::tc_orient3d(a, b, c, p)) / n : INFINITY;
 }
 
-bool contains(const Tet& q, int32_t x) { return q[0] == x || q[1] == x || q[2] == x || q[3] == x; }
-
 }  // namespace
 
 // The height of a quad, relative to its diagonal, below which it counts as flat.

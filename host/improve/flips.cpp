@@ -47,7 +47,7 @@ bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b) {
   std::vector<int32_t> ring_tets;
   for (int32_t t : m.tets_of(a)) {
     const Tet& q = m.tet(t);
-    if (q[0] == b || q[1] == b || q[2] == b || q[3] == b) ring_tets.push_back(t);
+    if (contains(q, b)) ring_tets.push_back(t);
   }
   const int n = int(ring_tets.size());  // tets
   if (n < 2 || n > kMaxRing) return false;
@@ -165,23 +165,12 @@ bool try_flip23(ImpMesh& m, int32_t t, int face) {
   const int32_t u = qt[geo::TC_TET_FACES[face][0]], v = qt[geo::TC_TET_FACES[face][1]],
                 w = qt[geo::TC_TET_FACES[face][2]];
   if (m.tagged_face(u, v, w)) return false;
-  int32_t o = -1, q = -1;
-  for (int32_t s : m.tets_of(u)) {
-    if (s == t) continue;
-    const Tet& qs = m.tet(s);
-    int hits = 0;
-    int32_t apex = -1;
-    for (int32_t x : qs) {
-      if (x == v || x == w || x == u) ++hits;
-      else apex = x;
-    }
-    if (hits == 3) {
-      o = s;
-      q = apex;
-      break;
-    }
-  }
-  if (o < 0 || m.label(o) != m.label(t) || m.has_edge(p, q)) return false;
+  const int32_t o = m.across(t, u, v, w);
+  if (o < 0) return false;
+  int32_t q = -1;  // o's apex
+  for (int32_t x : m.tet(o))
+    if (x != u && x != v && x != w) q = x;
+  if (m.label(o) != m.label(t) || m.has_edge(p, q)) return false;
   if (!m.selected(p) || !m.selected(q) || !m.selected(u) || !m.selected(v) || !m.selected(w)) return false;
   const std::vector<Tet> added = {{p, q, u, v}, {p, q, v, w}, {p, q, w, u}};
   double new_min = std::numeric_limits<double>::infinity(), new_cos = -1;

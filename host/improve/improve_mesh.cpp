@@ -216,10 +216,7 @@ void ImpMesh::surface_moved(int32_t v) {
 int32_t ImpMesh::across(int32_t t, int32_t a, int32_t b, int32_t c) const {
   for (int32_t s : vtets_[size_t(a)]) {
     if (s == t) continue;
-    const Tet& q = tets_[size_t(s)];
-    const bool hb = q[0] == b || q[1] == b || q[2] == b || q[3] == b;
-    const bool hc = q[0] == c || q[1] == c || q[2] == c || q[3] == c;
-    if (hb && hc) return s;
+    if (contains(tets_[size_t(s)], b) && contains(tets_[size_t(s)], c)) return s;
   }
   return -1;
 }
@@ -425,20 +422,8 @@ bool ImpMesh::has_edge(int32_t a, int32_t b) const {
   const auto& lb = vtets_[size_t(b)];
   const auto& l = la.size() <= lb.size() ? la : lb;
   const int32_t other = la.size() <= lb.size() ? b : a;
-  for (int32_t t : l) {
-    const Tet& q = tets_[size_t(t)];
-    if (q[0] == other || q[1] == other || q[2] == other || q[3] == other) return true;
-  }
-  return false;
-}
-
-bool ImpMesh::has_face(int32_t a, int32_t b, int32_t c) const {
-  for (int32_t t : vtets_[size_t(a)]) {
-    const Tet& q = tets_[size_t(t)];
-    const bool hb = q[0] == b || q[1] == b || q[2] == b || q[3] == b;
-    const bool hc = q[0] == c || q[1] == c || q[2] == c || q[3] == c;
-    if (hb && hc) return true;
-  }
+  for (int32_t t : l)
+    if (contains(tets_[size_t(t)], other)) return true;
   return false;
 }
 

@@ -20,6 +20,8 @@ namespace tc::improve_detail {
 using geo::tc_d3;
 using Tet = std::array<int32_t, 4>;
 
+inline bool contains(const Tet& q, int32_t x) { return q[0] == x || q[1] == x || q[2] == x || q[3] == x; }
+
 enum Motion : uint8_t { kFixed = 0, kFree = 1, kInPlane = 2, kAlongLine = 3 };
 
 class ImpMesh {
@@ -61,7 +63,7 @@ class ImpMesh {
   }
 
   bool has_edge(int32_t a, int32_t b) const;
-  bool has_face(int32_t a, int32_t b, int32_t c) const;
+  bool has_face(int32_t a, int32_t b, int32_t c) const { return across(-1, a, b, c) >= 0; }
   bool tagged_edge(int32_t a, int32_t b) const { return tagged_edges_.count(key2(a, b)) != 0; }
   bool tagged_face(int32_t a, int32_t b, int32_t c) const { return tris_.count(face_key(a, b, c)) != 0; }
   // The tet other than t with the face (a, b, c), or -1 (a boundary face).

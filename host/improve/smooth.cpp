@@ -72,21 +72,23 @@ bool try_smooth(ImpMesh& m, int32_t v) {
   const double inf = std::numeric_limits<double>::infinity();
   double current = star_min(m, star, v, p, -inf), current_cos = star_max_cos(m, v, p);
   const double start = current;
+  std::vector<double> qualities;  // of the star's tets (tets_of(v) order) at p
   bool moved = false;
   for (int step = 0; step < kSteps; ++step) {
     double worst = std::numeric_limits<double>::infinity();
     int32_t worst_tet = -1;
+    qualities.clear();
     for (int32_t t : m.tets_of(v)) {
-      const double q = m.quality_with(t, v, p);
-      if (q < worst) {
-        worst = q;
+      qualities.push_back(m.quality_with(t, v, p));
+      if (qualities.back() < worst) {
+        worst = qualities.back();
         worst_tet = t;
       }
     }
     tc_d3 directions[2] = {allowed(gradient(m, worst_tet, v, p, h)), {0, 0, 0}};
-    for (int32_t t : m.tets_of(v))
-      if (m.quality_with(t, v, p) <= worst + kNearlyWorst)
-        directions[1] = directions[1] + geo::normalize(allowed(gradient(m, t, v, p, h)));
+    for (size_t i = 0; i < qualities.size(); ++i)
+      if (qualities[i] <= worst + kNearlyWorst)
+        directions[1] = directions[1] + geo::normalize(allowed(gradient(m, m.tets_of(v)[i], v, p, h)));
     // The mean of opposed unit gradients cancels to rounding noise, whose direction is
     // arbitrary (off the allowed plane or line): skip it. Every direction is projected again
     // after normalising, so rounding does not take a vertex off its plane or line.
