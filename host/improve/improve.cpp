@@ -16,6 +16,8 @@ namespace {
 constexpr double kDeg = 180.0 / 3.14159265358979323846;
 constexpr double kMinAngleGain = 0.05;  // degrees
 constexpr double kMinCountGain = 0.05;  // share of the tets below 10 or 13 degrees
+// A tet is below 10 (13) degrees when the cosine of its smallest angle is above these.
+const double kCos10 = std::cos(10 / kDeg), kCos13 = std::cos(13 / kDeg);
 
 // The live tets below the threshold, worst first (ties by index: deterministic).
 std::vector<int32_t> bad_tets(const ImpMesh& m, double threshold) {
@@ -30,22 +32,20 @@ std::vector<int32_t> bad_tets(const ImpMesh& m, double threshold) {
 
 // The smallest dihedral angle and the tets below 10 and 13 degrees, from the kept cosines.
 void measure(const ImpMesh& m, ImprovePassStats& s) {
-  const double c10 = std::cos(10 / kDeg), c13 = std::cos(13 / kDeg);
   double c = -1;
   for (int32_t t = 0; t < m.num_tet_slots(); ++t)
     if (m.alive(t)) {
       c = std::max(c, m.max_cos(t));
-      s.below_10_deg += m.max_cos(t) > c10;
-      s.below_13_deg += m.max_cos(t) > c13;
+      s.below_10_deg += m.max_cos(t) > kCos10;
+      s.below_13_deg += m.max_cos(t) > kCos13;
     }
   s.min_dihedral_deg = std::acos(std::min(1.0, c)) * kDeg;
 }
 
 int64_t pinned_below_13(const ImpMesh& m) {
-  const double c13 = std::cos(13 / kDeg);
   int64_t n = 0;
   for (int32_t t = 0; t < m.num_tet_slots(); ++t) {
-    if (!m.alive(t) || m.max_cos(t) <= c13) continue;
+    if (!m.alive(t) || m.max_cos(t) <= kCos13) continue;
     const Tet& q = m.tet(t);
     n += m.motion(q[0]) == kFixed && m.motion(q[1]) == kFixed && m.motion(q[2]) == kFixed && m.motion(q[3]) == kFixed;
   }
@@ -59,15 +59,14 @@ QualitySummary quality_summary(const Mesh& mesh) {
   s.tets = mesh.num_tets();
   if (s.tets == 0) return s;
   // By the cosine of each tet's smallest angle: one arc cosine per figure, not six per tet.
-  const double c10 = std::cos(10 / kDeg), c13 = std::cos(13 / kDeg);
   std::vector<double> cosines(size_t(s.tets));
   for (int64_t t = 0; t < s.tets; ++t) {
     geo::tc_d3 p[4];
     for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(mesh.points.data(), mesh.tets[size_t(4 * t + k)]);
     const double c = geo::tc_tet_max_dihedral_cos(p[0], p[1], p[2], p[3]);
     cosines[size_t(t)] = c;
-    s.below_10_deg += c > c10;
-    s.below_13_deg += c > c13;
+    s.below_10_deg += c > kCos10;
+    s.below_13_deg += c > kCos13;
   }
   const auto deg = [](double c) { return std::acos(std::max(-1.0, std::min(1.0, c))) * kDeg; };
   s.min_dihedral_deg = deg(*std::max_element(cosines.begin(), cosines.end()));
@@ -126,13 +125,12 @@ double median_edge_length_of(const Mesh& mesh) {
 
 // The collapse step: edges between vertices of tets below 13 degrees.
 int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options) {
-  const double c13 = std::cos(13 / kDeg);
   std::vector<uint8_t> mask(size_t(mesh.num_vertices()), 0);
   int64_t bad = 0;
   for (int64_t t = 0; t < mesh.num_tets(); ++t) {
     geo::tc_d3 p[4];
     for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(mesh.points.data(), mesh.tets[size_t(4 * t + k)]);
-    if (geo::tc_tet_max_dihedral_cos(p[0], p[1], p[2], p[3]) <= c13) continue;
+    if (geo::tc_tet_max_dihedral_cos(p[0], p[1], p[2], p[3]) <= kCos13) continue;
     ++bad;
     for (int k = 0; k < 4; ++k) mask[size_t(mesh.tets[size_t(4 * t + k)])] = 1;
   }
@@ -165,8 +163,9 @@ ImproveReport improve(Mesh& mesh, const ImproveOptions& options) {
     ImprovePassStats stats;
     stats.iteration = int(report.passes.size());
     // The collapse's guard measures the mean ratio, not the dihedral angles: the step is kept
-    // only if it left the smallest angle and the counts below 10 and 13 degrees no worse.
-    const QualitySummary q0 = quality_summary(mesh);
+    // only if it left the smallest angle and the counts below 10 and 13 degrees no worse than
+    // the last pass measured them.
+    const ImprovePassStats q0 = report.passes.back();
     Mesh kept = mesh;
     stats.collapsed = collapse_bad(mesh, options);
     const QualitySummary q = quality_summary(mesh);
