@@ -109,20 +109,6 @@ void passes(Mesh& mesh, const ImproveOptions& options, int max_passes, ImproveRe
   m.write_back();
 }
 
-double median_edge_length_of(const Mesh& mesh) {
-  std::vector<double> l;
-  l.reserve(size_t(mesh.num_tets()) * 6);
-  for (int64_t t = 0; t < mesh.num_tets(); ++t)
-    for (const auto& e : geo::TC_TET_EDGES) {
-      const auto a = geo::tc_point(mesh.points.data(), mesh.tets[size_t(4 * t + e[0])]);
-      const auto b = geo::tc_point(mesh.points.data(), mesh.tets[size_t(4 * t + e[1])]);
-      l.push_back(geo::length(b - a));
-    }
-  if (l.empty()) return 0;
-  std::nth_element(l.begin(), l.begin() + ptrdiff_t(l.size() / 2), l.end());
-  return l[l.size() / 2];
-}
-
 // The collapse step: edges between vertices of tets below 13 degrees.
 int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options) {
   std::vector<uint8_t> mask(size_t(mesh.num_vertices()), 0);
@@ -143,7 +129,7 @@ int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options) {
   o.eps_r = options.eps_r;
   o.use_labels = options.use_labels;
   o.min_quality = 1;  // the guard at its strictest: never below the worst quality before
-  o.target_length = options.collapse_length > 0 ? options.collapse_length : 1.5 * median_edge_length_of(mesh);
+  o.target_length = options.collapse_length > 0 ? options.collapse_length : 1.5 * median_edge_length(mesh);
   o.vertex_mask = std::move(mask);
   int64_t collapsed = 0;
   for (const IterationStats& it : collapse_sequential(mesh, o).iterations) collapsed += it.collapsed;
