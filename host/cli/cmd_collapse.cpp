@@ -282,9 +282,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
     if (c->check) input = mesh;
 
     CollapseOptions& opt = c->opt;
-    opt.boundary = c->boundary == "strict" ? CollapseOptions::Strict
-                   : c->boundary == "free" ? CollapseOptions::Free
-                                           : CollapseOptions::Features;
+    opt.boundary = boundary_mode(c->boundary);
     opt.use_labels = !c->no_labels;
     opt.tuning.spatial_order = !c->no_spatial_order;
     opt.method = c->method == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;

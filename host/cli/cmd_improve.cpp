@@ -132,9 +132,7 @@ void register_improve(CLI::App& app, int& exit_code) {
     Mesh input;
     if (o->check) input = mesh;
     ImproveOptions& opt = o->improve.opt;
-    opt.boundary = o->boundary == "strict" ? CollapseOptions::Strict
-                   : o->boundary == "free" ? CollapseOptions::Free
-                                           : CollapseOptions::Features;
+    opt.boundary = boundary_mode(o->boundary);
     opt.use_labels = !o->no_labels;
     ImproveReport r = run_improve(mesh, o->improve, o->quiet);
     exit_code = kOk;

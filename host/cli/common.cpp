@@ -57,6 +57,10 @@ void check_output_path(const std::string& path, const OutputOptions* o) {
   io::require_output_folder(path);
 }
 
+CollapseOptions::Boundary boundary_mode(const std::string& name) {
+  return name == "strict" ? CollapseOptions::Strict : name == "free" ? CollapseOptions::Free : CollapseOptions::Features;
+}
+
 std::string check_result(const Mesh& result, const Mesh& input, bool hausdorff, bool quiet, int& exit_code) {
 #ifdef TETCOLLAPSE_HAVE_CHECK
   CheckOptions co;

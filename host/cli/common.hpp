@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "tetcollapse/collapse.hpp"
 #include "tetcollapse/io.hpp"
 
 namespace tc::cli {
@@ -39,6 +40,9 @@ WriteOptions write_options(const OutputOptions& o);
 // format or extension, a folder that does not exist), so that a long run does not end in
 // them. `o` null: a report file (JSON), whose format is not a mesh format, and "-" is stdout.
 void check_output_path(const std::string& path, const OutputOptions* o);
+
+// --boundary strict|features|free (the option checks the name) as the options' enum.
+CollapseOptions::Boundary boundary_mode(const std::string& name);
 
 // --check of the commands that change a mesh: checks `result` against `input` (validity, the
 // boundary's topology; with `hausdorff` also the boundary distance, 0 expected in strict mode),
