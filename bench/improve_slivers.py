@@ -55,11 +55,7 @@ def main():
     tc = os.path.abspath(a.tetcollapse or peers.default_tetcollapse() or "")
     if not os.access(tc, os.X_OK):
         sys.exit("improve_slivers.py: no tetcollapse binary (give --tetcollapse PATH)")
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
-    device = subprocess.run([tc, "devices"], capture_output=True, text=True).stdout.strip().splitlines()
-    doc = {"command": " ".join(["bench/improve_slivers.py"] + sys.argv[1:]), "commit": commit,
-           "device": device[0] if device else None, "reps": a.reps, "rows": []}
+    doc = dict(peers.provenance("improve_slivers.py", tc), reps=a.reps, rows=[])
     for name in a.meshes.split(","):
         mesh = os.path.join(SHARED, name)
         if not os.path.exists(mesh):

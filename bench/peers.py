@@ -98,6 +98,16 @@ def default_tetcollapse():
     return shutil.which("tetcollapse")
 
 
+def provenance(script, tc):
+    """What a results file records of its run: the command, the commit, the device (bench/make_tables.py
+    prints them over the table)."""
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
+    device = subprocess.run([tc, "devices"], capture_output=True, text=True).stdout.strip().splitlines()
+    return {"command": " ".join([f"bench/{script}"] + sys.argv[1:]), "commit": commit,
+            "device": device[0] if device else None}
+
+
 def write_boundary_faces(ele, face):
     """Writes the faces that lie in exactly one tet of the TetGen .ele file as a TetGen .face file."""
     with open(ele) as f:

@@ -79,11 +79,7 @@ def main():
         sys.exit(f"quality_peers.py: no shared meshes at {SHARED}")
     names = a.meshes.split(",") if a.meshes else sorted(
         f for f in os.listdir(SHARED) if f.endswith((".msh", ".mesh", ".vtk", ".vtu")))
-    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
-    device = subprocess.run([tc, "devices"], capture_output=True, text=True).stdout.strip().splitlines()
-    doc = {"command": " ".join(["bench/quality_peers.py"] + sys.argv[1:]), "commit": commit,
-           "device": device[0] if device else None, "factor": a.factor, "reps": a.reps, "meshes": []}
+    doc = dict(peers.provenance("quality_peers.py", tc), factor=a.factor, reps=a.reps, meshes=[])
     for name in names:
         mesh = os.path.join(SHARED, name)
         info = json.loads(subprocess.run([tc, "info", mesh, "--json"], capture_output=True, text=True).stdout)
