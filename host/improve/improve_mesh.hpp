@@ -32,6 +32,9 @@ class ImpMesh {
   void write_back();
 
   tc_d3 point(int32_t v) const { return geo::tc_point(points_.data(), v); }
+  const double* point_data() const { return points_.data(); }
+  // The tets as 4 ints each (dead ones included: see alive).
+  const int32_t* tet_data() const { return tets_.empty() ? nullptr : tets_[0].data(); }
   // Moves v to p, a point inside its star, with its vertex field values interpolated there.
   void move(int32_t v, tc_d3 p);
   bool selected(int32_t v) const { return mask_.empty() || mask_[size_t(v)] != 0; }
@@ -46,9 +49,8 @@ class ImpMesh {
   // kInPlane: the plane's normal; kAlongLine: the line's direction.
   tc_d3 motion_direction(int32_t v) const { return normal_[size_t(v)]; }
   // How far v may get from where it started (infinite but on curved surfaces and lines).
-  bool within_reach(int32_t v, tc_d3 p) const {
-    return geo::length(p - start_[size_t(v)]) <= max_offset_[size_t(v)];
-  }
+  tc_d3 start(int32_t v) const { return start_[size_t(v)]; }
+  double max_offset(int32_t v) const { return max_offset_[size_t(v)]; }
   // Whether moving v to p keeps the feature surface free of self-intersections (only needed
   // where the move changes the surface's shape: off flat patches and straight lines).
   bool bends_surface(int32_t v) const { return max_offset_[size_t(v)] < std::numeric_limits<double>::infinity(); }
@@ -171,7 +173,10 @@ class ImpMesh {
 
 // One topological pass over the bad tets (worst first); returns the counts in `stats`.
 void flip_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& stats);
-// One smoothing pass over the vertices of the bad tets.
+// The vertices a smoothing pass tries: those of the bad tets that may move, in index order
+// (each is skipped while `settled`).
+std::vector<int32_t> smoothing_candidates(const ImpMesh& m, const std::vector<int32_t>& bad);
+// One smoothing pass over the vertices of the bad tets, one after the other.
 void smooth_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& stats);
 
 // The operations alone (tests): each returns whether it changed the mesh.
