@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -262,7 +263,8 @@ void register_collapse(CLI::App& app, int& exit_code) {
   app.add_flag("--no-improve", c->no_improve,
                "Coarsen only, as the paper (default: end with the improvement phase of 'tetcollapse\n"
                "improve': flips, vertex relocation and collapses that raise the worst element quality;\n"
-               "only within --region/--labels when given; not with --predicate-cl or --placement-cl)");
+               "only within --region/--labels when given; not with --predicate-cl or --placement-cl;\n"
+               "the relocation on the device, or with --method sequential on the CPU)");
   add_improve_options(app, c->improve);
   app.add_flag("-q,--quiet", c->quiet, "No progress lines, only errors");
   add_input_options(app, c->input);
@@ -351,13 +353,14 @@ void register_collapse(CLI::App& app, int& exit_code) {
     QualitySummary quality_in, quality_collapsed;
     if (report_quality) quality_in = quality_summary(mesh);
     CollapseReport r;
+    std::unique_ptr<Context> ctx;  // the improvement's too
     if (opt.method == CollapseOptions::Sequential) {
       if (!c->quiet) std::cerr << "method: sequential (CPU)\n";
       r = collapse_sequential(mesh, opt);
     } else {
-      Context ctx(c->device);
-      if (!c->quiet) std::cerr << "device: " << ctx.info().name << " (" << ctx.info().platform_name << ")\n";
-      r = collapse(mesh, opt, ctx);
+      ctx = std::make_unique<Context>(c->device);
+      if (!c->quiet) std::cerr << "device: " << ctx->info().name << " (" << ctx->info().platform_name << ")\n";
+      r = collapse(mesh, opt, *ctx);
     }
     if (!c->sizing_field.empty()) std::swap(mesh.vertex_fields[0], mesh.vertex_fields[sizing_index]);
     // A user's predicate or placement states rules the improvement cannot know: no phase then.
@@ -373,7 +376,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
       // --region, --labels: improve there only (the masks of the coarse mesh)
       if (!c->region.empty()) combine(io.vertex_mask, region_mask(mesh, c->region));
       if (!c->labels.empty()) combine(io.vertex_mask, label_mask(mesh, c->labels));
-      ir = run_improve(mesh, c->improve, c->quiet);
+      ir = run_improve(mesh, c->improve, c->quiet, ctx.get());
       quality_collapsed = ir.before;
       // the output's counts (the improvement's collapse step may remove a few more)
       r.vertices_out = mesh.num_vertices();

@@ -1,6 +1,7 @@
 // tetcollapse improve IN OUT: raise the worst element quality (flips and vertex relocation).
 #include <cstdio>
 #include <iostream>
+#include <memory>
 
 #include "cli/common.hpp"
 #include "cli/improve_cli.hpp"
@@ -40,7 +41,7 @@ std::string quality_line(const QualitySummary& q) {
   return buf;
 }
 
-ImproveReport run_improve(Mesh& mesh, ImproveCli& c, bool quiet) {
+ImproveReport run_improve(Mesh& mesh, ImproveCli& c, bool quiet, Context* ctx) {
   c.opt.flips = !c.no_flips;
   c.opt.smoothing = !c.no_smoothing;
   c.opt.collapse = !c.no_collapse;
@@ -54,7 +55,7 @@ ImproveReport run_improve(Mesh& mesh, ImproveCli& c, bool quiet) {
                    (long long)s.relocated, (long long)s.collapsed, s.min_dihedral_deg, (long long)s.below_10_deg,
                    (long long)s.below_13_deg, s.seconds);
     };
-  return improve(mesh, c.opt);
+  return ctx ? improve(mesh, c.opt, *ctx) : improve(mesh, c.opt);
 }
 
 void write_quality(JsonWriter& w, std::string_view key, const QualitySummary& q) {
@@ -93,7 +94,7 @@ void write_improve(JsonWriter& w, const ImproveReport& r) {
 
 void register_improve(CLI::App& app, int& exit_code) {
   struct Opts {
-    std::string in, out, boundary = "features", stats;
+    std::string in, out, boundary = "features", stats, method = "parallel", device;
     InputOptions input;
     OutputOptions output;
     ImproveCli improve;
@@ -119,6 +120,14 @@ void register_improve(CLI::App& app, int& exit_code) {
   cmd->add_option("--eps-f", o->improve.opt.eps_f, "Face-vertex threshold on 1 - dot of normals")->capture_default_str();
   cmd->add_option("--eps-r", o->improve.opt.eps_r, "Ridge-edge threshold on 1 - dot of normals")->capture_default_str();
   add_improve_options(*cmd, o->improve);
+  cmd->add_option("--method", o->method,
+                  "parallel (default): vertex relocation on the OpenCL device, in rounds of vertices that\n"
+                  "share no tet; sequential: everything on the CPU, one operation after the other (no\n"
+                  "OpenCL device needed). Flips and the collapse step run on the CPU either way")
+      ->check(CLI::IsMember({"parallel", "sequential"}));
+  cmd->add_option("--device", o->device,
+                  "OpenCL device: index or name substring (see 'tetcollapse devices');\n"
+                  "default: $TETCOLLAPSE_DEVICE, else the first GPU, else the first CPU");
   cmd->add_option("--stats", o->stats, "Write the run's statistics as JSON to this file ('-' for stdout)");
   cmd->add_flag("--check", o->check, "Check the result (validity, unchanged boundary topology) and fail if invalid");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress lines, only errors");
@@ -134,7 +143,14 @@ void register_improve(CLI::App& app, int& exit_code) {
     ImproveOptions& opt = o->improve.opt;
     opt.boundary = boundary_mode(o->boundary);
     opt.use_labels = !o->no_labels;
-    ImproveReport r = run_improve(mesh, o->improve, o->quiet);
+    if (o->method == "sequential" && !o->device.empty())
+      throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
+    std::unique_ptr<Context> ctx;
+    if (o->method == "parallel") {
+      ctx = std::make_unique<Context>(o->device);
+      if (!o->quiet) std::cerr << "device: " << ctx->info().name << " (" << ctx->info().platform_name << ")\n";
+    }
+    ImproveReport r = run_improve(mesh, o->improve, o->quiet, ctx.get());
     exit_code = kOk;
     const std::string verdict =
         o->check ? check_result(mesh, input, opt.boundary == CollapseOptions::Strict, o->quiet, exit_code) : "";

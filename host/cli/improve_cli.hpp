@@ -15,7 +15,8 @@ struct ImproveCli {
 };
 void add_improve_options(CLI::App& cmd, ImproveCli& c);
 // Runs the phase with progress lines on stderr unless quiet.
-ImproveReport run_improve(Mesh& mesh, ImproveCli& c, bool quiet);
+// With a context, the relocation runs on its device (tc::improve's overloads).
+ImproveReport run_improve(Mesh& mesh, ImproveCli& c, bool quiet, Context* ctx);
 void write_quality(JsonWriter& w, std::string_view key, const QualitySummary& q);
 void write_improve(JsonWriter& w, const ImproveReport& r);
 // "min 4.8, median 41.2 degrees, 52 below 10, 160 below 13"

@@ -78,7 +78,9 @@ QualitySummary quality_summary(const Mesh& mesh) {
 namespace {
 
 // Passes of flips and relocation on `mesh` until they stall; appends them to the report.
-void passes(Mesh& mesh, const ImproveOptions& options, int max_passes, ImproveReport& report, bool first) {
+// With a context, the relocation runs on its device.
+void passes(Mesh& mesh, const ImproveOptions& options, Context* ctx, int max_passes, ImproveReport& report,
+            bool first) {
   ImpMesh m(mesh, options);
   if (first) report.pinned_below_13_before = pinned_below_13(m);
   const double threshold = std::sin(options.threshold_deg / kDeg);
@@ -89,7 +91,10 @@ void passes(Mesh& mesh, const ImproveOptions& options, int max_passes, ImproveRe
     const std::vector<int32_t> bad = bad_tets(m, threshold);
     stats.bad_tets = int64_t(bad.size());
     if (options.flips) flip_pass(m, bad, stats);
-    if (options.smoothing) smooth_pass(m, bad_tets(m, threshold), stats);
+    if (options.smoothing) {
+      if (ctx) smooth_pass(m, *ctx, bad_tets(m, threshold), stats);
+      else smooth_pass(m, bad_tets(m, threshold), stats);
+    }
     measure(m, stats);
     stats.seconds = pass_clock.peek();
     report.passes.push_back(stats);
@@ -136,13 +141,11 @@ int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options) {
   return collapsed;
 }
 
-}  // namespace
-
-ImproveReport improve(Mesh& mesh, const ImproveOptions& options) {
+ImproveReport improve_on(Mesh& mesh, const ImproveOptions& options, Context* ctx) {
   const Stopwatch clock;
   ImproveReport report;
   report.before = quality_summary(mesh);
-  passes(mesh, options, options.max_iterations, report, true);
+  passes(mesh, options, ctx, options.max_iterations, report, true);
   // (With a vertex mask the step does not run: the collapse renumbers the vertices.)
   if (options.collapse && options.vertex_mask.empty() && int(report.passes.size()) < options.max_iterations) {
     const Stopwatch step;
@@ -167,12 +170,19 @@ ImproveReport improve(Mesh& mesh, const ImproveOptions& options) {
       stats.seconds = step.peek();
       report.passes.push_back(stats);
       if (options.progress) options.progress(stats);
-      passes(mesh, options, options.max_iterations - int(report.passes.size()), report, false);
+      passes(mesh, options, ctx, options.max_iterations - int(report.passes.size()), report, false);
     }
   }
   report.after = quality_summary(mesh);
   report.seconds_total = clock.peek();
   return report;
+}
+
+}  // namespace
+
+ImproveReport improve(Mesh& mesh, const ImproveOptions& options) { return improve_on(mesh, options, nullptr); }
+ImproveReport improve(Mesh& mesh, const ImproveOptions& options, Context& ctx) {
+  return improve_on(mesh, options, &ctx);
 }
 
 }  // namespace tc

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "geometry.h"
+#include "tetcollapse/device.hpp"
 #include "tetcollapse/improve.hpp"
 #include "tetcollapse/mesh.hpp"
 
@@ -178,6 +179,9 @@ void flip_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& st
 std::vector<int32_t> smoothing_candidates(const ImpMesh& m, const std::vector<int32_t>& bad);
 // One smoothing pass over the vertices of the bad tets, one after the other.
 void smooth_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& stats);
+// The same on `ctx`: the vertices off curved surfaces move on the device, in rounds of
+// vertices no two of which share a tet; the others then move on the host.
+void smooth_pass(ImpMesh& m, Context& ctx, const std::vector<int32_t>& bad, ImprovePassStats& stats);
 
 // The operations alone (tests): each returns whether it changed the mesh.
 bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b);

@@ -16,10 +16,14 @@
 //                                          and free modes; the boundary moves by at most
 //                                          max_boundary_move)
 //         accepted only if the worst q of the changed tets rises
-//       for v in vertices of bad tets:    -- smoothing pass
+//       for v in vertices of bad tets:    -- smoothing pass (with a device: in rounds of
+//                                          vertices no two of which share a tet, lowest star
+//                                          quality first; curved surfaces' vertices after, on
+//                                          the host)
 //         move v to raise the worst q of its star (ascent along the worst tets' gradients
-//         with a line search; a Face vertex of a flat boundary patch moves within its plane;
-//         other boundary vertices do not move)
+//         with a line search; a Face vertex of a flat boundary patch moves within its plane,
+//         a ridge vertex along its line, on curved ones within max_boundary_move; corners
+//         do not move)
 //       stop when nothing changed, or when a pass left the smallest dihedral angle and the
 //       counts of tets below 10 and 13 degrees as they were
 //     collapse short edges between vertices of the tets still below 13 degrees, each only when
@@ -37,6 +41,7 @@
 #include <vector>
 
 #include "tetcollapse/collapse.hpp"
+#include "tetcollapse/device.hpp"
 #include "tetcollapse/mesh.hpp"
 
 namespace tc {
@@ -102,6 +107,13 @@ struct ImproveOptions {
 // Improves `mesh` in place: tets, labels and tet fields (a new tet takes those of a tet it
 // replaces), vertex positions (a moved vertex takes the values of the vertex fields at its new
 // place, interpolated linearly in the tets around it). Throws InputError for an inverted tet.
+// On the CPU, one operation after the other (the sequential baseline).
 ImproveReport improve(Mesh& mesh, const ImproveOptions& options = {});
+// The same with the relocation on ctx's device: each smoothing pass moves the vertices off
+// curved surfaces in rounds of vertices no two of which share a tet (the one of lowest star
+// quality, then index, first: the result does not depend on the device's work-group size),
+// then the others on the host, where the surface guard runs. The operations are those of the
+// CPU version, in another order, so the meshes differ slightly.
+ImproveReport improve(Mesh& mesh, const ImproveOptions& options, Context& ctx);
 
 }  // namespace tc
