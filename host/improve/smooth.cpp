@@ -21,10 +21,13 @@ bool try_smooth(ImpMesh& m, int32_t v) {
     return geo::tci_relocate(m.point_data(), m.tet_data(), star.data(), sorted.data(), int(star.size()), v, motion,
                              m.motion_direction(v), m.start(v), m.max_offset(v), m.cos_threshold(), surface_clear, p);
   };
-  std::function<bool(int, tc_d3)> surface_clear;
-  if (m.bends_surface(v)) surface_clear = [&m](int u, tc_d3 x) { return m.surface_stays_clear(u, x); };
   tc_d3 p;
-  if (!relocate(surface_clear, &p)) return false;
+  if (!relocate({}, &p)) return false;
+  // On a curved surface the guard is the costly part: it is asked of the ascent's end only,
+  // and of every step only when that end would cross the surface.
+  if (m.bends_surface(v) && !m.surface_stays_clear(v, p) &&
+      !relocate([&m](int u, tc_d3 x) { return m.surface_stays_clear(u, x); }, &p))
+    return false;
   m.move(v, p);
   if (motion != kFree) m.surface_moved(v);  // its surface triangles moved: re-list them
   return true;
