@@ -70,7 +70,7 @@ void write_quality(JsonWriter& w, std::string_view key, const QualitySummary& q)
 }
 
 void write_improve(JsonWriter& w, const ImproveReport& r) {
-  w.key("improve").begin_object().field("seconds", r.seconds_total);
+  w.key("improve").begin_object().field("seconds", r.seconds_total).field("seconds_setup", r.seconds_setup);
   write_quality(w, "quality_before", r.before);
   write_quality(w, "quality_after", r.after);
   w.field("pinned_below_13_before", r.pinned_below_13_before).field("pinned_below_13_after", r.pinned_below_13_after);
@@ -88,6 +88,8 @@ void write_improve(JsonWriter& w, const ImproveReport& r) {
         .field("below_10_deg", p.below_10_deg)
         .field("below_13_deg", p.below_13_deg)
         .field("seconds", p.seconds)
+        .field("seconds_flips", p.seconds_flips)
+        .field("seconds_relocation", p.seconds_relocation)
         .end_object();
   w.end_array().end_object();
 }

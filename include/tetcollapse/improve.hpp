@@ -66,6 +66,7 @@ struct ImprovePassStats {
   double min_dihedral_deg = 0;  // after the pass
   int64_t below_10_deg = 0, below_13_deg = 0;
   double seconds = 0;
+  double seconds_flips = 0, seconds_relocation = 0;  // parts of `seconds`
 };
 
 struct ImproveReport {
@@ -75,6 +76,8 @@ struct ImproveReport {
   int64_t pinned_below_13_before = 0, pinned_below_13_after = 0;
   std::vector<ImprovePassStats> passes;
   double seconds_total = 0;
+  // Building the improvement's mesh (the vertex classes, the surface grid) and writing it back.
+  double seconds_setup = 0;
 };
 
 struct ImproveOptions {
