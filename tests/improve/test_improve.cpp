@@ -134,6 +134,37 @@ TEST(ImproveOps, FlipsKeepLabelsApart) {
   EXPECT_FALSE(improve_detail::try_edge_removal(im, 0, 1)) << "the faces around the edge include an interface";
 }
 
+// Half of a 4-ring around a long edge (a, b): its two boundary faces lie in the plane y = 0, a
+// flat quad (a, r0, b, r2) whose long diagonal (a, b) flips to (r0, r2).
+TEST(ImproveOps, FlatBoundaryPairFlipsItsDiagonal) {
+  Mesh m = edge_ring(4, 3.0);
+  m.tets.resize(2 * 4);  // (a, b, r1, r0), (a, b, r2, r1)
+  const double v0 = volume_of(m), q0 = worst(m);
+  const Mesh before = m;
+  {
+    ImpMesh im(m, {});
+    EXPECT_TRUE(improve_detail::try_edge_removal(im, 0, 1));
+    im.write_back();
+  }
+  ASSERT_EQ(m.num_tets(), 2);
+  EXPECT_NEAR(volume_of(m), v0, 1e-12);
+  EXPECT_GT(worst(m), q0);
+  EXPECT_EQ(sface_keys(m).count({0, 2, 4}), 1u) << "the new diagonal (r0, r2) on the boundary";
+  EXPECT_EQ(sface_keys(m).count({1, 2, 4}), 1u);
+  const CheckReport cr = check_mesh(m, {}, &before);
+  EXPECT_TRUE(cr.valid) << check_report_text(cr);
+
+  ImproveOptions strict;
+  strict.boundary = CollapseOptions::Strict;
+  Mesh s = before;
+  EXPECT_FALSE(improve_detail::try_edge_removal(*std::make_unique<ImpMesh>(s, strict), 0, 1)) << "strict";
+  ImproveOptions fixed;
+  fixed.max_boundary_move = 0;
+  Mesh f = before;
+  EXPECT_FALSE(improve_detail::try_edge_removal(*std::make_unique<ImpMesh>(f, fixed), 0, 1))
+      << "max_boundary_move 0: no boundary face changes";
+}
+
 // A thin tet (a, b, x1, x2) on top of two others (c below), which four more tets (e1..e4)
 // wrap so that they keep one face each on the boundary: its faces through (a, b) are on the
 // boundary.
