@@ -142,7 +142,11 @@ int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options) {
   o.eps_f = options.eps_f;
   o.eps_r = options.eps_r;
   o.use_labels = options.use_labels;
-  o.min_quality = 1;  // the guard at its strictest: never below the worst quality before
+  // What the collapse reshapes may fall to this mean ratio (or stay as bad as it was): a
+  // collapse whose removed tets are the slivers must be allowed to lower the others a little
+  // (with 1, the guard at its strictest, a short edge's slivers were never collapsed); the
+  // dihedral figures are checked after the step.
+  o.min_quality = 0.3;
   o.target_length = options.collapse_length > 0 ? options.collapse_length : 1.5 * median_edge_length(mesh);
   o.vertex_mask = std::move(mask);
   int64_t collapsed = 0;

@@ -165,6 +165,37 @@ TEST(ImproveOps, FlatBoundaryPairFlipsItsDiagonal) {
       << "max_boundary_move 0: no boundary face changes";
 }
 
+// A short interior edge (u, v): the tets around it are slivers that no flip can mend (the
+// two vertices stay nearly one whatever the triangulation) and that, with smoothing off, only
+// the collapse step removes.
+TEST(ImproveOps, ASliverOnlyACollapseRemoves) {
+  Mesh m = cube_tets(4);
+  int32_t u = -1, v = -1;  // (0.5, 0.5, 0.5) and (0.75, 0.5, 0.5), neighbours in the Kuhn split
+  for (int64_t i = 0; i < m.num_vertices(); ++i) {
+    const double* p = &m.points[3 * size_t(i)];
+    if (p[1] == 0.5 && p[2] == 0.5 && p[0] == 0.5) u = int32_t(i);
+    if (p[1] == 0.5 && p[2] == 0.5 && p[0] == 0.75) v = int32_t(i);
+  }
+  ASSERT_GE(u, 0);
+  ASSERT_GE(v, 0);
+  m.points[3 * size_t(v)] = 0.5075;  // along the edge, so every tet stays positive
+  ImproveOptions o;
+  o.smoothing = false;
+  Mesh without = m;
+  o.collapse = false;
+  const ImproveReport r0 = improve(without, o);
+  EXPECT_LT(r0.before.min_dihedral_deg, 5);
+  EXPECT_LT(r0.after.min_dihedral_deg, 5) << "flips alone leave the slivers";
+  o.collapse = true;
+  const ImproveReport r = improve(m, o);
+  int64_t collapsed = 0;
+  for (const auto& p : r.passes) collapsed += p.collapsed;
+  EXPECT_GE(collapsed, 1);
+  EXPECT_GT(r.after.min_dihedral_deg, 25) << "the collapse took the short edge and its slivers";
+  EXPECT_EQ(r.after.below_13_deg, 0);
+  EXPECT_TRUE(check_mesh(m, {}, nullptr).valid);
+}
+
 // A thin tet (a, b, x1, x2) on top of two others (c below), which four more tets (e1..e4)
 // wrap so that they keep one face each on the boundary: its faces through (a, b) are on the
 // boundary.
