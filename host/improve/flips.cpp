@@ -6,30 +6,13 @@
 #include <limits>
 
 #include "improve/improve_mesh.hpp"
+#include "improve_flip.h"
 
 namespace tc::improve_detail {
 
 namespace {
 
-constexpr int kMaxRing = 7;  // Shewchuk: larger rings rarely give a better triangulation
-
-// The two vertices of q other than a and b, ordered so that (a, b, c, d) is an even
-// permutation of q, i.e. has q's (positive) orientation.
-void others(const Tet& q, int32_t a, int32_t b, int32_t& c, int32_t& d) {
-  int pos[4], n = 0, ia = -1, ib = -1;
-  for (int k = 0; k < 4; ++k) {
-    if (q[k] == a) ia = k;
-    else if (q[k] == b) ib = k;
-    else pos[n++] = k;
-  }
-  int perm[4] = {ia, ib, pos[0], pos[1]};
-  int inversions = 0;
-  for (int i = 0; i < 4; ++i)
-    for (int j = i + 1; j < 4; ++j) inversions += perm[i] > perm[j];
-  c = q[pos[0]];
-  d = q[pos[1]];
-  if (inversions & 1) std::swap(c, d);
-}
+constexpr int kMaxRing = TCI_MAX_RING;
 
 }  // namespace
 
@@ -42,7 +25,7 @@ void others(const Tet& q, int32_t a, int32_t b, int32_t& c, int32_t& d) {
 // positive. On the boundary, the polygon's closing edge (r_0, r_m-1) becomes the diagonal of the
 // boundary quad (a, r_0, b, r_m-1) in place of (a, b): the boundary 2-2 flip for two tets, and
 // its generalisation for more.
-bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b) {
+bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b, bool open_rings_only) {
   if (m.tagged_edge(a, b) || !m.selected(a) || !m.selected(b)) return false;
   std::vector<int32_t> ring_tets;
   for (int32_t t : m.tets_of(a)) {
@@ -55,33 +38,15 @@ bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b) {
   double old_min = std::numeric_limits<double>::infinity(), old_cos = -1;
   for (int i = 0; i < n; ++i) {
     if (m.label(ring_tets[size_t(i)]) != m.label(ring_tets[0])) return false;
-    others(m.tet(ring_tets[size_t(i)]), a, b, from[i], to[i]);
+    geo::tci_others(m.tet(ring_tets[size_t(i)]).data(), a, b, &from[i], &to[i]);
     old_min = std::min(old_min, m.quality(ring_tets[size_t(i)]));
     old_cos = std::max(old_cos, m.max_cos(ring_tets[size_t(i)]));
   }
-  // The start: a vertex no arc enters (an open ring), else the first arc's.
-  int start = 0;
-  for (int i = 0; i < n; ++i) {
-    bool entered = false;
-    for (int k = 0; k < n; ++k) entered = entered || to[k] == from[i];
-    if (!entered) start = i;
-  }
   int32_t r[kMaxRing + 1] = {};
-  r[0] = from[start];
-  int len = 1;
-  for (int step = 0; step < n; ++step) {
-    int j = 0;
-    while (j < n && from[j] != r[len - 1]) ++j;
-    if (j == n) return false;  // not one chain
-    r[len++] = to[j];
-  }
-  const bool closed = r[len - 1] == r[0];
-  if (closed) --len;
-  for (int i = 0; i < len; ++i)
-    for (int k = 0; k < i; ++k)
-      if (r[k] == r[i]) return false;  // not a simple ring or chain
-  const int mm = len;                  // polygon vertices: n closed, n + 1 open
+  int mm = 0, closed = 0, start = 0;  // mm: polygon vertices, n closed, n + 1 open
+  if (!geo::tci_chain(n, from, to, r, &mm, &closed, &start)) return false;
   if (closed ? n < 3 : !m.may_change_boundary() || mm > kMaxRing) return false;
+  if (open_rings_only && closed) return false;
   for (int i = 0; i < mm; ++i) {  // a face of the old tets that the input tags must stay
     const bool outer = !closed && (i == 0 || i == mm - 1);  // these two: replace_on_boundary
     if ((!outer && m.tagged_face(a, b, r[i])) || !m.selected(r[i])) return false;
@@ -97,56 +62,28 @@ bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b) {
     if (!flat_quad(m, a, b, r[0], r[mm - 1])) return false;
   }
 
-  // Klincsek's dynamic programme: best[i][j] is the best worst quality of a triangulation of
-  // the sub-polygon r_i..r_j; a chord that is already an edge of the mesh is not allowed.
-  const double kNone = -std::numeric_limits<double>::infinity();
-  double best[kMaxRing][kMaxRing];
-  int split[kMaxRing][kMaxRing];
-  auto chord_ok = [&](int i, int j) {
-    return j - i == 1 || (i == 0 && j == mm - 1) || !m.has_edge(r[i], r[j]);
-  };
-  auto triangle = [&](int i, int j, int k) {
-    if (m.tagged_face(r[i], r[j], r[k]) || m.has_face(r[i], r[j], r[k])) return kNone;
-    return std::min(m.quality_of({r[i], r[j], r[k], b}), m.quality_of({r[k], r[j], r[i], a}));
-  };
-  for (int l = 1; l < mm; ++l)
-    for (int i = 0; i + l < mm; ++i) {
-      const int j = i + l;
-      split[i][j] = -1;
-      if (l == 1) {
-        best[i][j] = std::numeric_limits<double>::infinity();
-        continue;
-      }
-      best[i][j] = kNone;
-      if (!chord_ok(i, j)) continue;
-      for (int k = i + 1; k < j; ++k) {
-        const double q = std::min({best[i][k], best[k][j], triangle(i, k, j)});
-        if (q > best[i][j]) {
-          best[i][j] = q;
-          split[i][j] = k;
-        }
-      }
+  // The best triangulation of the polygon; a chord that is already an edge of the mesh is not
+  // allowed, nor a triangle that is a face of the mesh or of the input's tags.
+  int chord_ok[kMaxRing * kMaxRing];
+  double tri_q[TCI_TRI_TABLE], best[kMaxRing * kMaxRing];
+  int split[kMaxRing * kMaxRing];
+  for (int i = 0; i < mm; ++i)
+    for (int j = i + 2; j < mm; ++j) {
+      chord_ok[i * kMaxRing + j] = (i == 0 && j == mm - 1) || !m.has_edge(r[i], r[j]);
+      if (!chord_ok[i * kMaxRing + j]) continue;
+      for (int k = i + 1; k < j; ++k)
+        tri_q[geo::tci_tri_index(i, k, j)] =
+            m.tagged_face(r[i], r[k], r[j]) || m.has_face(r[i], r[k], r[j])
+                ? -std::numeric_limits<double>::infinity()
+                : std::min(m.quality_of({r[i], r[k], r[j], b}), m.quality_of({r[j], r[k], r[i], a}));
     }
-  if (!(best[0][mm - 1] > old_min) || split[0][mm - 1] < 0) return false;
-  std::vector<Tet> added;
-  int stack[2 * kMaxRing][2], top = 0;
-  stack[top][0] = 0;
-  stack[top++][1] = mm - 1;
-  while (top > 0) {
-    --top;
-    const int i = stack[top][0], j = stack[top][1];
-    if (j - i < 2) continue;
-    const int k = split[i][j];
-    added.push_back({r[i], r[k], r[j], b});
-    added.push_back({r[j], r[k], r[i], a});
-    stack[top][0] = i;
-    stack[top++][1] = k;
-    stack[top][0] = k;
-    stack[top++][1] = j;
-  }
+  const double new_min = geo::tci_klincsek(mm, chord_ok, tri_q, best, split);
+  if (!(new_min > old_min) || split[mm - 1] < 0) return false;
+  std::vector<Tet> added(size_t(2 * mm - 4));
+  geo::tci_emit(mm, r, split, a, b, added[0].data());
   double new_cos = -1;
   for (const Tet& q : added) new_cos = std::max(new_cos, m.max_cos_of(q));
-  if (!m.improves(old_min, old_cos, best[0][mm - 1], new_cos)) return false;
+  if (!m.improves(old_min, old_cos, new_min, new_cos)) return false;
   if (closed) {
     m.replace(ring_tets, added, ring_tets[0]);
     return true;

@@ -184,7 +184,8 @@ void smooth_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& 
 void smooth_pass(ImpMesh& m, Context& ctx, const std::vector<int32_t>& bad, ImprovePassStats& stats);
 
 // The operations alone (tests): each returns whether it changed the mesh.
-bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b);
+// open_rings_only: only the edges of the boundary (the device takes the others).
+bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b, bool open_rings_only = false);
 bool try_flip23(ImpMesh& m, int32_t t, int face);
 bool try_smooth(ImpMesh& m, int32_t v);
 bool try_remove_boundary_sliver(ImpMesh& m, int32_t t);
