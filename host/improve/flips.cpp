@@ -121,6 +121,20 @@ bool try_flip23(ImpMesh& m, int32_t t, int face) {
   return true;
 }
 
+bool try_boundary_flips(ImpMesh& m, int32_t t, ImprovePassStats& stats) {
+  const Tet q = m.tet(t);
+  for (int e = 0; e < 6; ++e)
+    if (try_edge_removal(m, q[geo::TC_TET_EDGES[e][0]], q[geo::TC_TET_EDGES[e][1]], true)) {
+      ++stats.edge_removals;
+      return true;
+    }
+  if (try_remove_boundary_sliver(m, t)) {
+    ++stats.boundary_removals;
+    return true;
+  }
+  return false;
+}
+
 void flip_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& stats) {
   for (int32_t t : bad) {
     if (!m.alive(t)) continue;

@@ -16,6 +16,23 @@ uint64_t ImpMesh::key2(int32_t a, int32_t b) {
   return uint64_t(uint32_t(a)) << 32 | uint32_t(b);
 }
 
+std::vector<uint64_t> ImpMesh::tagged_edge_keys() const {
+  std::vector<uint64_t> keys(tagged_edges_.begin(), tagged_edges_.end());
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
+std::vector<int32_t> ImpMesh::tagged_face_records() const {
+  std::vector<FaceKey> faces;
+  faces.reserve(tris_.size());
+  for (const auto& [k, index] : tris_) faces.push_back(k);
+  std::sort(faces.begin(), faces.end());
+  std::vector<int32_t> out;
+  out.reserve(4 * faces.size());
+  for (const FaceKey& f : faces) out.insert(out.end(), {f[0], f[1], f[2], 0});
+  return out;
+}
+
 ImpMesh::FaceKey ImpMesh::face_key(int32_t a, int32_t b, int32_t c) {
   FaceKey k{a, b, c};
   std::sort(k.begin(), k.end());

@@ -68,6 +68,10 @@ class ImpMesh {
   bool has_edge(int32_t a, int32_t b) const;
   bool has_face(int32_t a, int32_t b, int32_t c) const { return across(-1, a, b, c) >= 0; }
   bool tagged_edge(int32_t a, int32_t b) const { return tagged_edges_.count(key2(a, b)) != 0; }
+  // The tagged edges as sorted keys (smaller vertex << 32 | larger), the tagged triangles as
+  // sorted records of 4 ints (the vertices in increasing order, 0): what the device searches.
+  std::vector<uint64_t> tagged_edge_keys() const;
+  std::vector<int32_t> tagged_face_records() const;
   bool tagged_face(int32_t a, int32_t b, int32_t c) const { return tris_.count(face_key(a, b, c)) != 0; }
   // The tet other than t with the face (a, b, c), or -1 (a boundary face).
   int32_t across(int32_t t, int32_t a, int32_t b, int32_t c) const;
@@ -174,6 +178,12 @@ class ImpMesh {
 
 // One topological pass over the bad tets (worst first); returns the counts in `stats`.
 void flip_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& stats);
+// The same on `ctx`: the interior flips found on the device and applied in rounds of flips
+// that share no vertex; the boundary's flips and removals then on the host.
+void flip_pass(ImpMesh& m, Context& ctx, const std::vector<int32_t>& bad, ImprovePassStats& stats);
+// The boundary operations of a bad tet alone (after the device's flips): the removal of an edge
+// of the boundary (a flat quad's diagonal), else of the tet itself. Counts in `stats`.
+bool try_boundary_flips(ImpMesh& m, int32_t t, ImprovePassStats& stats);
 // The vertices a smoothing pass tries: those of the bad tets that may move, in index order
 // (each is skipped while `settled`).
 std::vector<int32_t> smoothing_candidates(const ImpMesh& m, const std::vector<int32_t>& bad);

@@ -113,11 +113,14 @@ struct ImproveOptions {
 // place, interpolated linearly in the tets around it). Throws InputError for an inverted tet.
 // On the CPU, one operation after the other (the sequential baseline).
 ImproveReport improve(Mesh& mesh, const ImproveOptions& options = {});
-// The same with the relocation on ctx's device: each smoothing pass moves the vertices off
-// curved surfaces in rounds of vertices no two of which share a tet (the one of lowest star
-// quality, then index, first: the result does not depend on the device's work-group size),
-// then the others on the host, where the surface guard runs. The operations are those of the
-// CPU version, in another order, so the meshes differ slightly.
+// The same on ctx's device. Each smoothing pass moves the vertices off curved surfaces in
+// rounds of vertices no two of which share a tet (the one of lowest star quality, then index,
+// first), then the others on the host, where the surface guard runs. Unless the context tunes
+// for a CPU (Context::cpu_tuning; a CPU finds them as fast on the host), each flip pass finds
+// the interior flips of the bad tets on the device and applies rounds of flips sharing no
+// vertex (worst tet first), the last quarter and the boundary's operations on the host. The
+// result does not depend on the work-group size; the operations are those of the CPU version,
+// in another order, so the meshes differ slightly.
 ImproveReport improve(Mesh& mesh, const ImproveOptions& options, Context& ctx);
 
 }  // namespace tc

@@ -310,7 +310,7 @@ TEST(ImproveDevice, RelocationMatchesTheHostForVerticesApart) {
   ImpMesh host_mesh(on_host, o), device_mesh(on_device, o);
   std::vector<int32_t> all(size_t(host_mesh.num_tet_slots()));
   for (size_t t = 0; t < all.size(); ++t) all[t] = int32_t(t);
-  ImprovePassStats hs, ds;
+  tc::ImprovePassStats hs, ds;
   improve_detail::smooth_pass(host_mesh, all, hs);
   Context ctx;
   improve_detail::smooth_pass(device_mesh, ctx, all, ds);
@@ -319,6 +319,25 @@ TEST(ImproveDevice, RelocationMatchesTheHostForVerticesApart) {
   // (OpenCL rounds a few operations differently; the numeric gradients carry that to ~1e-11)
   for (size_t i = 0; i < m.points.size(); ++i)
     ASSERT_NEAR(on_device.points[i], on_host.points[i], 1e-9) << i / 3;
+}
+
+// The device finds the flips the host finds: an edge of n tets alone, on its closed ring.
+TEST(ImproveDevice, FlipsMatchTheHostOnARing) {
+  for (const auto& [n, h] : std::vector<std::pair<int, double>>{{3, 1.0}, {4, 2.0}, {5, 3.0}}) {
+    Mesh on_host = edge_ring(n, h), on_device = on_host;
+    ImpMesh host_mesh(on_host, {}), device_mesh(on_device, {});
+    std::vector<int32_t> all(static_cast<size_t>(n));
+    for (int t = 0; t < n; ++t) all[size_t(t)] = t;
+    tc::ImprovePassStats hs, ds;
+    improve_detail::flip_pass(host_mesh, all, hs);
+    Context ctx;
+    improve_detail::flip_pass(device_mesh, ctx, all, ds);
+    EXPECT_EQ(hs.edge_removals, 1) << n;
+    EXPECT_EQ(ds.edge_removals, 1) << n;
+    host_mesh.write_back();
+    device_mesh.write_back();
+    expect_same_mesh(on_device, on_host, "ring of " + std::to_string(n));
+  }
 }
 
 // Neighbouring vertices move in rounds chosen by their keys alone: the same mesh whatever the
@@ -333,21 +352,26 @@ TEST(ImproveDevice, SameMeshWhateverTheWorkGroupSize) {
   o.threshold_deg = 30;
   o.collapse = false;
   Context ctx;
-  Mesh first;
-  for (const auto& [wg, cpu] : std::vector<std::pair<size_t, bool>>{{0, true}, {1, true}, {4, false}, {64, false}}) {
+  Mesh first[2];  // per tuning: on a GPU the flips are found on the device too
+  for (const auto& [wg, cpu] :
+       std::vector<std::pair<size_t, bool>>{{0, true}, {1, true}, {0, false}, {1, false}, {4, false}, {64, false}}) {
     ctx.set_work_group_size(wg);
     ctx.set_cpu_tuning(cpu);
     Mesh d = m;
     const ImproveReport r = improve(d, o, ctx);
-    int64_t relocated = 0;
-    for (const auto& p : r.passes) relocated += p.relocated;
+    int64_t relocated = 0, flipped = 0;
+    for (const auto& p : r.passes) {
+      relocated += p.relocated;
+      flipped += p.edge_removals + p.flips23;
+    }
     EXPECT_GT(relocated, 20);
+    EXPECT_GT(flipped, 5);
     EXPECT_GE(worst(d), worst(m));
-    if (first.points.empty()) {
+    if (first[cpu].points.empty()) {
       EXPECT_TRUE(check_mesh(d, {}, nullptr).valid);
-      first = d;
+      first[cpu] = d;
     } else {
-      expect_same_mesh(d, first, "work-group size " + std::to_string(wg));
+      expect_same_mesh(d, first[cpu], "work-group size " + std::to_string(wg));
     }
   }
 }
@@ -397,11 +421,15 @@ TEST(ImprovePhase, BracketGetsValidAndBetter) {
     const ImproveReport r = improve(m, o);
     EXPECT_LT(r.before.min_dihedral_deg, 8) << "the coarsened bracket has slivers to remove";
     Context ctx;
-    const ImproveReport rd = improve(on_device, o, ctx);
-    EXPECT_GT(rd.after.min_dihedral_deg, rd.before.min_dihedral_deg + 2.5) << "on the device";
-    EXPECT_LT(rd.after.below_10_deg, rd.before.below_10_deg / 4 + 1) << "on the device";
-    EXPECT_GE(worst(on_device), worst(before)) << "on the device";
-    EXPECT_TRUE(check_mesh(on_device, {}, &before).valid) << "on the device";
+    for (bool cpu : {true, false}) {  // (the GPU tuning: flips found on the device too)
+      Mesh d = on_device;
+      ctx.set_cpu_tuning(cpu);
+      const ImproveReport rd = improve(d, o, ctx);
+      EXPECT_GT(rd.after.min_dihedral_deg, rd.before.min_dihedral_deg + 2.5) << "on the device " << cpu;
+      EXPECT_LT(rd.after.below_10_deg, rd.before.below_10_deg / 4 + 1) << "on the device " << cpu;
+      EXPECT_GE(worst(d), worst(before)) << "on the device " << cpu;
+      EXPECT_TRUE(check_mesh(d, {}, &before).valid) << "on the device " << cpu;
+    }
     EXPECT_GT(r.after.min_dihedral_deg, r.before.min_dihedral_deg + 2.5);
     EXPECT_LT(r.after.below_10_deg, r.before.below_10_deg / 4 + 1);
     EXPECT_GE(worst(m), worst(before)) << "the worst tet is never made worse";
