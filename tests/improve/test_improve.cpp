@@ -65,6 +65,16 @@ Mesh two_tets(double h) {
   return m;
 }
 
+// cube_tets(n) with every coordinate strictly inside (0, 1) moved by up to `amplitude`.
+Mesh jiggled_cube(int n, double amplitude, unsigned seed) {
+  Mesh m = cube_tets(n);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-amplitude, amplitude);
+  for (double& x : m.points)
+    if (x > 0 && x < 1) x += u(rng);
+  return m;
+}
+
 TEST(ImproveMeasure, MinSineMatchesTheDihedralAngles) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
@@ -343,11 +353,7 @@ TEST(ImproveDevice, FlipsMatchTheHostOnARing) {
 // Neighbouring vertices move in rounds chosen by their keys alone: the same mesh whatever the
 // work-group size, on the CPU and the GPU tuning paths; valid, and the worst tet no worse.
 TEST(ImproveDevice, SameMeshWhateverTheWorkGroupSize) {
-  Mesh m = cube_tets(6);
-  std::mt19937 rng(9);
-  std::uniform_real_distribution<double> u(-0.05, 0.05);
-  for (double& x : m.points)
-    if (x > 0 && x < 1) x += u(rng);
+  const Mesh m = jiggled_cube(6, 0.05, 9);
   ImproveOptions o;
   o.threshold_deg = 30;
   o.collapse = false;
@@ -377,11 +383,7 @@ TEST(ImproveDevice, SameMeshWhateverTheWorkGroupSize) {
 }
 
 TEST(ImprovePhase, OnlyTheMaskedVerticesMove) {
-  Mesh m = cube_tets(5);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> u(-0.03, 0.03);
-  for (double& x : m.points)
-    if (x > 0 && x < 1) x += u(rng);
+  Mesh m = jiggled_cube(5, 0.03, 11);
   ImproveOptions o;
   o.threshold_deg = 40;
   o.vertex_mask.resize(size_t(m.num_vertices()));
