@@ -21,6 +21,7 @@ results files:
     shared_meshes   bench/results/shared_meshes.json                    (bench/shared_meshes.py; its table)
     quality_peers   bench/results/quality_peers.json                    (bench/quality_peers.py; its table)
     improve_slivers bench/results/improve_slivers.json                  (bench/improve_slivers.py; its table)
+    improve_paths   bench/results/improve_paths.json                    (bench/improve_paths.py; its tables)
     robustness      bench/robustness/results.json                       (scripts/robustness.py)
     io, primitives, bench/results/io.json, primitives.json, connectivity.json, checker.json,
     connectivity,   boundary_rule.json
@@ -340,6 +341,7 @@ BLOCKS = {
     "shared_meshes": shared_meshes_block,
     "quality_peers": lambda: recorded_block("quality_peers", "quality_peers"),
     "improve_slivers": lambda: recorded_block("improve_slivers", "improve_slivers"),
+    "improve_paths": lambda: recorded_block("improve_paths", "improve_paths"),
     "robustness": robustness_block,
     "io": io_block,
     "primitives": primitives_block,
