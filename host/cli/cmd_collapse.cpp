@@ -2,6 +2,7 @@
 #include <cmath>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -14,6 +15,9 @@
 #include "tetcollapse/collapse.hpp"
 
 namespace tc::cli {
+
+// The share of a boundary error bound the collapse may use when the improvement phase follows.
+constexpr double kCollapseShareOfBound = 0.75;
 
 void write_report(const std::string& path, const std::string& text);  // cmd_check.cpp
 
@@ -114,6 +118,8 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, const Impr
       .field("median_edge_length", r.median_edge_length)
       .field("eps_c", c.opt.eps_c)
       .field("eps_v", r.eps_v)
+      .field("boundary_error_bound", r.boundary_error_bound)
+      .field("boundary_error", r.boundary_error)
       .field("min_quality", c.opt.min_quality)
       .field("boundary", c.boundary)
       .field("method", c.method)
@@ -142,6 +148,7 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, const Impr
         .field("tested", it.tested)
         .field("selected", it.selected)
         .field("refused_by_guard", it.refused_by_guard)
+        .field("refused_by_bound", it.refused_by_bound)
         .field("collapsed", it.collapsed)
         .field("tets_after", it.tets_after)
         .field("vertices_after", it.vertices_after)
@@ -197,6 +204,17 @@ void register_collapse(CLI::App& app, int& exit_code) {
       ->capture_default_str();
   app.add_option("--eps-r", c->opt.eps_r, "Ridge-edge threshold on 1 - dot of normals (paper: 0.1)")
       ->capture_default_str();
+  app.add_option("--max-boundary-error", c->opt.max_boundary_error,
+                 "Features mode, with --method sequential (the parallel method does not carry it yet):\n"
+                 "keep the boundary and the material interfaces within E x the input's bounding-box\n"
+                 "diagonal of where they were, both ways (a conservative bound on the two-sided Hausdorff\n"
+                 "distance, carried per vertex); smoothly curved faces then coarsen (--eps-f is not used).\n"
+                 "0 (default): no bound")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--max-boundary-error-abs", c->opt.max_boundary_error_abs,
+                 "The same bound in mesh units (used instead of --max-boundary-error when > 0)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--eps-v", c->opt.eps_v, "Refuse collapses leaving a tet with volume below this (paper: 2e-12)")
       ->capture_default_str();
   app.add_option("--min-quality", c->opt.min_quality,
@@ -299,6 +317,14 @@ void register_collapse(CLI::App& app, int& exit_code) {
                                    "applies to the greedy and matching conflict detections only (--conflicts greedy|matching)");
       opt.tuning.priority_levels = c->priority_levels;
     }
+    if (opt.bounds_boundary_error()) {
+      if (opt.method != CollapseOptions::Sequential)
+        throw CLI::ValidationError("--max-boundary-error",
+                                   "needs --method sequential (the parallel method does not carry the bound yet)");
+      if (opt.boundary != CollapseOptions::Features)
+        throw CLI::ValidationError("--max-boundary-error",
+                                   "applies to --boundary features (strict keeps the boundary exactly, free does not bound it)");
+    }
     if (opt.method == CollapseOptions::Sequential && !c->device.empty())
       throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
     if (opt.method == CollapseOptions::Sequential)
@@ -344,7 +370,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
                      "iteration %3d: marked %9lld  tested %9lld  selected %8lld  refused %6lld  collapsed %8lld  "
                      "tets %9lld  %.3f s%s\n",
                      it.iteration + 1, (long long)it.marked, (long long)it.tested, (long long)it.selected,
-                     (long long)it.refused_by_guard, (long long)it.collapsed, (long long)it.tets_after, it.seconds_total,
+                     (long long)(it.refused_by_guard + it.refused_by_bound), (long long)it.collapsed, (long long)it.tets_after, it.seconds_total,
                      it.on_host ? "  (host tail)" : "");
       };
 
@@ -356,7 +382,16 @@ void register_collapse(CLI::App& app, int& exit_code) {
     std::unique_ptr<Context> ctx;  // the improvement's too
     if (opt.method == CollapseOptions::Sequential) {
       if (!c->quiet) std::cerr << "method: sequential (CPU)\n";
-      r = collapse_sequential(mesh, opt);
+      // With a boundary error bound and the improvement phase, the collapse keeps a share of
+      // it for the improvement's boundary moves (which remove the slivers at a curved surface).
+      CollapseOptions co = opt;
+      const double bound = boundary_error_bound(mesh, opt);
+      if (bound > 0 && !c->no_improve) {
+        co.max_boundary_error_abs = kCollapseShareOfBound * bound;
+        co.max_boundary_error = 0;
+      }
+      r = collapse_sequential(mesh, co);
+      if (bound > 0) r.boundary_error_bound = bound;
     } else {
       ctx = std::make_unique<Context>(c->device);
       if (!c->quiet) std::cerr << "device: " << ctx->info().name << " (" << ctx->info().platform_name << ")\n";
@@ -373,6 +408,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
       io.eps_f = opt.eps_f;
       io.eps_r = opt.eps_r;
       io.use_labels = opt.use_labels;
+      // what the collapse left of the boundary error bound (DBL_MIN: only exact changes)
+      if (r.boundary_error_bound > 0)
+        io.max_boundary_error_abs =
+            std::max(r.boundary_error_bound - r.boundary_error, std::numeric_limits<double>::min());
       // --region, --labels: improve there only (the masks of the coarse mesh)
       if (!c->region.empty()) combine(io.vertex_mask, region_mask(mesh, c->region));
       if (!c->labels.empty()) combine(io.vertex_mask, label_mask(mesh, c->labels));

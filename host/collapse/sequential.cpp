@@ -33,8 +33,17 @@ SeqParams checked_params(const Mesh& mesh, const CollapseOptions& o) {
   if (!o.vertex_mask.empty() && o.vertex_mask.size() != size_t(mesh.num_vertices()))
     throw std::invalid_argument("vertex_mask has " + std::to_string(o.vertex_mask.size()) + " entries for " +
                                 std::to_string(mesh.num_vertices()) + " vertices");
+  if (!(o.max_boundary_error >= 0) || !(o.max_boundary_error_abs >= 0) || std::isinf(o.max_boundary_error) ||
+      std::isinf(o.max_boundary_error_abs))
+    throw std::invalid_argument("max_boundary_error and max_boundary_error_abs must be finite and >= 0");
+  if (o.bounds_boundary_error() && o.boundary != CollapseOptions::Features)
+    throw std::invalid_argument(
+        "max_boundary_error applies to the features boundary mode (strict keeps the boundary exactly, free "
+        "does not bound it)");
   SeqParams p = seq_params_from(o);
   p.eps_v = volume_threshold(mesh, o);  // as collapse() computes it
+  // With a bound, a smoothly curved face's vertices are face vertices: the bound decides.
+  if (o.bounds_boundary_error()) p.eps_f = 2;
   return p;
 }
 
@@ -88,6 +97,8 @@ SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const T
   report_.tets_in = mesh.num_tets();
   report_.eps_v = params_.eps_v;
   mask_ = options.vertex_mask;
+  bound_ = boundary_error_bound(mesh, options);
+  if (bound_ > 0) eps_.assign(size_t(sm_.num_vertices()), 0.0);
   if (!mesh.tris.empty() || !mesh.edges.empty()) {
     origin_.resize(size_t(mesh.num_vertices()));
     for (size_t i = 0; i < origin_.size(); ++i) origin_[i] = int32_t(i);
@@ -233,7 +244,18 @@ bool SequentialRun::step() {
       if (greedy_) refused_.insert(refused_.end(), {e.a, e.b});
       continue;
     }
-    sm_.collapse(e.a, e.b, dir);
+    double eps_after = 0;
+    if (bound_ > 0) {
+      double base = 0;
+      const double change = sm_.surface_change(e.a, e.b, dir, eps_, &base);
+      if (!(base + change <= bound_)) {
+        ++s.refused_by_bound;
+        continue;  // (the verdict depends on the star alone: no retest unless it changes)
+      }
+      if (change > 0) eps_after = base + change;
+    }
+    const int32_t survivor = sm_.collapse(e.a, e.b, dir);
+    if (eps_after > 0) eps_[size_t(survivor)] = std::max(eps_[size_t(survivor)], eps_after);
     ++s.collapsed;
     for (int32_t u : sm_.touched()) touched_[u] = cur;
     if (greedy_) {
@@ -278,6 +300,10 @@ bool SequentialRun::step() {
       for (size_t i = 0; i < kept_.size(); ++i) mask_[i] = mask_[kept_[i]];
       mask_.resize(kept_.size());
     }
+    if (!eps_.empty()) {
+      for (size_t i = 0; i < kept_.size(); ++i) eps_[i] = eps_[kept_[i]];
+      eps_.resize(kept_.size());
+    }
     for (int32_t& x : origin_) x = vmap_[x];
     for (int32_t& x : refused_) x = vmap_[x];  // their end points are alive (above)
   }
@@ -306,6 +332,9 @@ CollapseReport SequentialRun::finish() {
     remap_elements(mesh_.edges, mesh_.edge_tags, 2, origin_);
   }
   report_.target_length = target_;
+  report_.boundary_error_bound = bound_;
+  for (size_t v = 0; v < eps_.size(); ++v)
+    if (sm_.alive(int32_t(v))) report_.boundary_error = std::max(report_.boundary_error, eps_[v]);
   report_.vertices_out = mesh_.num_vertices();
   report_.tets_out = mesh_.num_tets();
   report_.seconds_total = seconds_since(t_start_);

@@ -122,6 +122,13 @@ class SeqMesh {
   // live entries that repeat a face in a cell.
   int64_t verify_guard();
 
+  // The boundary error bound (CollapseOptions::max_boundary_error): a bound on the two-sided
+  // Hausdorff distance between S before and after the collapse of (a, b) in direction dir
+  // (cl/collapse_surface_error.h; 0 when S does not change, infinity when it cannot be bounded),
+  // and in *base the largest of eps over the vertices of the S faces it replaces. The run
+  // carries eps per vertex: the survivor's becomes *base + the bound.
+  double surface_change(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base);
+
   // Surface guard (the device's: cl/collapse_guard.cl). build_guard() indexes the current
   // S faces in a grid of cells of the mean extent of an S face (h when there is none);
   // collapses keep it current and compact() renumbers it (rebuilds it once the collapses

@@ -111,6 +111,10 @@ class SequentialRun {
   int it_ = 0;
   bool done_ = false;
   std::vector<uint8_t> mask_;      // per current vertex (empty: no mask)
+  // The boundary error bound (mesh units, 0: none) and, per current vertex, the bound on how far
+  // S near it has moved from the input's (SeqMesh::surface_change).
+  double bound_ = 0;
+  std::vector<double> eps_;
   std::vector<int32_t> origin_;    // input vertex -> current vertex (only with tris or edges)
   std::vector<uint32_t> touched_;  // per vertex: 1 + the last iteration that touched its star (0: none)
   std::vector<QueueEntry> edges_, heap_;

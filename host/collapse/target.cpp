@@ -48,8 +48,8 @@ double median_edge_length(const Mesh& mesh) {
   return median_of(std::move(len));
 }
 
-double volume_threshold(const Mesh& mesh, const CollapseOptions& options) {
-  if (!options.eps_v_relative) return options.eps_v;
+namespace {
+double bbox_diagonal_squared(const Mesh& mesh) {
   double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
   for (size_t i = 0; i + 2 < mesh.points.size(); i += 3)
     for (int c = 0; c < 3; ++c) {
@@ -58,7 +58,19 @@ double volume_threshold(const Mesh& mesh, const CollapseOptions& options) {
     }
   double d2 = 0;
   for (int c = 0; c < 3; ++c) d2 += hi[c] > lo[c] ? (hi[c] - lo[c]) * (hi[c] - lo[c]) : 0;
+  return d2;
+}
+}  // namespace
+
+double volume_threshold(const Mesh& mesh, const CollapseOptions& options) {
+  if (!options.eps_v_relative) return options.eps_v;
+  const double d2 = bbox_diagonal_squared(mesh);
   return options.eps_v * d2 * std::sqrt(d2);
+}
+
+double boundary_error_bound(const Mesh& mesh, const CollapseOptions& options) {
+  if (options.max_boundary_error_abs > 0) return options.max_boundary_error_abs;
+  return options.max_boundary_error * std::sqrt(bbox_diagonal_squared(mesh));
 }
 
 namespace collapse_detail {

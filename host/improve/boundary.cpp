@@ -33,7 +33,8 @@ bool flat_quad(const ImpMesh& m, int32_t a, int32_t b, int32_t x1, int32_t x2) {
 }
 
 bool try_remove_boundary_sliver(ImpMesh& m, int32_t t) {
-  if (!m.may_change_boundary()) return false;
+  // (under a bound: repeated removals in one place would add up, untracked)
+  if (!m.may_change_boundary() || m.bounded()) return false;
   const Tet q = m.tet(t);
   int boundary[4], nb = 0;
   for (int f = 0; f < 4; ++f) {

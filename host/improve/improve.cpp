@@ -153,15 +153,20 @@ int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options) {
   o.min_quality = 0.3;
   o.target_length = options.collapse_length > 0 ? options.collapse_length : 1.5 * median_edge_length(mesh);
   o.vertex_mask = std::move(mask);
+  if (options.boundary == CollapseOptions::Features) o.max_boundary_error_abs = options.max_boundary_error_abs;
   int64_t collapsed = 0;
   for (const IterationStats& it : collapse_sequential(mesh, o).iterations) collapsed += it.collapsed;
   return collapsed;
 }
 
-ImproveReport improve_on(Mesh& mesh, const ImproveOptions& options, Context* ctx) {
+ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) {
   const Stopwatch clock;
   ImproveReport report;
   report.before = quality_summary(mesh);
+  // A boundary error bound is shared by the three stages that may move S: the passes, the
+  // collapse step and the passes after it (each measures from where it starts).
+  ImproveOptions options = given;
+  if (given.max_boundary_error_abs > 0) options.max_boundary_error_abs = given.max_boundary_error_abs / 3;
   passes(mesh, options, ctx, options.max_iterations, report, true);
   // (With a vertex mask the step does not run: the collapse renumbers the vertices.)
   if (options.collapse && options.vertex_mask.empty() && int(report.passes.size()) < options.max_iterations) {

@@ -77,7 +77,12 @@ ImpMesh::ImpMesh(Mesh& mesh, const ImproveOptions& options) : mesh_(mesh), point
     throw std::invalid_argument("vertex_mask has " + std::to_string(options.vertex_mask.size()) + " entries for " +
                                 std::to_string(nv) + " vertices");
   mask_ = options.vertex_mask;
-  if (options.boundary != CollapseOptions::Strict && options.max_boundary_move > 0 && nv > 0) {
+  if (options.max_boundary_error_abs > 0 && options.boundary != CollapseOptions::Strict) {
+    // A boundary error bound: every point of S moves by at most what its vertices do, so S
+    // stays within the bound when no vertex gets further than it from where it started.
+    bounded_ = true;
+    max_boundary_move_ = options.max_boundary_error_abs;
+  } else if (options.boundary != CollapseOptions::Strict && options.max_boundary_move > 0 && nv > 0) {
     double lo[3], hi[3];
     for (int k = 0; k < 3; ++k) lo[k] = hi[k] = points_[size_t(k)];
     for (int64_t v = 0; v < nv; ++v)
@@ -356,7 +361,7 @@ void ImpMesh::mark_motion(const ImproveOptions& options) {
     }
     if (bend > kStraight) {
       if (!may_bend) continue;
-      max_offset_[size_t(v)] = max_boundary_move_ / bend;
+      max_offset_[size_t(v)] = bounded_ ? max_boundary_move_ : max_boundary_move_ / bend;
     }
     motion_[size_t(v)] = lines == 0 ? kInPlane : kAlongLine;
     normal_[size_t(v)] = dir;

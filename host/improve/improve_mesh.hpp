@@ -76,6 +76,9 @@ class ImpMesh {
   // The tet other than t with the face (a, b, c), or -1 (a boundary face).
   int32_t across(int32_t t, int32_t a, int32_t b, int32_t c) const;
   bool may_change_boundary() const { return max_boundary_move_ > 0; }
+  // Under a boundary error bound (ImproveOptions::max_boundary_error_abs): only relocations
+  // within it and flips of flat quads change the boundary.
+  bool bounded() const { return bounded_; }
   double max_boundary_move() const { return max_boundary_move_; }
   // Replaces the tets `old` by `added` where that changes the boundary: its faces `gone` (two)
   // give way to `exposed` (two), which take over the input's tags of `gone`. False (nothing
@@ -174,6 +177,7 @@ class ImpMesh {
   std::unordered_set<uint64_t> tagged_edges_;
   std::unordered_map<FaceKey, int64_t, FaceHash> tris_;  // the input's tagged triangles -> index
   double max_boundary_move_ = 0;
+  bool bounded_ = false;
 };
 
 // One topological pass over the bad tets (worst first); returns the counts in `stats`.

@@ -78,6 +78,8 @@ struct IterationStats {
   // Chosen collapses the surface guard refused, over all its runs (the selection then runs
   // again, or with the matching selection the collapse and those that saw it are undone).
   int64_t refused_by_guard = 0;
+  // Collapses refused because they would take S beyond the boundary error bound.
+  int64_t refused_by_bound = 0;
   int64_t collapsed = 0;
   int64_t tets_after = 0, vertices_after = 0;
   // Seconds per stage (wall time, the queue finished after each stage): the connectivity, the
@@ -96,6 +98,9 @@ struct CollapseReport {
   double target_length = 0;   // the threshold actually used
   double median_edge_length = 0;  // of the input (computed when target_length <= 0)
   double eps_v = 0;           // the volume threshold actually used
+  // With a boundary error bound: the bound in mesh units, and the largest bound the run's
+  // changes of S reached (the result's S is within it of the input's, both ways).
+  double boundary_error_bound = 0, boundary_error = 0;
 };
 
 // How the parallel method goes about its work: choices of speed and memory that a user rarely
@@ -191,6 +196,17 @@ struct CollapseOptions {
 
   double eps_f = 0.01;   // face threshold on 1 - dot(n_i, n_j)  (see topology.hpp)
   double eps_r = 0.1;    // ridge threshold on 1 - dot(n_1, n_2)
+  // Boundary error bound (features mode, the sequential method so far): a collapse that changes
+  // S (the boundary and the material interfaces) is made only while a bound on the two-sided
+  // Hausdorff distance between the input's S and the result's stays within max_boundary_error
+  // x the bounding-box diagonal of the input (or max_boundary_error_abs in mesh units, when
+  // > 0). The bound is carried per vertex and grows by each change of S near it
+  // (cl/collapse_surface_error.h); it is conservative, so the measured distance is smaller. With
+  // a bound, eps_f is not used: a vertex of a smoothly curved face is a face vertex (ridges and
+  // corners as eps_r says), so curved faces coarsen within the bound. 0 (both): no bound.
+  double max_boundary_error = 0;
+  double max_boundary_error_abs = 0;
+  bool bounds_boundary_error() const { return max_boundary_error > 0 || max_boundary_error_abs > 0; }
   // Tets of the collapsed neighbourhood must keep a volume >= eps_v. With eps_v_relative the
   // threshold is eps_v x (bounding-box diagonal of the input)^3.
   double eps_v = 2e-12;
@@ -264,5 +280,8 @@ double median_edge_length(const Mesh& mesh);
 // The volume threshold a run uses: options.eps_v, or with eps_v_relative options.eps_v x (the
 // bounding-box diagonal of the mesh)^3.
 double volume_threshold(const Mesh& mesh, const CollapseOptions& options);
+// The boundary error bound in mesh units: max_boundary_error_abs when > 0, else
+// max_boundary_error x the bounding-box diagonal of `mesh` (0: no bound).
+double boundary_error_bound(const Mesh& mesh, const CollapseOptions& options);
 
 }  // namespace tc

@@ -93,6 +93,14 @@ struct ImproveOptions {
   // (its two other faces become boundary: the boundary quad's diagonal flips) when the
   // boundary moves by at most this share of the bounding-box diagonal; 0: never.
   double max_boundary_move = 0.001;
+  // With > 0 (mesh units): the boundary changes stay within this two-sided distance of the
+  // surface as it was. A third each goes to the passes, the collapse step (which carries it as
+  // CollapseOptions::max_boundary_error_abs) and the passes after it: in a series of passes no
+  // boundary vertex off a flat patch or straight line gets further than its third from where
+  // it started (every point of S then moves no further), and no thin boundary tet is removed
+  // (max_boundary_move is not used). The coarsening command passes what its own bound left
+  // (CollapseReport::boundary_error).
+  double max_boundary_error_abs = 0;
   // Collapse of the short edges of the tets below 13 degrees that flips and relocation left
   // (the paper's improvement by collapse), through the sequential method's checks, with the
   // quality guard at 0.3 (no collapse lowers the worst mean ratio of what it reshapes below

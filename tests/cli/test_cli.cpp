@@ -209,6 +209,33 @@ TEST(Cli, CoarsenWritesAValidMeshAndStats) {
 
 // TETCOLLAPSE_PROFILE_KERNELS=1: the per-kernel table on stderr at the end, with the stages'
 // kernels in it, and the same output mesh as without it (the waits change no decision).
+// The boundary error bound: the sequential method keeps it (the checker measures the bracket's
+// boundary within it), the parallel method and the other modes refuse it as a usage error.
+TEST(Cli, MaxBoundaryErrorHoldsAndIsRefusedWhereItCannot) {
+  tc::test::TempDir dir;
+  std::string out;
+  const std::string in = q(tc::test::project_mesh("bracket.msh")), result = dir.file("b.msh"),
+                    stats = dir.file("s.json");
+  ASSERT_EQ(run_command(cli() + " " + in + " " + q(result) + " --target-factor 2 --method sequential " +
+                            "--max-boundary-error 0.002 --check -q --stats " + q(stats),
+                        &out),
+            0)
+      << out;
+  EXPECT_NE(tc::test::read_text(stats).find("\"boundary_error_bound\":"), std::string::npos);
+  EXPECT_NE(tc::test::read_text(stats).find("\"refused_by_bound\":"), std::string::npos);
+  ASSERT_EQ(run_command(cli() + " check " + q(result) + " --reference " + in + " --json -", &out), 0) << out;
+  const size_t at = out.find("\"hausdorff_rel\":");
+  ASSERT_NE(at, std::string::npos) << out;
+  EXPECT_LE(std::stod(out.substr(at + 16)), 0.002) << out.substr(at, 40);
+  EXPECT_EQ(run_command(cli() + " " + in + " " + q(result) + " --max-boundary-error 0.002", &out), 2);
+  EXPECT_NE(out.find("--method sequential"), std::string::npos) << out;
+  EXPECT_EQ(run_command(cli() + " " + in + " " + q(result) + " --method sequential --boundary free " +
+                            "--max-boundary-error 0.002",
+                        &out),
+            2);
+  EXPECT_NE(out.find("--boundary features"), std::string::npos) << out;
+}
+
 TEST(Cli, KernelProfileTableAndTheSameResult) {
   tc::test::TempDir dir;
   std::string out;

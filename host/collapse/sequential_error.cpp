@@ -1,0 +1,80 @@
+// The boundary error bound of the sequential method's dynamic mesh (SeqMesh::surface_change):
+// the S faces a collapse replaces and those it makes, as the surface guard finds them, one
+// side of each interface (its owner's, so that a sheet is oriented one way), and the bound of
+// cl/collapse_surface_error.h between the two.
+#include <algorithm>
+#include <cmath>
+
+#include "collapse/sequential_mesh.hpp"
+#include "collapse_predicate.h"
+#include "collapse_surface_error.h"
+
+namespace tc::sequential_detail {
+
+using geo::tc_d3;
+
+double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base) {
+  *base = 0;
+  if (a > b) std::swap(a, b);
+  const bool remove_b = (dir & TCC_DIR_REMOVE_V1) != 0;
+  const int32_t x = remove_b ? b : a, y = remove_b ? a : b;
+  const tc_d3 p = placement(a, b, dir), py = point(y);
+  const bool moves_y = !(py.x == p.x && py.y == p.y && py.z == p.z);
+  if (!vflags_[x] && !(moves_y && vflags_[y])) return 0;  // S is not touched
+  tc_d3 olds[3 * TCC_MAX_FAN], news[3 * TCC_MAX_FAN];
+  int no = 0, nn = 0;
+  // the owned S faces through x, those of the tets the collapse removes, and through y when it
+  // moves (each once: a tet through x is seen from ring(x))
+  for (int side = 0; side < (moves_y ? 2 : 1); ++side) {
+    const int32_t z = side == 0 ? x : y;
+    const int32_t* rz = ring(z);
+    for (uint32_t i = 0; i < rlen_[z]; ++i) {
+      const int32_t t = rz[i];
+      const int32_t* q = tet(t);
+      if (side == 1 && has(q, x)) continue;
+      const bool removed = side == 0 && has(q, y);
+      for (int f = 0; f < 4; ++f) {
+        if ((q[f] == z && !removed) || !owned_sface(t, f)) continue;
+        if (no == TCC_MAX_FAN) return INFINITY;
+        for (int k = 0; k < 3; ++k) {
+          const int32_t v = q[geo::TC_TET_FACES[f][k]];
+          olds[3 * no + k] = point(v);
+          *base = std::max(*base, eps[size_t(v)]);
+        }
+        ++no;
+      }
+    }
+  }
+  // the new S faces (tcc_sg_new_tri, as guard_ok), on the owner's side
+  for (int side = 0; side < 2; ++side) {
+    const int32_t z = side == 0 ? x : y, w = side == 0 ? y : x;
+    const int32_t* rz = ring(z);
+    for (uint32_t i = 0; i < rlen_[z]; ++i) {
+      const int32_t t = rz[i];
+      const int32_t* q = tet(t);
+      if (has(q, w)) continue;  // removed by the collapse, or seen from ring(x)
+      for (int f = 0; f < 4; ++f) {
+        if (q[f] == z) continue;
+        const int32_t o = across(t, f);
+        int32_t other;  // the tet across the face after the collapse (-1: the boundary)
+        if (o >= 0 && has(tet(o), x) && has(tet(o), y)) {  // glued through the removed tet o
+          other = across(o, local(tet(o), z));
+        } else {
+          if (side == 1 && !moves_y) continue;  // unchanged
+          other = o;
+        }
+        const bool owned = other < 0 || (labels_ && label(t) < label(other));
+        if (!owned) continue;
+        if (nn == TCC_MAX_FAN) return INFINITY;
+        for (int k = 0; k < 3; ++k) {
+          const int32_t v = q[geo::TC_TET_FACES[f][k]];
+          news[3 * nn + k] = v == x || v == y ? p : point(v);
+        }
+        ++nn;
+      }
+    }
+  }
+  return geo::tcc_fan_distance(olds, no, news, nn);
+}
+
+}  // namespace tc::sequential_detail

@@ -1,0 +1,180 @@
+// The boundary error bound (CollapseOptions::max_boundary_error): the fan bound of
+// cl/collapse_surface_error.h on fans built for it, then whole runs on curved shapes, measured
+// by the checker's two-sided Hausdorff distance.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include "check/check_cgal.hpp"  // check_detail::hausdorff, for the interface
+#include "collapse_surface_error.h"
+#include "geometry.h"
+#include "test_support.hpp"
+#include "tetcollapse/check.hpp"
+#include "tetcollapse/collapse.hpp"
+
+namespace tc {
+namespace {
+
+using geo::tc_d3;
+using namespace test;
+constexpr double kPi = 3.14159265358979323846;
+
+// The fan of n triangles around `centre` over the regular n-gon of radius 1 in z = 0.
+std::vector<tc_d3> fan(tc_d3 centre, int n) {
+  std::vector<tc_d3> t;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2 * kPi * i / n, b = 2 * kPi * (i + 1) / n;
+    t.insert(t.end(), {centre, {std::cos(a), std::sin(a), 0}, {std::cos(b), std::sin(b), 0}});
+  }
+  return t;
+}
+
+// The polygon's fan from its vertex 0 (a half-edge collapse of the centre onto it).
+std::vector<tc_d3> fan_from_corner(int n) {
+  std::vector<tc_d3> t;
+  for (int i = 1; i + 1 < n; ++i) {
+    const double a = 2 * kPi * i / n, b = 2 * kPi * (i + 1) / n;
+    t.insert(t.end(), {{1, 0, 0}, {std::cos(a), std::sin(a), 0}, {std::cos(b), std::sin(b), 0}});
+  }
+  return t;
+}
+
+TEST(BoundaryErrorFan, FlatPatchRetriangulatedMovesNothing) {
+  const auto olds = fan({0.1, -0.2, 0}, 6), news = fan_from_corner(6);
+  EXPECT_LT(geo::tcc_fan_distance(olds.data(), 6, news.data(), 4), 1e-9);
+}
+
+TEST(BoundaryErrorFan, ATentFlattenedMovesByItsHeight) {
+  for (double h : {0.01, 0.2}) {
+    const auto olds = fan({0.1, 0.05, h}, 8), news = fan_from_corner(8);
+    const double d = geo::tcc_fan_distance(olds.data(), 8, news.data(), 6);
+    // the apex is h above the plane of the new fan, straight over a point of it
+    EXPECT_NEAR(d, h, 1e-9 + 0.05 * h) << h;
+    EXPECT_GE(d, h * std::cos(std::atan(h / 0.9))) << "no less than the apex's distance to the plane";
+  }
+}
+
+TEST(BoundaryErrorFan, FoldedFanGetsNoBound) {
+  const auto olds = fan({0, 0, 0}, 6);
+  const auto folded = fan({1.5, 0, 0}, 6);  // the centre outside the polygon: triangles flip
+  EXPECT_TRUE(std::isinf(geo::tcc_fan_distance(olds.data(), 6, folded.data(), 6)));
+  const auto half = fan_from_corner(4);  // covers another area
+  EXPECT_TRUE(std::isinf(geo::tcc_fan_distance(olds.data(), 6, half.data(), 2)));
+}
+
+// cube_tets(n) in [-1, 1]^3, pushed out to the unit ball (x -> x |x|_inf / |x|_2).
+Mesh ball(int n) {
+  Mesh m = cube_tets(n);
+  for (size_t i = 0; i < m.points.size(); i += 3) {
+    double p[3], inf = 0, two = 0;
+    for (int c = 0; c < 3; ++c) {
+      p[c] = 2 * m.points[i + size_t(c)] - 1;
+      inf = std::max(inf, std::fabs(p[c]));
+      two += p[c] * p[c];
+    }
+    two = std::sqrt(two);
+    for (int c = 0; c < 3; ++c) m.points[i + size_t(c)] = two > 0 ? p[c] * inf / two : 0;
+  }
+  return m;
+}
+
+double hausdorff_rel(const Mesh& out, const Mesh& in) {
+  CheckOptions co;
+  co.hausdorff = true;
+  const CheckReport r = check_mesh(out, co, &in);
+  EXPECT_TRUE(r.valid) << check_report_text(r);
+  return r.reference.hausdorff_rel;
+}
+
+TEST(BoundaryErrorRun, ABallStaysWithinTheBoundAndCoarsens) {
+  const Mesh in = ball(10);
+  for (int64_t t = 0; t < in.num_tets(); ++t) {
+    geo::tc_d3 p[4];
+    for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(in.points.data(), in.tets[size_t(4 * t + k)]);
+    ASSERT_GT(geo::tc_tet_volume(p[0], p[1], p[2], p[3]), 0) << "the ball's tets are positive";
+  }
+  CollapseOptions o;
+  o.method = CollapseOptions::Sequential;
+  o.target_factor = 2;
+  Mesh unbounded = in;
+  collapse_sequential(unbounded, o);
+  for (double e : {0.002, 0.01}) {
+    Mesh m = in;
+    o.max_boundary_error = e;
+    const CollapseReport r = collapse_sequential(m, o);
+    EXPECT_NEAR(r.boundary_error_bound, e * std::sqrt(12.0), 1e-9);
+    EXPECT_LE(r.boundary_error, r.boundary_error_bound);
+    EXPECT_GT(r.boundary_error, 0) << "the sphere's vertices moved";
+    const double measured = hausdorff_rel(m, in);
+    EXPECT_LE(measured, e) << "the checker's two-sided distance within the bound";
+    EXPECT_LT(m.num_tets(), unbounded.num_tets()) << e << ": the curved boundary coarsens too";
+    int64_t refused = 0;
+    for (const auto& it : r.iterations) refused += it.refused_by_bound;
+    EXPECT_GT(refused, 0) << e << ": the bound refused some collapses";
+  }
+}
+
+// The faces between tets of labels 1 and 2, as a triangle soup oriented out of label 1.
+check_detail::Soup interface_soup(const Mesh& m) {
+  std::map<std::array<int32_t, 3>, std::pair<int64_t, std::array<int32_t, 3>>> seen;
+  check_detail::Soup s;
+  s.points = m.points;
+  const auto& label = m.tet_labels[0].values;
+  for (int64_t t = 0; t < m.num_tets(); ++t)
+    for (const auto& F : geo::TC_TET_FACES) {
+      std::array<int32_t, 3> f, k;
+      for (int c = 0; c < 3; ++c) f[size_t(c)] = m.tets[size_t(4 * t + F[c])];
+      k = f;
+      std::sort(k.begin(), k.end());
+      const auto [it, fresh] = seen.emplace(k, std::make_pair(t, f));
+      if (fresh || label[size_t(it->second.first)] == label[size_t(t)]) continue;
+      const auto& out = label[size_t(t)] == 1 ? f : it->second.second;
+      s.tris.insert(s.tris.end(), out.begin(), out.end());
+    }
+  return s;
+}
+
+TEST(BoundaryErrorRun, TheInterfaceOfTwoMaterialsKeepsItsShapeAndLabels) {
+  Mesh in = ball(8);
+  in.tet_labels.push_back({"material", {}});
+  for (int64_t t = 0; t < in.num_tets(); ++t) {  // an inner ball of radius 0.5
+    double c[3] = {0, 0, 0};
+    for (int k = 0; k < 4; ++k)
+      for (int d = 0; d < 3; ++d) c[d] += in.points[3 * size_t(in.tets[size_t(4 * t + k)]) + size_t(d)] / 4;
+    in.tet_labels[0].values.push_back(std::hypot(c[0], c[1], c[2]) < 0.5 ? 1 : 2);
+  }
+  CollapseOptions o;
+  o.method = CollapseOptions::Sequential;
+  o.target_factor = 2;
+  o.max_boundary_error = 0.005;
+  Mesh m = in;
+  const CollapseReport r = collapse_sequential(m, o);
+  EXPECT_LE(r.boundary_error, r.boundary_error_bound);
+  EXPECT_LE(hausdorff_rel(m, in), 0.005);
+  const check_detail::Hausdorff h = check_detail::hausdorff(interface_soup(m), interface_soup(in), 1e-5);
+  ASSERT_TRUE(h.ran) << h.why_not;
+  EXPECT_LE(std::max(h.a_to_b, h.b_to_a), r.boundary_error_bound) << "the interface within the bound";
+  EXPECT_GT(std::max(h.a_to_b, h.b_to_a), 0) << "and it moved";
+  EXPECT_LT(m.num_tets(), in.num_tets() / 2);
+}
+
+TEST(BoundaryErrorRun, RefusedWhereItCannotHold) {
+  Mesh m = ball(4);
+  CollapseOptions o;
+  o.max_boundary_error = 0.001;
+  Context ctx;
+  EXPECT_THROW(collapse(m, o, ctx), std::invalid_argument) << "the parallel method does not carry it yet";
+  o.method = CollapseOptions::Sequential;
+  o.boundary = CollapseOptions::Free;
+  EXPECT_THROW(collapse_sequential(m, o), std::invalid_argument) << "free mode does not bound the boundary";
+  o.boundary = CollapseOptions::Features;
+  o.max_boundary_error = -1;
+  EXPECT_THROW(collapse_sequential(m, o), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace tc
