@@ -22,6 +22,7 @@ results files:
     quality_peers   bench/results/quality_peers.json                    (bench/quality_peers.py; its table)
     improve_slivers bench/results/improve_slivers.json                  (bench/improve_slivers.py; its table)
     improve_paths   bench/results/improve_paths.json                    (bench/improve_paths.py; its tables)
+    boundary_error  bench/results/boundary_error.json                   (bench/quality_peers.py; its table)
     robustness      bench/robustness/results.json                       (scripts/robustness.py)
     io, primitives, bench/results/io.json, primitives.json, connectivity.json, checker.json,
     connectivity,   boundary_rule.json
@@ -342,6 +343,7 @@ BLOCKS = {
     "quality_peers": lambda: recorded_block("quality_peers", "quality_peers"),
     "improve_slivers": lambda: recorded_block("improve_slivers", "improve_slivers"),
     "improve_paths": lambda: recorded_block("improve_paths", "improve_paths"),
+    "boundary_error": lambda: recorded_block("boundary_error", "quality_peers"),
     "robustness": robustness_block,
     "io": io_block,
     "primitives": primitives_block,

@@ -8,6 +8,9 @@
 Runs, on mesh M with the uniform target edge length L, in this order:
   tetcollapse           tetcollapse M OUT --target-length L            (default options, quality guard 0.1)
   tetcollapse_noimprove ... --no-improve                             (the collapse alone)
+  tetcollapse_bounded   ... --method sequential --max-boundary-error 0.001
+                                                                       (the boundary error bound, as MMG's -hausd
+                                                                        below: 0.001 x the bounding-box diagonal)
   tetcollapse_q0        ... --min-quality 0 --no-improve               (the paper: no quality guard, no
                                                                         improvement phase)
   mmg3d_hsiz            mmg3d_O3 IN.mesh -hsiz L                        (MMG3D, surface remeshed too)
@@ -54,7 +57,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-ALL_PEERS = ["tetcollapse", "tetcollapse_noimprove", "tetcollapse_q0", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "mmg3d_hmin", "mmg3d_hmin_nosurf", "mmg3d_hmin_hausd",
+ALL_PEERS = ["tetcollapse", "tetcollapse_noimprove", "tetcollapse_bounded", "tetcollapse_q0", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "mmg3d_hmin", "mmg3d_hmin_nosurf", "mmg3d_hmin_hausd",
              "cgal_remesh", "tetgen_rR", "tetgen_rR_keepbnd"]
 
 
@@ -250,6 +253,8 @@ def main():
                 cmd += ["--min-quality", "0", "--no-improve"]
             if peer == "tetcollapse_noimprove":
                 cmd += ["--no-improve"]
+            if peer == "tetcollapse_bounded":
+                cmd += ["--method", "sequential", "--max-boundary-error", "0.001"]
 
             def alg(stdout, stderr):  # the collapse and the improvement, without I/O
                 with open(stats) as f:
