@@ -4,7 +4,8 @@
 #   scripts/setup.sh              build + test dependencies (with the gmsh and tetgen programs,
 #                                 which some I/O tests run)
 #   scripts/setup.sh --with-tools also what scripts/ and bench/ use (gmsh's Python module,
-#                                 matplotlib, clang for fuzzing; MMG3D, which Debian does not
+#                                 matplotlib, VTK and Xvfb for the renderings, clang for fuzzing;
+#                                 MMG3D, which Debian does not
 #                                 package, from PyPI's mmgpy wheel for the peers benchmark)
 set -euo pipefail
 
@@ -17,7 +18,7 @@ packages=(
   gmsh tetgen                     # the tests that read files these programs write, and vice versa
 )
 if [[ "${1:-}" == "--with-tools" ]]; then
-  packages+=(python3-gmsh python3-matplotlib python3-numpy clang libclang-rt-14-dev llvm-14)
+  packages+=(python3-gmsh python3-matplotlib python3-numpy python3-vtk9 xvfb clang libclang-rt-14-dev llvm-14)
 fi
 
 missing=()

@@ -880,6 +880,8 @@ void compare(const Mesh& mesh, const Mesh& ref, const CheckOptions& opt, CheckRe
     }
     timer.lap("hausdorff");
   }
+  c.fields = field_errors(ref, mesh, opt.field_samples);
+  timer.lap("fields");
 }
 
 }  // namespace

@@ -110,6 +110,18 @@ std::string check_report_json(const CheckReport& r) {
     w.field("hausdorff", c.hausdorff).field("hausdorff_rel", c.hausdorff_rel);
     w.field("hausdorff_to_reference", c.hausdorff_to_reference).field("hausdorff_from_reference", c.hausdorff_from_reference);
     w.field("hausdorff_error_bound", c.hausdorff_error_bound);
+    w.key("fields").begin_array();
+    for (const FieldError& f : c.fields)
+      w.begin_object()
+          .field("name", f.name)
+          .field("range", f.range)
+          .field("max_abs", f.max_abs)
+          .field("rms_abs", f.rms_abs)
+          .field("max_rel", f.max_rel)
+          .field("rms_rel", f.rms_rel)
+          .field("samples", f.samples)
+          .end_object();
+    w.end_array();
     w.end_object();
   }
 
@@ -154,6 +166,10 @@ std::string check_report_text(const CheckReport& r) {
     if (c.hausdorff_computed)
       o << "Hausdorff distance: " << num(c.hausdorff) << " (" << num(c.hausdorff_rel) << " x bbox diagonal; to reference "
         << num(c.hausdorff_to_reference) << ", from reference " << num(c.hausdorff_from_reference) << ")\n";
+    for (const FieldError& f : c.fields)
+      o << "field '" << f.name << "': max difference " << num(f.max_abs) << " (" << num(100 * f.max_rel)
+        << "% of its range), RMS " << num(f.rms_abs) << " (" << num(100 * f.rms_rel) << "%) at " << f.samples
+        << " points\n";
   }
   return o.str();
 }

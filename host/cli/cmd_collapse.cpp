@@ -13,8 +13,21 @@
 #include "json.hpp"
 #include "stopwatch.hpp"
 #include "tetcollapse/collapse.hpp"
+#include "tetcollapse/fields.hpp"
 
 namespace tc::cli {
+
+namespace {
+// Moves the vertex field `name` to the front (the user cost sees the first); returns where it was.
+size_t field_first(Mesh& mesh, const std::string& file, const std::string& name) {
+  for (size_t i = 0; i < mesh.vertex_fields.size(); ++i)
+    if (mesh.vertex_fields[i].name == name) {
+      std::swap(mesh.vertex_fields[0], mesh.vertex_fields[i]);
+      return i;
+    }
+  throw InputError(file, "no vertex field named '" + name + "'");
+}
+}  // namespace
 
 // The share of a boundary error bound the collapse may use when the improvement phase follows.
 constexpr double kCollapseShareOfBound = 0.75;
@@ -32,7 +45,10 @@ struct CollapseCli {
   double priority_levels = -1;  // not given
   std::string boundary = "features", method = "parallel", conflicts = "matching";
   std::string region, sizing_field, labels, cost_cl, placement_cl, predicate_cl, device, stats;
-  bool check = false, quiet = false, no_labels = false, no_spatial_order = false, no_improve = false;
+  bool check = false, quiet = false, no_labels = false, no_spatial_order = false, no_improve = false,
+       average_fields = false;
+  std::string preserve_field;
+  double field_tolerance = 0.02;
   ImproveCli improve;
 };
 
@@ -230,6 +246,17 @@ void register_collapse(CLI::App& app, int& exit_code) {
                  "Per-vertex field of the input giving the wanted edge length: an edge is collapsed\n"
                  "when shorter than the mean of the field at its ends (replaces --target-*)");
   app.add_option("--labels", c->labels, "Only coarsen inside these primary labels, e.g. 1,3");
+  app.add_option("--preserve-field", c->preserve_field,
+                 "Coarsen for volume rendering of this per-vertex field (the paper's Section 4.5): an\n"
+                 "edge is collapsed when its ends' values differ by less than --field-tolerance x the\n"
+                 "field's range (replaces --target-*; use --boundary free for the paper's setting)");
+  app.add_option("--field-tolerance", c->field_tolerance, "With --preserve-field: T (the paper: 0.02)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--average-fields", c->average_fields,
+               "Vertex fields at a survivor: the average of the collapsed edge's ends (default: the\n"
+               "input's piecewise linear field at the vertex's final place, by point location in the\n"
+               "input, after the improvement phase too)");
   app.add_option("--cost-cl", c->cost_cl,
                  "OpenCL C file defining double tc_user_cost(double3 p0, double3 p1, double f0, double f1);\n"
                  "edges with a cost below --target-length are collapsed (see README)");
@@ -298,8 +325,9 @@ void register_collapse(CLI::App& app, int& exit_code) {
     Stopwatch stage;
     Mesh mesh = read_input(c->in, c->input, c->quiet);
     double seconds_read = stage.lap();
-    Mesh input;
-    if (c->check) input = mesh;
+    Mesh input;  // for --check, and the vertex fields' values at new places
+    const bool resample = !mesh.vertex_fields.empty() && !c->average_fields;
+    if (c->check || resample) input = mesh;
 
     CollapseOptions& opt = c->opt;
     opt.boundary = boundary_mode(c->boundary);
@@ -330,6 +358,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
     if (opt.method == CollapseOptions::Sequential)
       for (const auto& [name, value] : {std::pair<const char*, const std::string*>{"--cost-cl", &c->cost_cl},
                                         {"--sizing-field", &c->sizing_field},
+                                        {"--preserve-field", &c->preserve_field},
                                         {"--placement-cl", &c->placement_cl},
                                         {"--predicate-cl", &c->predicate_cl}})
         if (!value->empty())
@@ -343,20 +372,31 @@ void register_collapse(CLI::App& app, int& exit_code) {
     if (!c->labels.empty()) combine(opt.vertex_mask, label_mask(mesh, c->labels));
     size_t sizing_index = 0;
     if (!c->cost_cl.empty()) {
-      if (!c->sizing_field.empty())
-        throw CLI::ValidationError("--cost-cl", "cannot be combined with --sizing-field");
+      if (!c->sizing_field.empty() || !c->preserve_field.empty())
+        throw CLI::ValidationError("--cost-cl", "cannot be combined with --sizing-field or --preserve-field");
       opt.cost_cl_source = cl_file(c->cost_cl);
       if (opt.target_length <= 0) throw CLI::ValidationError("--cost-cl", "needs --target-length");
+    } else if (!c->preserve_field.empty()) {
+      if (!c->sizing_field.empty())
+        throw CLI::ValidationError("--preserve-field", "cannot be combined with --sizing-field");
+      // The paper's cost for volume rendering, |Phi(v0) - Phi(v1)|, on the named field, which
+      // goes first (the cost sees the first vertex field) for the run; edges below
+      // T x (max Phi - min Phi) are collapsed.
+      sizing_index = field_first(mesh, c->in, c->preserve_field);
+      const std::vector<double>& phi = mesh.vertex_fields[0].values;
+      const size_t nc = size_t(mesh.vertex_fields[0].components);
+      double lo = INFINITY, hi = -INFINITY;
+      for (size_t i = 0; i < phi.size(); i += nc) {
+        lo = std::min(lo, phi[i]);
+        hi = std::max(hi, phi[i]);
+      }
+      opt.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return fabs(f0 - f1); }\n";
+      opt.target_length = c->field_tolerance * (hi - lo);
+      if (!(opt.target_length > 0))
+        throw InputError(c->in, "vertex field '" + c->preserve_field + "' is constant: nothing bounds a collapse");
     } else if (!c->sizing_field.empty()) {
       // The user cost sees the first vertex field: move the sizing field there for the run.
-      bool found = false;
-      for (size_t i = 0; i < mesh.vertex_fields.size(); ++i)
-        if (mesh.vertex_fields[i].name == c->sizing_field) {
-          sizing_index = i;
-          found = true;
-        }
-      if (!found) throw InputError(c->in, "no vertex field named '" + c->sizing_field + "'");
-      std::swap(mesh.vertex_fields[0], mesh.vertex_fields[sizing_index]);
+      sizing_index = field_first(mesh, c->in, c->sizing_field);
       opt.cost_cl_source =
           "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) {\n"
           "  double h = 0.5 * (f0 + f1);\n"
@@ -397,7 +437,8 @@ void register_collapse(CLI::App& app, int& exit_code) {
       if (!c->quiet) std::cerr << "device: " << ctx->info().name << " (" << ctx->info().platform_name << ")\n";
       r = collapse(mesh, opt, *ctx);
     }
-    if (!c->sizing_field.empty()) std::swap(mesh.vertex_fields[0], mesh.vertex_fields[sizing_index]);
+    if (!c->sizing_field.empty() || !c->preserve_field.empty())
+      std::swap(mesh.vertex_fields[0], mesh.vertex_fields[sizing_index]);
     // A user's predicate or placement states rules the improvement cannot know: no phase then.
     if (!opt.predicate_cl_source.empty() || !opt.placement_cl_source.empty()) c->no_improve = true;
     if (report_quality && c->no_improve) quality_collapsed = quality_summary(mesh);
@@ -421,6 +462,11 @@ void register_collapse(CLI::App& app, int& exit_code) {
       r.vertices_out = mesh.num_vertices();
       r.tets_out = mesh.num_tets();
     }
+    int64_t outside = 0;
+    if (resample) outside = resample_vertex_fields(input, mesh);
+    if (outside > 0 && !c->quiet)
+      std::fprintf(stderr, "note: %lld vertices lie outside the input; their fields come from the nearest tet\n",
+                   (long long)outside);
 
     const std::string verdict =
         c->check ? check_result(mesh, input, opt.boundary == CollapseOptions::Strict, c->quiet, exit_code) : "";

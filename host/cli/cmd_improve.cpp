@@ -6,6 +6,7 @@
 #include "cli/common.hpp"
 #include "cli/improve_cli.hpp"
 #include "stopwatch.hpp"
+#include "tetcollapse/fields.hpp"
 
 namespace tc::cli {
 
@@ -140,8 +141,8 @@ void register_improve(CLI::App& app, int& exit_code) {
     check_output_path(o->stats, nullptr);
     const Stopwatch total;
     Mesh mesh = read_input(o->in, o->input, o->quiet);
-    Mesh input;
-    if (o->check) input = mesh;
+    Mesh input;  // for --check, and the vertex fields' values at the moved vertices
+    if (o->check || !mesh.vertex_fields.empty()) input = mesh;
     ImproveOptions& opt = o->improve.opt;
     opt.boundary = boundary_mode(o->boundary);
     opt.use_labels = !o->no_labels;
@@ -153,6 +154,8 @@ void register_improve(CLI::App& app, int& exit_code) {
       if (!o->quiet) std::cerr << "device: " << ctx->info().name << " (" << ctx->info().platform_name << ")\n";
     }
     ImproveReport r = run_improve(mesh, o->improve, o->quiet, ctx.get());
+    // (a relocation interpolates in the star as it was then; the input's field is the truth)
+    if (!mesh.vertex_fields.empty()) resample_vertex_fields(input, mesh);
     exit_code = kOk;
     const std::string verdict =
         o->check ? check_result(mesh, input, opt.boundary == CollapseOptions::Strict, o->quiet, exit_code) : "";

@@ -33,6 +33,7 @@
 #include <utility>
 #include <vector>
 
+#include "tetcollapse/fields.hpp"
 #include "tetcollapse/mesh.hpp"
 
 namespace tc {
@@ -45,6 +46,7 @@ struct CheckOptions {
   bool quality = true;            // dihedral angles, radius ratio, AMIPS, edge lengths
   bool hausdorff = true;          // with a reference: two-sided Hausdorff distance
   double hausdorff_rel_error = 1e-4;  // error bound of the Hausdorff distance, x bbox diagonal
+  int64_t field_samples = 100000;    // with a reference: random points for the field errors
   int max_offenders = 5;          // offenders named per finding
   int histogram_bins = 18;
 
@@ -133,6 +135,9 @@ struct ReferenceComparison {
   double hausdorff_from_reference = std::numeric_limits<double>::quiet_NaN();  // reference -> mesh
   double hausdorff_rel = std::numeric_limits<double>::quiet_NaN();      // / reference bbox diagonal
   double hausdorff_error_bound = 0;
+  // Per vertex field both meshes have: how far the mesh's field is from the reference's
+  // (tc::field_errors, CheckOptions::field_samples random points and every reference vertex).
+  std::vector<FieldError> fields;
 };
 
 struct QualityReport {

@@ -1,0 +1,173 @@
+// Vertex fields from the original mesh: point location against a brute-force search, a linear
+// field kept exact by any coarsening, the field errors, and the CLI's --preserve-field.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "geometry.h"
+#include "test_support.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/fields.hpp"
+#include "tetcollapse/io.hpp"
+
+namespace tc {
+namespace {
+
+using namespace test;
+using geo::tc_d3;
+
+Mesh jiggled(int n, unsigned seed) {
+  Mesh m = cube_tets(n);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.3 / n, 0.3 / n);
+  for (double& x : m.points)
+    if (x > 0 && x < 1) x += u(rng);
+  return m;
+}
+
+double linear(const double* p) { return 1 + p[0] + 2 * p[1] - 3 * p[2]; }
+
+void add_linear_field(Mesh& m) {
+  m.vertex_fields.push_back({"f", 1, {}});
+  for (int64_t v = 0; v < m.num_vertices(); ++v) m.vertex_fields.back().values.push_back(linear(&m.points[3 * size_t(v)]));
+}
+
+// The smallest barycentric coordinate of p in tet t, and p's distance to the tet (brute force:
+// the distance to its nearest sample among a fine grid of its points would be slow; outside
+// points are compared through the located tet's own coordinates instead).
+double min_bary(const Mesh& m, int64_t t, tc_d3 p) {
+  tc_d3 c[4];
+  for (int k = 0; k < 4; ++k) c[k] = geo::tc_point(m.points.data(), m.tets[size_t(4 * t + k)]);
+  const double v = geo::tc_orient3d(c[0], c[1], c[2], c[3]);
+  const double b[4] = {geo::tc_orient3d(p, c[1], c[2], c[3]) / v, geo::tc_orient3d(c[0], p, c[2], c[3]) / v,
+                       geo::tc_orient3d(c[0], c[1], p, c[3]) / v, geo::tc_orient3d(c[0], c[1], c[2], p) / v};
+  return std::min({b[0], b[1], b[2], b[3]});
+}
+
+TEST(TetLocator, FindsTheTetABruteForceSearchFinds) {
+  const Mesh m = jiggled(6, 3);
+  const TetLocator loc(m);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.001, 0.999);
+  for (int i = 0; i < 2000; ++i) {
+    const double p[3] = {u(rng), u(rng), u(rng)};
+    double bary[4];
+    const int64_t t = loc.locate(p, bary);
+    ASSERT_GE(t, 0);
+    int64_t holding = 0;
+    for (int64_t s = 0; s < m.num_tets(); ++s) holding += min_bary(m, s, {p[0], p[1], p[2]}) >= -1e-12;
+    ASSERT_GE(holding, 1) << "the cube holds every point";
+    EXPECT_GE(min_bary(m, t, {p[0], p[1], p[2]}), -1e-12) << "the located tet holds p";
+    // the coordinates reproduce p
+    tc_d3 q{0, 0, 0};
+    for (int k = 0; k < 4; ++k) q = q + geo::tc_point(m.points.data(), m.tets[size_t(4 * t + k)]) * bary[k];
+    EXPECT_NEAR(q.x, p[0], 1e-12);
+    EXPECT_NEAR(q.y, p[1], 1e-12);
+    EXPECT_NEAR(q.z, p[2], 1e-12);
+  }
+  // outside: the nearest point of the nearest tet, on the cube's face
+  const double out[3] = {1.5, 0.5, 0.25};
+  double bary[4];
+  const int64_t t = loc.locate(out, bary);
+  ASSERT_GE(t, 0);
+  tc_d3 q{0, 0, 0};
+  for (int k = 0; k < 4; ++k) q = q + geo::tc_point(m.points.data(), m.tets[size_t(4 * t + k)]) * bary[k];
+  EXPECT_NEAR(q.x, 1.0, 1e-12);
+  EXPECT_NEAR(q.y, 0.5, 1e-9);
+  EXPECT_NEAR(q.z, 0.25, 1e-9);
+}
+
+TEST(ResampleFields, AnyCoarseningKeepsALinearFieldExact) {
+  Mesh in = jiggled(8, 7);
+  add_linear_field(in);
+  for (auto boundary : {CollapseOptions::Features, CollapseOptions::Free}) {
+    Mesh m = in;
+    CollapseOptions o;
+    o.method = CollapseOptions::Sequential;
+    o.target_factor = 2.5;
+    o.boundary = boundary;
+    collapse_sequential(m, o);
+    ASSERT_LT(m.num_vertices(), in.num_vertices() / 2);
+    const int64_t outside = resample_vertex_fields(in, m);
+    double err = 0;
+    for (int64_t v = 0; v < m.num_vertices(); ++v)
+      err = std::max(err, std::fabs(m.vertex_fields[0].values[size_t(v)] - linear(&m.points[3 * size_t(v)])));
+    EXPECT_LT(err, 1e-12) << "exact at every vertex";
+    if (boundary == CollapseOptions::Features) {
+      EXPECT_EQ(outside, 0);
+      // the same volume: the two linear fields agree everywhere
+      const std::vector<FieldError> e = field_errors(in, m, 20000);
+      ASSERT_EQ(e.size(), 1u);
+      EXPECT_EQ(e[0].name, "f");
+      EXPECT_LT(e[0].max_rel, 1e-12);
+    }
+  }
+}
+
+TEST(ResampleFields, TheValueAtANewPlaceIsTheOriginalsNotAnAverage) {
+  Mesh in = jiggled(8, 11);
+  in.vertex_fields.push_back({"g", 1, {}});
+  for (int64_t v = 0; v < in.num_vertices(); ++v) {
+    const double* p = &in.points[3 * size_t(v)];
+    in.vertex_fields[0].values.push_back(std::sin(6 * p[0]) * std::cos(5 * p[1]) + p[2] * p[2]);
+  }
+  Mesh m = in;
+  CollapseOptions o;
+  o.method = CollapseOptions::Sequential;
+  o.target_factor = 2;
+  o.boundary = CollapseOptions::Free;
+  collapse_sequential(m, o);
+  const double before = field_errors(in, m, 50000)[0].rms_rel;
+  resample_vertex_fields(in, m);
+  const double after = field_errors(in, m, 50000)[0].rms_rel;
+  EXPECT_LT(after, before) << "the original field at each vertex is closer than the average of two ends";
+  EXPECT_GT(before, 0);
+  // at an output vertex, the value is the input's field there (located in the input)
+  const TetLocator loc(in);
+  for (int64_t v = 0; v < m.num_vertices(); v += 7) {
+    double b[4];
+    const int64_t t = loc.locate(&m.points[3 * size_t(v)], b);
+    double x = 0;
+    for (int k = 0; k < 4; ++k) x += b[k] * in.vertex_fields[0].values[size_t(in.tets[size_t(4 * t + k)])];
+    EXPECT_NEAR(m.vertex_fields[0].values[size_t(v)], x, 1e-12);
+  }
+}
+
+TEST(FieldErrors, NoneAgainstItselfAndOneWhereTheFieldDiffers) {
+  Mesh a = jiggled(4, 1);
+  add_linear_field(a);
+  EXPECT_LT(field_errors(a, a, 5000)[0].max_abs, 1e-14);
+  Mesh b = a;
+  b.vertex_fields[0].values[size_t(40)] += 0.5;
+  const FieldError e = field_errors(a, b, 5000)[0];
+  EXPECT_NEAR(e.max_abs, 0.5, 1e-12) << "at the vertex itself";
+  EXPECT_GT(e.rms_abs, 0);
+  EXPECT_EQ(e.samples, 5000 + a.num_vertices());
+}
+
+TEST(FieldsCli, PreserveFieldCoarsensAndChecksTheField) {
+  Mesh in = jiggled(8, 13);
+  in.vertex_fields.push_back({"rho", 1, {}});
+  for (int64_t v = 0; v < in.num_vertices(); ++v)
+    in.vertex_fields[0].values.push_back(std::exp(-8 * std::pow(in.points[3 * size_t(v)] - 0.5, 2)));
+  TempDir dir;
+  const std::string src = dir.file("in.vtu"), out = dir.file("out.vtu");
+  write_mesh(src, in);
+  std::string log;
+  ASSERT_EQ(run_command(std::string("'") + TC_CLI + "' '" + src + "' '" + out +
+                            "' --preserve-field rho --field-tolerance 0.05 --no-improve",
+                        &log),
+            0)
+      << log;
+  const Mesh m = read_mesh(out);
+  EXPECT_LT(m.num_vertices(), in.num_vertices());
+  ASSERT_EQ(run_command(std::string("'") + TC_CLI + "' check '" + out + "' --reference '" + src + "'", &log), 0) << log;
+  EXPECT_NE(log.find("field 'rho'"), std::string::npos) << log;
+  EXPECT_EQ(run_command(std::string("'") + TC_CLI + "' '" + src + "' '" + out + "' --preserve-field nope", &log), 2);
+  EXPECT_NE(log.find("nope"), std::string::npos) << log;
+}
+
+}  // namespace
+}  // namespace tc
