@@ -23,6 +23,7 @@ results files:
     improve_slivers bench/results/improve_slivers.json                  (bench/improve_slivers.py; its table)
     improve_paths   bench/results/improve_paths.json                    (bench/improve_paths.py; its tables)
     boundary_error  bench/results/boundary_error.json                   (bench/quality_peers.py; its table)
+    volume_rendering bench/results/volume_rendering.json               (bench/volume_rendering.py; its table)
     robustness      bench/robustness/results.json                       (scripts/robustness.py)
     io, primitives, bench/results/io.json, primitives.json, connectivity.json, checker.json,
     connectivity,   boundary_rule.json
@@ -344,6 +345,7 @@ BLOCKS = {
     "improve_slivers": lambda: recorded_block("improve_slivers", "improve_slivers"),
     "improve_paths": lambda: recorded_block("improve_paths", "improve_paths"),
     "boundary_error": lambda: recorded_block("boundary_error", "quality_peers"),
+    "volume_rendering": lambda: recorded_block("volume_rendering", "volume_rendering"),
     "robustness": robustness_block,
     "io": io_block,
     "primitives": primitives_block,

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <random>
 
@@ -167,6 +168,31 @@ TEST(FieldsCli, PreserveFieldCoarsensAndChecksTheField) {
   EXPECT_NE(log.find("field 'rho'"), std::string::npos) << log;
   EXPECT_EQ(run_command(std::string("'") + TC_CLI + "' '" + src + "' '" + out + "' --preserve-field nope", &log), 2);
   EXPECT_NE(log.find("nope"), std::string::npos) << log;
+}
+
+// scripts/render_dvr.py renders a small mesh and its coarsened copy (when VTK and Xvfb are
+// installed: scripts/setup.sh --with-tools).
+TEST(FieldsCli, TheRenderingScriptComparesTwoMeshes) {
+  std::string probe;
+  if (run_command("/usr/bin/python3 -c 'import vtk, numpy' && command -v xvfb-run", &probe) != 0)
+    GTEST_SKIP() << "no VTK Python module or xvfb-run (scripts/setup.sh --with-tools installs them)";
+  Mesh in = jiggled(6, 17);
+  in.vertex_fields.push_back({"rho", 1, {}});
+  for (int64_t v = 0; v < in.num_vertices(); ++v) in.vertex_fields[0].values.push_back(in.points[3 * size_t(v)]);
+  TempDir dir;
+  const std::string a = dir.file("a.vtu"), b = dir.file("b.vtu"), png = dir.file("pair.png");
+  write_mesh(a, in);
+  std::string log;
+  const std::string script = std::string("/usr/bin/python3 '") + TC_SOURCE_DIR + "/scripts/render_dvr.py' ";
+  ASSERT_EQ(run_command(script + "'" + a + "' '" + a + "' --field rho --size 96 --json", &log), 0) << log;
+  EXPECT_NE(log.find("\"psnr\": Infinity"), std::string::npos) << "an image against itself: " << log;
+  Mesh shifted = in;
+  for (double& x : shifted.vertex_fields[0].values) x = 1 - x;
+  write_mesh(b, shifted);
+  ASSERT_EQ(run_command(script + "'" + a + "' '" + b + "' --field rho --size 96 --json --png '" + png + "'", &log), 0)
+      << log;
+  EXPECT_EQ(log.find("Infinity"), std::string::npos) << "a reversed field renders otherwise: " << log;
+  EXPECT_TRUE(std::filesystem::exists(png));
 }
 
 }  // namespace

@@ -1,0 +1,168 @@
+#!/usr/bin/python3
+"""Coarsening for direct volume rendering (the paper's Section 4.5), measured.
+
+    bench/volume_rendering.py [--tetcollapse PATH] [--out-json bench/results/volume_rendering.json]
+                              [--no-render] [--images DIR]
+
+Data sets: shared meshes carrying an analytic field written here (a sum of three Gaussians, a
+smooth field spanning tens of vertices; the Marschner-Lobb signal, the standard volume-rendering
+test, with its 6 cycles, which a mesh of this size does not resolve), and the shared
+`vtkdata_post_pressure.vtk` with its own field. Each is coarsened by
+
+    tetcollapse IN OUT --preserve-field F [--field-tolerance T] --boundary B --no-improve
+
+at T = 0.02 (the paper) in `features` and `free` modes, with `--average-fields` as the before
+(the survivor's value the average of the edge's ends), and the Gaussian set over a sweep of T.
+Recorded per run: vertices and tets in and out, the tool's time without I/O, the volume kept,
+and `tetcollapse check OUT --reference IN`'s field error (largest and RMS difference of the two
+piecewise linear fields at every input vertex and 100,000 random points, as a share of the
+field's range). With VTK (Debian python3-vtk9) and Xvfb, the input and the output are rendered
+by VTK's unstructured-grid ray casting with one camera and transfer function, and the PSNR and
+SSIM of the output's image against the input's are recorded (images in --images).
+
+    bench/volume_rendering.py --table F.json   prints the markdown table of a results file
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+import peers  # noqa: E402
+
+SHARED = os.path.join(os.path.dirname(ROOT), "shared", "meshes")
+
+
+def table(doc):
+    out = ["| data | field | mode | T | vertices in -> out | fewer vertices | tets out | volume kept | "
+           "field RMS | field max | PSNR dB | SSIM | own s |",
+           "|---|---|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in doc["rows"]:
+        f = lambda x, spec: "-" if x is None else format(x, spec)  # noqa: E731
+        out.append(f"| {r['data']} | {r['field']} | {r['mode']} | {r['T']} | {r['vertices_in']} -> "
+                   f"{r['vertices_out']} | {100 * r['vertex_reduction']:.1f}% | {r['tets_out']} | "
+                   f"{100 * r['volume_kept']:.2f}% | {100 * r['rms_rel']:.3f}% | {100 * r['max_rel']:.2f}% | "
+                   f"{f(r.get('psnr'), '.1f')} | {f(r.get('ssim'), '.3f')} | {r['seconds']:.2f} |")
+    return "\n".join(out)
+
+
+def gaussians(p, lo, hi):
+    """Three Gaussians of widths a fifth of the box, at fixed places in it."""
+    u = [(p[c] - lo[c]) / (hi[c] - lo[c]) for c in range(3)]
+    centres = [(0.3, 0.3, 0.5), (0.7, 0.6, 0.4), (0.5, 0.8, 0.7)]
+    return sum(math.exp(-sum((u[c] - m[c]) ** 2 for c in range(3)) / (2 * 0.2 ** 2)) for m in centres)
+
+
+def marschner_lobb(p, lo, hi):
+    x, y, z = (2 * (p[c] - lo[c]) / (hi[c] - lo[c]) - 1 for c in range(3))
+    alpha, fm = 0.25, 6.0
+    rho = math.cos(2 * math.pi * fm * math.cos(math.pi * math.sqrt(x * x + y * y) / 2))
+    return (1 - math.sin(math.pi * z / 2) + alpha * (1 + rho)) / (2 * (1 + alpha))
+
+
+def with_field(vtk, src, dst, name, fn):
+    """Writes src (any format tetcollapse reads, converted to .vtu) with the point field `name`."""
+    r = vtk.vtkXMLUnstructuredGridReader()
+    r.SetFileName(src)
+    r.Update()
+    g = r.GetOutput()
+    pts = g.GetPoints()
+    lo = [min(pts.GetPoint(i)[c] for i in range(pts.GetNumberOfPoints())) for c in range(3)]
+    hi = [max(pts.GetPoint(i)[c] for i in range(pts.GetNumberOfPoints())) for c in range(3)]
+    arr = vtk.vtkDoubleArray()
+    arr.SetName(name)
+    for i in range(pts.GetNumberOfPoints()):
+        arr.InsertNextValue(fn(pts.GetPoint(i), lo, hi))
+    g.GetPointData().AddArray(arr)
+    w = vtk.vtkXMLUnstructuredGridWriter()
+    w.SetFileName(dst)
+    w.SetInputData(g)
+    w.Write()
+
+
+def main():
+    if len(sys.argv) == 3 and sys.argv[1] == "--table":
+        with open(sys.argv[2]) as f:
+            print(table(json.load(f)))
+        return
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--tetcollapse", default=None)
+    ap.add_argument("--out-json", default=os.path.join(HERE, "results", "volume_rendering.json"))
+    ap.add_argument("--no-render", action="store_true")
+    ap.add_argument("--images", default=os.path.join(HERE, "plots", "volume_rendering"))
+    a = ap.parse_args()
+    tc = os.path.abspath(a.tetcollapse or peers.default_tetcollapse() or "")
+    if not os.access(tc, os.X_OK):
+        sys.exit("volume_rendering.py: no tetcollapse binary (give --tetcollapse PATH)")
+    try:
+        import vtk  # noqa: F401
+    except ImportError:
+        sys.exit("volume_rendering.py: needs VTK's Python module (Debian python3-vtk9; scripts/setup.sh --with-tools)")
+    import vtk
+    doc = dict(peers.provenance("volume_rendering.py", tc), rows=[])
+    render = None
+    if not a.no_render:
+        sys.path.insert(0, os.path.join(ROOT, "scripts"))
+        import render_dvr  # noqa: E402
+        render = render_dvr
+        os.makedirs(a.images, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="tc_vr_") as work:
+        data = []
+        for mesh, field, fn in (("gen_tetgen_octagonal_pocket_160k.msh", "gauss", gaussians),
+                                ("gen_tetgen_octagonal_pocket_160k.msh", "ml", marschner_lobb),
+                                ("vtkdata_post_pressure.vtk", "Pressure", None)):
+            src = os.path.join(SHARED, mesh)
+            if not os.path.exists(src):
+                print(f"skipped {mesh}: not in {SHARED}")
+                continue
+            vtu = os.path.join(work, f"{os.path.splitext(mesh)[0]}_{field}.vtu")
+            subprocess.run([tc, "convert", src, vtu, "-q"], check=True)
+            if fn:
+                with_field(vtk, vtu, vtu, field, fn)
+            data.append((mesh, field, vtu))
+        runs = []
+        for mesh, field, vtu in data:
+            sweep = [0.01, 0.02, 0.05] if field == "gauss" else [0.02]
+            for mode in ("features", "free"):
+                for t in sweep:
+                    runs.append((mesh, field, vtu, mode, t, False))
+                runs.append((mesh, field, vtu, mode, 0.02, True))
+        for mesh, field, vtu, mode, t, average in runs:
+            out = os.path.join(work, "out.vtu")
+            stats = os.path.join(work, "s.json")
+            cmd = [tc, vtu, out, "--preserve-field", field, "--field-tolerance", str(t), "--boundary", mode,
+                   "--no-improve", "--stats", stats, "-q"] + (["--average-fields"] if average else [])
+            p = subprocess.run(cmd, capture_output=True, text=True)
+            if p.returncode != 0:
+                print(f"failed: {' '.join(cmd)}: {p.stderr.strip()}")
+                continue
+            with open(stats) as f:
+                st = json.load(f)
+            c = subprocess.run([tc, "check", out, "--reference", vtu, "--json", "-", "-q"], capture_output=True,
+                               text=True)
+            rep = json.loads(c.stdout)
+            ref = rep["reference"]
+            fe = next(x for x in ref["fields"] if x["name"] == field)
+            row = {"data": os.path.splitext(mesh)[0].replace("gen_tetgen_", ""), "field": field,
+                   "mode": mode + (", averaged" if average else ""), "T": t, "vertices_in": st["vertices_in"],
+                   "vertices_out": st["vertices_out"], "vertex_reduction": 1 - st["vertices_out"] / st["vertices_in"],
+                   "tets_out": st["tets_out"], "volume_kept": 1 + ref["volume_change_rel"],
+                   "rms_rel": fe["rms_rel"], "max_rel": fe["max_rel"], "seconds": st["seconds_collapse"]}
+            if render and t == 0.02:
+                tag = f"{field}_{mode}"
+                m = render.compare(vtu, out, field, None if average else os.path.join(a.images, f"{tag}.png"))
+                row.update(psnr=m["psnr"], ssim=m["ssim"])
+            print(row)
+            doc["rows"].append(row)
+    with open(a.out_json, "w") as f:
+        json.dump(doc, f, indent=1)
+    print(table(doc))
+
+
+if __name__ == "__main__":
+    main()
