@@ -89,6 +89,7 @@ OrientationReport normalize_orientation(Mesh& mesh, OrientationPolicy policy) {
     r.flipped = r.negative;
     return r;
   }
+  if (policy == OrientationPolicy::Keep) return r;
   if (policy == OrientationPolicy::Refuse)
     throw InputError("mesh", "mixed tet orientation: " + std::to_string(r.positive) + " positive, " +
                                  std::to_string(r.negative) + " negative, " + std::to_string(r.degenerate) +
@@ -132,11 +133,18 @@ Mesh make_cube_mesh(int n) {
   return m;
 }
 
+bool geometry_is_sound(const Mesh& mesh) {
+  for (double x : mesh.points)
+    if (!std::isfinite(x)) return false;
+  const int64_t nv = mesh.num_vertices();
+  for (int32_t v : mesh.tets)
+    if (v < 0 || v >= nv) return false;
+  return true;
+}
+
 void validate_structure(const Mesh& mesh, const std::string& source) {
-  if (mesh.points.size() % 3 != 0) throw InputError(source, "internal: coordinate array not a multiple of 3");
-  if (mesh.tets.size() % 4 != 0) throw InputError(source, "internal: tet array not a multiple of 4");
+  validate_arrays(mesh, source);
   const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
-  if (nt == 0) throw InputError(source, "the mesh has no tetrahedra");
   for (size_t i = 0; i < mesh.points.size(); ++i)
     if (!std::isfinite(mesh.points[i]))
       throw InputError(source, "vertex " + std::to_string(i / 3 + 1) + " has a non-finite coordinate");
@@ -147,6 +155,13 @@ void validate_structure(const Mesh& mesh, const std::string& source) {
         throw InputError(source, "tet " + std::to_string(t + 1) + " refers to vertex " + std::to_string(int64_t(v) + 1) +
                                      ", outside 1.." + std::to_string(nv));
     }
+}
+
+void validate_arrays(const Mesh& mesh, const std::string& source) {
+  if (mesh.points.size() % 3 != 0) throw InputError(source, "internal: coordinate array not a multiple of 3");
+  if (mesh.tets.size() % 4 != 0) throw InputError(source, "internal: tet array not a multiple of 4");
+  const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
+  if (nt == 0) throw InputError(source, "the mesh has no tetrahedra");
   for (int64_t i = 0; i < static_cast<int64_t>(mesh.tris.size()); ++i)
     if (mesh.tris[i] < 0 || mesh.tris[i] >= nv)
       throw InputError(source, "triangle " + std::to_string(i / 3 + 1) + " refers to a vertex outside 1.." + std::to_string(nv));

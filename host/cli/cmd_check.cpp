@@ -52,6 +52,8 @@ void register_check(CLI::App& app, int& exit_code) {
   add_input_options(*cmd, o->input);
   cmd->callback([o, &exit_code] {
     check_output_path(o->json, nullptr);
+    // Defects are findings (exit 1), not read errors: only an unparsable file is exit 2.
+    o->input.as_is = true;
     Mesh m = read_input(o->path, o->input, o->quiet);
     Mesh ref;
     if (!o->reference.empty()) ref = read_input(o->reference, o->input, o->quiet);

@@ -22,6 +22,7 @@ Mesh read_input(const std::string& path, const InputOptions& o, bool quiet) {
   if (!o.format.empty()) ro.format = parse_format(o.format);
   ro.orientation = o.fix_orientation ? OrientationPolicy::Fix : OrientationPolicy::Refuse;
   ro.read_sol = !o.no_sol;
+  ro.as_is = o.as_is;
   ReadNotes notes;
   Mesh m = read_mesh(path, ro, &notes);
   if (!quiet)

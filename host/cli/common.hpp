@@ -24,6 +24,7 @@ struct InputOptions {
   std::string format;            // "" = from the extension
   bool fix_orientation = false;  // flip negatively oriented tets of a mixed mesh
   bool no_sol = false;
+  bool as_is = false;            // the checker's reading (ReadOptions::as_is); not an option
 };
 void add_input_options(CLI::App& cmd, InputOptions& o);
 Mesh read_input(const std::string& path, const InputOptions& o, bool quiet);

@@ -427,7 +427,7 @@ int32_t node_index(Src& s, const ReaderState& st, int64_t tag) {
 template <class Src>
 void read_coords(Src& s, Mesh& m, int64_t tag) {
   double x = s.real(), y = s.real(), z = s.real();
-  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z))
+  if ((!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) && !io::lenient())
     s.fail("node " + std::to_string(tag) + " has a non-finite coordinate (NaN or infinity)");
   m.points.push_back(x);
   m.points.push_back(y);

@@ -45,6 +45,7 @@ Mesh read_mesh(const std::string& path, const ReadOptions& options, ReadNotes* n
   Format f = options.format == Format::Auto ? format_from_name(path) : options.format;
   ReadNotes notes;
   Mesh mesh;
+  const io::Lenient lenient(options.as_is);
   switch (f) {
     case Format::Gmsh: mesh = read_gmsh(path, notes); break;
     case Format::Medit: mesh = read_medit(path, notes, options.read_sol); break;
@@ -59,12 +60,20 @@ Mesh read_mesh(const std::string& path, const ReadOptions& options, ReadNotes* n
       why += " (" + std::to_string(notes.skipped_elements) + " non-tetrahedral elements were skipped)";
     throw InputError(path, why);
   }
-  validate_structure(mesh, path);
   OrientationReport orient;
-  try {
-    orient = normalize_orientation(mesh, options.orientation);
-  } catch (const InputError& e) {
-    throw InputError(path, e.reason());
+  if (options.as_is) {
+    validate_arrays(mesh, path);
+    // (orientation needs every tet's points; the checker reports the rest)
+    if (geometry_is_sound(mesh))
+      orient = normalize_orientation(
+          mesh, options.orientation == OrientationPolicy::Fix ? OrientationPolicy::Fix : OrientationPolicy::Keep);
+  } else {
+    validate_structure(mesh, path);
+    try {
+      orient = normalize_orientation(mesh, options.orientation);
+    } catch (const InputError& e) {
+      throw InputError(path, e.reason());
+    }
   }
   if (orient.flipped_all)
     notes.notes.push_back("all " + std::to_string(orient.flipped) + " tets were negatively oriented; flipped");

@@ -126,9 +126,16 @@ double TextCursor::next_double() {
   return v;
 }
 
+namespace {
+thread_local bool lenient_reading = false;
+}
+bool lenient() { return lenient_reading; }
+Lenient::Lenient(bool on) : before(lenient_reading) { lenient_reading = on; }
+Lenient::~Lenient() { lenient_reading = before; }
+
 double TextCursor::next_finite_double(const char* what) {
   double v = next_double();
-  if (!std::isfinite(v)) fail(std::string("non-finite ") + what + " (NaN or infinity)");
+  if (!std::isfinite(v) && !lenient()) fail(std::string("non-finite ") + what + " (NaN or infinity)");
   return v;
 }
 

@@ -151,6 +151,15 @@ class AtomicFile {
 // Commits several files together (all or, on the first failure, as few as possible).
 void commit_all(std::initializer_list<AtomicFile*> files);
 
+// The checker's reading (ReadOptions::as_is), on this thread while a Lenient lives: the readers
+// keep non-finite coordinates and out-of-range vertex indices for tc::check_mesh to report.
+bool lenient();
+struct Lenient {
+  explicit Lenient(bool on);
+  ~Lenient();
+  bool before;
+};
+
 // Shortest text that reads back as exactly the same double ("%.17g" style, shortest form).
 std::string format_double(double v);
 void append_double(std::string& out, double v);

@@ -255,17 +255,19 @@ class AsciiReader {
     for (int64_t i = 0; i < n; ++i) {
       for (int j = 0; j < per; ++j) {
         int64_t v = c_.next_int();
-        if (v == 0) c_.fail("index 0 where Medit indices are one-based (" + std::string(k.name) + ")");
-        if (v < 0) c_.fail("negative vertex index " + std::to_string(v) + " (" + std::string(k.name) + ")");
-        if (nv_ >= 0 && v > nv_) c_.fail(std::string(k.name) + ": " + out_of_range(v, nv_));
-        if (v > std::numeric_limits<int32_t>::max()) c_.fail(out_of_range(v, std::max<int64_t>(nv_, 0)));
+        const bool keep_bad = io::lenient() && k.code == kTetrahedra;  // the checker reports it
+        if (v == 0 && !keep_bad) c_.fail("index 0 where Medit indices are one-based (" + std::string(k.name) + ")");
+        if (v < 0 && !keep_bad) c_.fail("negative vertex index " + std::to_string(v) + " (" + std::string(k.name) + ")");
+        if (nv_ >= 0 && v > nv_ && !keep_bad) c_.fail(std::string(k.name) + ": " + out_of_range(v, nv_));
+        if (v > std::numeric_limits<int32_t>::max() || v < std::numeric_limits<int32_t>::min() + 1)
+          c_.fail(out_of_range(v, std::max<int64_t>(nv_, 0)));
         max_seen = std::max(max_seen, v);
         if (j < keep) conn[base + static_cast<size_t>(i * keep + j)] = static_cast<int32_t>(v - 1);
       }
       int32_t ref = next_int32("reference");
       if (refs) refs->push_back(ref);
     }
-    if (nv_ < 0 && n > 0) pending_.push_back({max_seen, section_line, k.name});
+    if (nv_ < 0 && n > 0 && !(io::lenient() && k.code == kTetrahedra)) pending_.push_back({max_seen, section_line, k.name});
     return n;
   }
 
@@ -451,9 +453,11 @@ Mesh read_meshb(std::string_view data, const std::string& file, ReadNotes& notes
       for (int j = 0; j < per; ++j) {
         const size_t at = b.pos();
         int64_t v = r.get_int();
-        if (v == 0) b.fail_at(at, "index 0 where Medit indices are one-based (" + std::string(k.name) + ")");
-        if (v < 0) b.fail_at(at, "negative vertex index " + std::to_string(v) + " (" + std::string(k.name) + ")");
-        if ((nv >= 0 && v > nv) || v > std::numeric_limits<int32_t>::max())
+        const bool keep_bad = io::lenient() && k.code == kTetrahedra;  // the checker reports it
+        if (v == 0 && !keep_bad) b.fail_at(at, "index 0 where Medit indices are one-based (" + std::string(k.name) + ")");
+        if (v < 0 && !keep_bad) b.fail_at(at, "negative vertex index " + std::to_string(v) + " (" + std::string(k.name) + ")");
+        if ((nv >= 0 && v > nv && !keep_bad) || v > std::numeric_limits<int32_t>::max() ||
+            v < std::numeric_limits<int32_t>::min() + 1)
           b.fail_at(at, std::string(k.name) + ": " + out_of_range(v, std::max<int64_t>(nv, 0)));
         max_seen = std::max(max_seen, v);
         if (j < keep) conn[base + static_cast<size_t>(i * keep + j)] = static_cast<int32_t>(v - 1);
@@ -464,7 +468,7 @@ Mesh read_meshb(std::string_view data, const std::string& file, ReadNotes& notes
         b.fail_at(at, "reference " + std::to_string(ref) + " does not fit in 32 bits");
       refs.push_back(static_cast<int32_t>(ref));
     }
-    if (nv < 0 && n > 0) pending.push_back({max_seen, 0, k.name});
+    if (nv < 0 && n > 0 && !(io::lenient() && k.code == kTetrahedra)) pending.push_back({max_seen, 0, k.name});
   };
 
   r.for_each_keyword([&](int code, const Keyword* k, int64_t n, size_t at) {
@@ -483,7 +487,7 @@ Mesh read_meshb(std::string_view data, const std::string& file, ReadNotes& notes
           for (int d = 0; d < 3; ++d) {
             const size_t p = b.pos();
             double x = r.get_real();
-            if (!std::isfinite(x)) b.fail_at(p, "non-finite vertex coordinate (NaN or infinity)");
+            if (!std::isfinite(x) && !io::lenient()) b.fail_at(p, "non-finite vertex coordinate (NaN or infinity)");
             m.points[static_cast<size_t>(3 * i + d)] = x;
           }
           if (r.get_int() != 0) ++nonzero_refs;

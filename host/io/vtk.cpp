@@ -325,7 +325,7 @@ class LegacyReader {
     Where w = Where{cur_.line(), int64_t(base_ + cur_.pos())};
     read_values(t, 3 * n, mesh_.points, "POINTS");
     int64_t bad = io::vtk::first_non_finite(mesh_.points);
-    if (bad >= 0) fail_at(w, "point " + std::to_string(bad / 3) + " has a non-finite coordinate (NaN or infinity)");
+    if (bad >= 0 && !io::lenient()) fail_at(w, "point " + std::to_string(bad / 3) + " has a non-finite coordinate (NaN or infinity)");
     have_points_ = true;
     skip_optional_metadata();
   }

@@ -484,7 +484,7 @@ class VtuReader {
         fail_line(pts->tag_pos, "Points have " + std::to_string(pts->components) + " components, expected 3");
       decode(*pts, 3 * num_points_, mesh.points);
       int64_t bad = io::vtk::first_non_finite(mesh.points);
-      if (bad >= 0)
+      if (bad >= 0 && !io::lenient())
         fail_line(pts->tag_pos, "point " + std::to_string(bad / 3) + " has a non-finite coordinate (NaN or infinity)");
     }
 

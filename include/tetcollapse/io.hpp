@@ -28,6 +28,11 @@ struct ReadOptions {
   Format format = Format::Auto;
   OrientationPolicy orientation = OrientationPolicy::Refuse;
   bool read_sol = true;     // Medit: read FILE.sol beside FILE.mesh when present
+  // The checker's reading: a mesh with non-finite coordinates or tets referring to missing
+  // vertices is returned as it is (tc::check_mesh reports them), and a mixed orientation is
+  // left as it is (a consistently negative mesh is still flipped). Only a file that cannot be
+  // parsed, or whose arrays do not fit together, is an error.
+  bool as_is = false;
 };
 
 Format format_from_name(const std::string& path);  // throws InputError when unknown

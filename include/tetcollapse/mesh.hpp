@@ -74,6 +74,7 @@ struct OrientationReport {
 enum class OrientationPolicy {
   Refuse,  // mixed orientation is an error (consistently negative is still flipped)
   Fix,     // flip each negative tet; degenerate tets are left as they are and reported
+  Keep,    // leave a mixed orientation as it is (reported; the checker's reading)
 };
 
 // Bring the mesh to positive orientation. A consistently negative mesh is flipped
@@ -89,5 +90,11 @@ Mesh make_cube_mesh(int n);
 // indices in range, finite coordinates, field/label sizes consistent.
 // Throws tc::InputError with `source` as the file name.
 void validate_structure(const Mesh& mesh, const std::string& source);
+// Its part that the checker's reading keeps (ReadOptions::as_is): the arrays' sizes, labels and
+// fields against the counts, triangles and edges against the vertices; not the coordinates'
+// finiteness nor the tets' indices.
+void validate_arrays(const Mesh& mesh, const std::string& source);
+// Whether every coordinate is finite and every tet refers to an existing vertex.
+bool geometry_is_sound(const Mesh& mesh);
 
 }  // namespace tc

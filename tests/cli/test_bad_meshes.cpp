@@ -114,6 +114,39 @@ TEST(BadMeshes, ConsistentlyNegativeMeshIsFlippedWithANote) {
   EXPECT_HAS(r.out, "check: valid");
 }
 
+// `check` reads what it can parse and reports the defects as findings (exit 1, the offender
+// named); the coarsening command still refuses such an input (exit 2, file and line).
+TEST(BadMeshes, CheckReportsWhatTheOtherCommandsRefuse) {
+  tc::test::TempDir dir;
+  const std::string head = "MeshVersionFormatted 2\nDimension 3\nVertices\n5\n0 0 0 0\n1 0 0 0\n0 1 0 0\n0 0 1 0\n";
+  struct Case {
+    const char* name;
+    std::string text;
+    const char* finding;
+  };
+  const Case cases[] = {
+      {"mixed.mesh", head + "1 1 1 0\nTetrahedra\n2\n1 2 3 4 1\n2 4 3 5 1\nEnd\n", "inverted_tet"},
+      {"nan.mesh", head + "nan 1 1 0\nTetrahedra\n2\n1 2 3 4 1\n2 4 3 5 1\nEnd\n", "non_finite_coordinate"},
+      {"index.mesh", head + "1 1 1 0\nTetrahedra\n2\n1 2 3 4 1\n2 4 3 9 1\nEnd\n", "index_out_of_range"},
+      {"nan.vtk",
+       "# vtk DataFile Version 3.0\nx\nASCII\nDATASET UNSTRUCTURED_GRID\nPOINTS 4 double\n0 0 0 1 0 0 0 1 0 nan 0 1\n"
+       "CELLS 1 5\n4 0 1 2 3\nCELL_TYPES 1\n10\n",
+       "non_finite_coordinate"},
+  };
+  for (const Case& c : cases) {
+    const std::string in = dir.file(c.name);
+    tc::test::write_text(in, c.text);
+    std::string out;
+    EXPECT_EQ(run_command(cli() + " check " + q(in), &out), 1) << c.name << ": " << out;
+    EXPECT_HAS(out, c.finding);
+    EXPECT_EQ(run_command(cli() + " " + q(in) + " " + q(dir.file("out.mesh")), &out), 2) << c.name << ": " << out;
+  }
+  const std::string junk = dir.file("junk.mesh");
+  tc::test::write_text(junk, "MeshVersionFormatted 2\nDimension 3\nVertices\nthree\n");
+  std::string out;
+  EXPECT_EQ(run_command(cli() + " check " + q(junk), &out), 2) << "an unparsable file: " << out;
+}
+
 TEST(BadMeshes, NonManifoldEdgeInputIsCoarsenedAndReportedInvalid) {
   // Two cubes touching along one edge: the boundary has an edge in four triangles.
   tc::test::TempDir dir;
