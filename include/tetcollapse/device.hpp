@@ -20,6 +20,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -110,9 +111,10 @@ class Context {
   // Enqueues a 1-D launch of n work items: the global size is n rounded up to a multiple of the
   // work-group size, so kernels must check their global id against n. `what` names the kernel
   // in error messages. local = 0 means group_size_for(kernel), on a CPU device with no size set
-  // (set_work_group_size) halved while the launch would have fewer than 4 work-groups per
-  // compute unit: the CPU drivers run a work-group on one thread, so a small launch in one or
-  // two large groups (a chunked scan's, say) would leave cores idle.
+  // (set_work_group_size) 8 when the launch would have fewer than 4 work-groups per compute
+  // unit: the CPU drivers run a work-group on one thread, so a small launch in one or two large
+  // groups (a chunked scan's, say) would leave cores idle; one small size, because they compile
+  // a work-group function per local size on the first run.
   void launch(cl::Kernel& kernel, size_t n, const char* what, size_t local = 0);
   // Enqueues one work-group of group_size_for(kernel) items (kernels that loop with barriers).
   void launch_one_group(cl::Kernel& kernel, const char* what);
@@ -124,6 +126,10 @@ class Context {
   // How the last program() call that compiled something was satisfied (for tests and benches).
   enum class BuildSource { Memory, DiskCache, Source };
   BuildSource last_build_source() const { return last_build_source_; }
+  // Called before a program is compiled from source (not found in the disk cache), with the
+  // file's name: on a new device, a new driver or a cleared cache, the first run compiles
+  // every kernel it uses, which takes seconds (the CLI says so on stderr).
+  void set_compile_notice(std::function<void(const std::string& file)> fn) { compile_notice_ = std::move(fn); }
 
  private:
   void init(const DeviceInfo& info);
@@ -136,6 +142,7 @@ class Context {
   bool cpu_tuning_ = false;
   std::map<std::pair<std::string, std::string>, cl::Program> programs_;
   BuildSource last_build_source_ = BuildSource::Memory;
+  std::function<void(const std::string&)> compile_notice_;
 };
 
 namespace detail {
