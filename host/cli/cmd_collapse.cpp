@@ -433,8 +433,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
       r = collapse_sequential(mesh, co);
       if (bound > 0) r.boundary_error_bound = bound;
     } else {
-      ctx = std::make_unique<Context>(c->device);
-      if (!c->quiet) std::cerr << "device: " << ctx->info().name << " (" << ctx->info().platform_name << ")\n";
+      ctx = open_device(c->device, c->quiet);
       r = collapse(mesh, opt, *ctx);
     }
     if (!c->sizing_field.empty() || !c->preserve_field.empty())

@@ -150,8 +150,7 @@ void register_improve(CLI::App& app, int& exit_code) {
       throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
     std::unique_ptr<Context> ctx;
     if (o->method == "parallel") {
-      ctx = std::make_unique<Context>(o->device);
-      if (!o->quiet) std::cerr << "device: " << ctx->info().name << " (" << ctx->info().platform_name << ")\n";
+      ctx = open_device(o->device, o->quiet);
     }
     ImproveReport r = run_improve(mesh, o->improve, o->quiet, ctx.get());
     // (a relocation interpolates in the star as it was then; the input's field is the truth)

@@ -17,6 +17,21 @@ void add_input_options(CLI::App& cmd, InputOptions& o) {
   cmd.add_flag("--no-sol", o.no_sol, "Medit: do not read the .sol file beside the .mesh");
 }
 
+std::unique_ptr<Context> open_device(const std::string& spec, bool quiet) {
+  auto ctx = std::make_unique<Context>(spec);
+  if (quiet) return ctx;
+  std::cerr << "device: " << ctx->info().name << " (" << ctx->info().platform_name << ")\n";
+  const std::string name = ctx->info().name;
+  ctx->set_compile_notice([name, said = false](const std::string&) mutable {
+    if (said) return;
+    said = true;
+    std::cerr << "compiling kernels for " << name
+              << " (a first run on this device, driver or cache; later runs read them from "
+              << Context::cache_dir() << ")...\n";
+  });
+  return ctx;
+}
+
 Mesh read_input(const std::string& path, const InputOptions& o, bool quiet) {
   ReadOptions ro;
   if (!o.format.empty()) ro.format = parse_format(o.format);

@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <memory>
 #include <string>
 
 #include "tetcollapse/collapse.hpp"
@@ -28,6 +29,9 @@ struct InputOptions {
 };
 void add_input_options(CLI::App& cmd, InputOptions& o);
 Mesh read_input(const std::string& path, const InputOptions& o, bool quiet);
+// The OpenCL context of --device SPEC; unless quiet, says which device, and says once when a
+// run compiles kernels (a first run on this device: seconds).
+std::unique_ptr<Context> open_device(const std::string& spec, bool quiet);
 
 struct OutputOptions {
   std::string format;
