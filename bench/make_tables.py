@@ -24,6 +24,7 @@ results files:
     improve_paths   bench/results/improve_paths.json                    (bench/improve_paths.py; its tables)
     boundary_error  bench/results/boundary_error.json                   (bench/quality_peers.py; its table)
     volume_rendering bench/results/volume_rendering.json               (bench/volume_rendering.py; its table)
+    cold_start      bench/results/cold_start.json                       (bench/cold_start.py; its table)
     robustness      bench/robustness/results.json                       (scripts/robustness.py)
     io, primitives, bench/results/io.json, primitives.json, connectivity.json, checker.json,
     connectivity,   boundary_rule.json
@@ -346,6 +347,7 @@ BLOCKS = {
     "improve_paths": lambda: recorded_block("improve_paths", "improve_paths"),
     "boundary_error": lambda: recorded_block("boundary_error", "quality_peers"),
     "volume_rendering": lambda: recorded_block("volume_rendering", "volume_rendering"),
+    "cold_start": lambda: recorded_block("cold_start", "cold_start"),
     "robustness": robustness_block,
     "io": io_block,
     "primitives": primitives_block,
