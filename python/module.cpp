@@ -1,0 +1,254 @@
+// The Python module tetcollapse._core (pybind11): NumPy arrays in, NumPy arrays out. The
+// package tetcollapse (python/tetcollapse/__init__.py) wraps it with the meshio bridge.
+// Option names are the command line's, with underscores.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "tetcollapse/check.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/device.hpp"
+#include "tetcollapse/error.hpp"
+#include "tetcollapse/fields.hpp"
+#include "tetcollapse/improve.hpp"
+#include "tetcollapse/io.hpp"
+
+namespace py = pybind11;
+using namespace tc;
+
+namespace {
+
+// A vector handed to NumPy without a copy: the array owns it through a capsule.
+template <class T>
+py::array_t<T> to_numpy(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
+  auto* owner = new std::vector<T>(std::move(v));
+  py::capsule free_when_done(owner, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>(shape, owner->data(), free_when_done);
+}
+
+Mesh from_numpy(py::array_t<double, py::array::c_style | py::array::forcecast> points,
+                py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets, py::object labels,
+                py::object vertex_fields) {
+  if (points.ndim() != 2 || points.shape(1) != 3) throw InputError("<points>", "points must be an (N, 3) array");
+  if (tets.ndim() != 2 || tets.shape(1) != 4) throw InputError("<tets>", "tets must be an (M, 4) array");
+  Mesh m;
+  m.points.assign(points.data(), points.data() + points.size());
+  m.tets.assign(tets.data(), tets.data() + tets.size());
+  if (!labels.is_none()) {
+    auto l = py::array_t<int32_t, py::array::c_style | py::array::forcecast>::ensure(labels);
+    if (!l || l.ndim() != 1 || l.shape(0) != tets.shape(0))
+      throw InputError("<labels>", "labels must be one integer per tet");
+    m.tet_labels.push_back({"label", std::vector<int32_t>(l.data(), l.data() + l.size())});
+  }
+  if (!vertex_fields.is_none())
+    for (auto item : vertex_fields.cast<py::dict>()) {
+      auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(item.second);
+      if (!a || a.ndim() < 1 || a.ndim() > 2 || a.shape(0) != points.shape(0))
+        throw InputError("<vertex_fields>", "field '" + py::str(item.first).cast<std::string>() +
+                                                "' must have one value (or row) per vertex");
+      m.vertex_fields.push_back(
+          {py::str(item.first), a.ndim() == 2 ? int(a.shape(1)) : 1, std::vector<double>(a.data(), a.data() + a.size())});
+    }
+  validate_structure(m, "<arrays>");
+  normalize_orientation(m, OrientationPolicy::Refuse);
+  return m;
+}
+
+py::dict to_dict(Mesh&& m) {
+  py::dict d;
+  const py::ssize_t nv = m.num_vertices(), nt = m.num_tets();
+  d["points"] = to_numpy(std::move(m.points), {nv, 3});
+  d["tets"] = to_numpy(std::move(m.tets), {nt, 4});
+  if (!m.tet_labels.empty()) d["labels"] = to_numpy(std::move(m.tet_labels[0].values), {nt});
+  py::dict fields;
+  for (Field& f : m.vertex_fields) {
+    const int c = f.components;
+    fields[py::str(f.name)] = c == 1 ? to_numpy(std::move(f.values), {nv}) : to_numpy(std::move(f.values), {nv, c});
+  }
+  d["vertex_fields"] = fields;
+  return d;
+}
+
+CollapseOptions::Boundary boundary_of(const std::string& b) {
+  if (b == "strict") return CollapseOptions::Strict;
+  if (b == "features") return CollapseOptions::Features;
+  if (b == "free") return CollapseOptions::Free;
+  throw InputError("<boundary>", "boundary must be 'strict', 'features' or 'free', not '" + b + "'");
+}
+
+py::dict quality_dict(const QualitySummary& q) {
+  py::dict d;
+  d["tets"] = q.tets;
+  d["min_dihedral_deg"] = q.min_dihedral_deg;
+  d["median_dihedral_deg"] = q.median_dihedral_deg;
+  d["below_10_deg"] = q.below_10_deg;
+  d["below_13_deg"] = q.below_13_deg;
+  return d;
+}
+
+py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forcecast> points,
+                     py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets, double target_factor,
+                     py::object target_length, const std::string& boundary, py::object labels,
+                     py::object vertex_fields, py::object device, const std::string& method, bool improve_phase,
+                     double min_quality, double max_boundary_error, bool average_fields) {
+  Mesh mesh = from_numpy(points, tets, labels, vertex_fields);
+  Mesh input;  // the fields' values at new places come from it
+  if (!mesh.vertex_fields.empty() && !average_fields) input = mesh;
+  CollapseOptions o;
+  o.target_factor = target_factor;
+  if (!target_length.is_none()) o.target_length = target_length.cast<double>();
+  o.boundary = boundary_of(boundary);
+  o.min_quality = min_quality;
+  o.max_boundary_error = max_boundary_error;
+  if (method != "parallel" && method != "sequential")
+    throw InputError("<method>", "method must be 'parallel' or 'sequential', not '" + method + "'");
+  std::unique_ptr<Context> ctx;
+  CollapseReport r;
+  ImproveReport ir;
+  {
+    py::gil_scoped_release release;
+    if (method == "sequential") {
+      o.method = CollapseOptions::Sequential;
+      r = collapse_sequential(mesh, o);
+    } else {
+      ctx = std::make_unique<Context>(device.is_none() ? std::string() : device.cast<std::string>());
+      r = collapse(mesh, o, *ctx);
+    }
+    if (improve_phase) {
+      ImproveOptions io;
+      io.boundary = o.boundary;
+      if (r.boundary_error_bound > 0)
+        io.max_boundary_error_abs = std::max(r.boundary_error_bound - r.boundary_error, 1e-300);
+      ir = ctx ? improve(mesh, io, *ctx) : improve(mesh, io);
+    }
+    if (!average_fields && !mesh.vertex_fields.empty()) resample_vertex_fields(input, mesh);
+  }
+  py::dict stats;
+  stats["vertices_in"] = r.vertices_in;
+  stats["tets_in"] = r.tets_in;
+  stats["vertices_out"] = mesh.num_vertices();
+  stats["tets_out"] = mesh.num_tets();
+  stats["iterations"] = r.iterations.size();
+  stats["target_length"] = r.target_length;
+  stats["device"] = r.device;
+  stats["seconds_collapse"] = r.seconds_total;
+  stats["boundary_error_bound"] = r.boundary_error_bound;
+  stats["boundary_error"] = r.boundary_error;
+  if (improve_phase) {
+    stats["seconds_improve"] = ir.seconds_total;
+    stats["quality_before_improve"] = quality_dict(ir.before);
+    stats["quality"] = quality_dict(ir.after);
+  } else {
+    stats["quality"] = quality_dict(quality_summary(mesh));
+  }
+  py::dict d = to_dict(std::move(mesh));
+  d["stats"] = stats;
+  return d;
+}
+
+py::dict improve_py(py::array_t<double, py::array::c_style | py::array::forcecast> points,
+                    py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets, const std::string& boundary,
+                    py::object labels, py::object vertex_fields, py::object device, const std::string& method) {
+  Mesh mesh = from_numpy(points, tets, labels, vertex_fields);
+  Mesh input;
+  if (!mesh.vertex_fields.empty()) input = mesh;
+  ImproveOptions io;
+  io.boundary = boundary_of(boundary);
+  ImproveReport ir;
+  {
+    py::gil_scoped_release release;
+    if (method == "sequential") {
+      ir = improve(mesh, io);
+    } else {
+      Context ctx(device.is_none() ? std::string() : device.cast<std::string>());
+      ir = improve(mesh, io, ctx);
+    }
+    if (!mesh.vertex_fields.empty()) resample_vertex_fields(input, mesh);
+  }
+  py::dict stats;
+  stats["seconds_improve"] = ir.seconds_total;
+  stats["quality_before"] = quality_dict(ir.before);
+  stats["quality"] = quality_dict(ir.after);
+  py::dict d = to_dict(std::move(mesh));
+  d["stats"] = stats;
+  return d;
+}
+
+py::dict check_py(py::array_t<double, py::array::c_style | py::array::forcecast> points,
+                  py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets) {
+  Mesh m;
+  m.points.assign(points.data(), points.data() + points.size());
+  m.tets.assign(tets.data(), tets.data() + tets.size());
+  if (points.ndim() != 2 || points.shape(1) != 3 || tets.ndim() != 2 || tets.shape(1) != 4)
+    throw InputError("<arrays>", "points must be (N, 3) and tets (M, 4)");
+  const CheckReport r = check_mesh(m, {}, nullptr);
+  py::module_ json = py::module_::import("json");
+  return json.attr("loads")(check_report_json(r)).cast<py::dict>();
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, mod) {
+  mod.doc() = "tetcollapse: coarsening of tetrahedral meshes by parallel edge collapse (C++ core)";
+  static py::exception<DeviceError> device_error(mod, "DeviceError", PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    } catch (const OutputError& e) {
+      PyErr_SetString(PyExc_OSError, e.what());
+    } catch (const DeviceError& e) {
+      device_error(e.what());
+    } catch (const std::invalid_argument& e) {
+      PyErr_SetString(PyExc_ValueError, e.what());
+    }
+  });
+  mod.def("collapse", &collapse_py, py::arg("points"), py::arg("tets"), py::kw_only(), py::arg("target_factor") = 1.0,
+          py::arg("target_length") = py::none(), py::arg("boundary") = "features", py::arg("labels") = py::none(),
+          py::arg("vertex_fields") = py::none(), py::arg("device") = py::none(), py::arg("method") = "parallel",
+          py::arg("improve") = true, py::arg("min_quality") = 0.1, py::arg("max_boundary_error") = 0.0,
+          py::arg("average_fields") = false,
+          "Coarsens a tet mesh; returns a dict: points, tets, labels (if given), vertex_fields, stats.");
+  mod.def("improve", &improve_py, py::arg("points"), py::arg("tets"), py::kw_only(), py::arg("boundary") = "features",
+          py::arg("labels") = py::none(), py::arg("vertex_fields") = py::none(), py::arg("device") = py::none(),
+          py::arg("method") = "parallel", "Raises the worst element quality; returns a dict as collapse does.");
+  mod.def("check", &check_py, py::arg("points"), py::arg("tets"),
+          "Checks a mesh (tetcollapse check): the report as a dict (valid, findings, quality, ...).");
+  mod.def(
+      "read",
+      [](const std::string& path) {
+        Mesh m = read_mesh(path);
+        return to_dict(std::move(m));
+      },
+      py::arg("path"), "Reads a mesh file (msh, mesh, meshb, vtk, vtu, node): a dict of arrays.");
+  mod.def(
+      "write",
+      [](const std::string& path, py::array_t<double, py::array::c_style | py::array::forcecast> points,
+         py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets, py::object labels,
+         py::object vertex_fields) { write_mesh(path, from_numpy(points, tets, labels, vertex_fields)); },
+      py::arg("path"), py::arg("points"), py::arg("tets"), py::kw_only(), py::arg("labels") = py::none(),
+      py::arg("vertex_fields") = py::none(), "Writes a mesh file (the format from the extension).");
+  mod.def(
+      "devices",
+      [] {
+        py::list out;
+        for (const DeviceInfo& d : list_devices()) {
+          py::dict e;
+          e["index"] = d.index;
+          e["name"] = d.name;
+          e["platform"] = d.platform_name;
+          e["type"] = d.type;
+          e["compute_units"] = d.compute_units;
+          e["fp64"] = d.fp64;
+          out.append(e);
+        }
+        return out;
+      },
+      "The OpenCL devices (as `tetcollapse devices`).");
+  mod.attr("__version__") = TETCOLLAPSE_VERSION;
+}
