@@ -24,7 +24,10 @@ print(f"output: {s['vertices_out']} vertices, {s['tets_out']} tets in {s['second
 print(f"smallest dihedral angle {s['quality']['min_dihedral_deg']:.1f} degrees, "
       f"{s['quality']['below_10_deg']} tets below 10")
 t = out["vertex_fields"]["temperature"]
-print(f"temperature kept exact: {np.allclose(t, 20 + 5 * out['points'][:, 2])}")
+gap = np.abs(t - (20 + 5 * out["points"][:, 2]))
+# (a linear field stays exact inside the input; a vertex the coarsening moved a little outside,
+# on a curved face, takes the value of the input's nearest point)
+print(f"temperature: exact at {np.mean(gap < 1e-9):.1%} of the vertices, off by at most {gap.max():.2g} elsewhere")
 print(f"valid: {tetcollapse.check(out['points'], out['tets'])['valid']}")
 if len(sys.argv) > 1:
     tetcollapse.write(sys.argv[1], out["points"], out["tets"], vertex_fields=out["vertex_fields"])
