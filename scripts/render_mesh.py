@@ -14,7 +14,14 @@ docs/images/bracket.png was made with
         --title "input: {tets} tets" --title "tetcollapse --target-factor 2: {tets} tets"
 
 --cut AXIS<VALUE (or >) keeps only the tets whose centroid lies on that side of a plane, whole
-tets, so the interior elements show in the cut face.
+tets, so the interior elements show in the cut face. --quality colours each tet by its smallest
+dihedral angle instead of its label; docs/images/bracket_quality.png was made with
+    build/tetcollapse meshes/bracket.msh /tmp/a.vtu --target-factor 2 --no-improve
+    build/tetcollapse meshes/bracket.msh /tmp/b.vtu --target-factor 2
+    scripts/render_mesh.py /tmp/a.vtu /tmp/b.vtu -o docs/images/bracket_quality.png --quality \\
+        --cut "y<1.0" --size 1200x460 --zoom 1.12 --colours 128 \\
+        --title "collapse alone (--no-improve): {tets} tets" \\
+        --title "with the improvement phase (default): {tets} tets"
 """
 import argparse
 import os
@@ -91,7 +98,30 @@ def pick_labels(arrays, label_name):
     return None, None
 
 
-def surface_actor(points, tets, labels, cut, colour_of, edge_rgb, line_width):
+def min_dihedral_deg(points, tets):
+    """The smallest dihedral angle of each tet, in degrees (the angle between the two faces at an
+    edge is pi minus the angle between their outward normals)."""
+    import numpy as np
+    p = points[tets]  # (M, 4, 3)
+    normals = []
+    for i in range(4):
+        a, b, c = (p[:, j] for j in range(4) if j != i)
+        n = np.cross(b - a, c - a)
+        n *= np.where(np.einsum("ij,ij->i", n, p[:, i] - a) > 0, -1.0, 1.0)[:, None]  # outward
+        normals.append(n / np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None])
+    cos = np.max([-np.einsum("ij,ij->i", normals[k], normals[l]) for k in range(4) for l in range(k + 1, 4)], axis=0)
+    return np.degrees(np.arccos(np.clip(cos, -1, 1)))
+
+
+def quality_rgb(angle):
+    """Red below 10 degrees, through orange and yellow, to blue at 40 and above."""
+    import numpy as np
+    stops = np.array([0, 10, 20, 30, 40], float)
+    colours = np.array([[200, 30, 30], [235, 90, 50], [245, 200, 80], [170, 205, 170], [95, 150, 205]], float)
+    return np.stack([np.interp(angle, stops, colours[:, c]) for c in range(3)], axis=1).astype(np.uint8)
+
+
+def surface_actor(points, tets, labels, cut, colour_of, edge_rgb, line_width, quality=False):
     import numpy as np
     import vtk
     from vtk.util import numpy_support as ns
@@ -109,8 +139,11 @@ def surface_actor(points, tets, labels, cut, colour_of, edge_rgb, line_width):
     cells.SetData(ns.numpy_to_vtkIdTypeArray(np.arange(0, 4 * len(tets) + 1, 4, dtype=np.int64), deep=True),
                   ns.numpy_to_vtkIdTypeArray(np.ascontiguousarray(tets.reshape(-1)), deep=True))
     grid.SetCells(vtk.VTK_TETRA, cells)
-    rgb = np.array([colour_of(v) for v in (labels if labels is not None else np.zeros(len(tets), int))],
-                   dtype=np.uint8).reshape(-1, 3)
+    if quality:
+        rgb = quality_rgb(min_dihedral_deg(points, tets))
+    else:
+        rgb = np.array([colour_of(v) for v in (labels if labels is not None else np.zeros(len(tets), int))],
+                       dtype=np.uint8).reshape(-1, 3)
     colours = ns.numpy_to_vtk(rgb, deep=True, array_type=vtk.VTK_UNSIGNED_CHAR)
     colours.SetName("colour")
     grid.GetCellData().SetScalars(colours)
@@ -184,6 +217,9 @@ def main():
                     help="cell array to colour by ('none': one colour; default: the first of "
                          + ", ".join(LABEL_NAMES) + ", else any integer cell array)")
     ap.add_argument("--cut", help="keep the tets with centroid on one side of a plane, e.g. 'y<1.0'")
+    ap.add_argument("--quality", action="store_true",
+                    help="colour each tet by its smallest dihedral angle: red below 10 degrees, orange, "
+                         "yellow, blue at 40 and above (with --cut, the inside shows)")
     ap.add_argument("--colours", type=int, default=0,
                     help="write an indexed PNG of at most N colours (2-256), a much smaller file")
     ap.add_argument("--line-width", type=float, default=1.0, help="edge width in pixels (default 1)")
@@ -221,7 +257,7 @@ def main():
         renderer.SetBackground(1, 1, 1)
         renderer.SetActiveCamera(camera)
         renderer.AddActor(surface_actor(points, tets, labels, cut, colour_of, (0.12, 0.14, 0.18),
-                                        args.line_width))
+                                        args.line_width, args.quality))
         title = args.title[i] if args.title else os.path.basename(path) + ": {tets} tets"
         text = vtk.vtkTextActor()
         text.SetInput(title.format(tets=f"{len(tets):,}", vertices=f"{len(used):,}"))
