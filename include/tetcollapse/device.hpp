@@ -226,6 +226,14 @@ class DeviceBuffer {
   void allocate(size_t n) {
     size_t cap = n == 0 ? 1 : n;
     if (cap > SIZE_MAX / sizeof(T)) throw DeviceError("DeviceBuffer: size overflow");
+    // A buffer the device cannot hold: say so with the sizes (the driver's error names none).
+    const uint64_t bytes = uint64_t(cap) * sizeof(T), limit = ctx_->info().max_alloc_bytes;
+    if (limit > 0 && bytes > limit)
+      throw DeviceError("the mesh is too large for device '" + ctx_->info().name + "': one of its buffers needs " +
+                        std::to_string(bytes >> 20) + " MiB, and the device allocates at most " +
+                        std::to_string(limit >> 20) + " MiB at once (CL_DEVICE_MAX_MEM_ALLOC_SIZE; global memory " +
+                        std::to_string(ctx_->info().global_mem_bytes >> 20) +
+                        " MiB); use a larger device or --method sequential");
     detail::cl_call("clCreateBuffer", [&] { buf_ = cl::Buffer(ctx_->context(), CL_MEM_READ_WRITE, cap * sizeof(T)); });
     capacity_ = cap;
     n_ = n;

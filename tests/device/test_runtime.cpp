@@ -196,6 +196,19 @@ __kernel void layout(__global uint* out, uint n) {
   EXPECT_EQ(v[1], full);
 }
 
+TEST_F(RuntimeCtx, ABufferBeyondTheDevicesLargestAllocationIsRefusedWithTheSizes) {
+  const uint64_t limit = ctx_->info().max_alloc_bytes;
+  ASSERT_GT(limit, 0u);
+  try {
+    tc::DeviceBuffer<double> b(*ctx_, size_t(limit / sizeof(double)) + 1);
+    FAIL() << "a buffer over CL_DEVICE_MAX_MEM_ALLOC_SIZE was allocated";
+  } catch (const tc::DeviceError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("too large for device"), std::string::npos) << what;
+    EXPECT_NE(what.find(std::to_string(limit >> 20) + " MiB"), std::string::npos) << what;
+  }
+}
+
 TEST_F(RuntimeCtx, BuildFailureCarriesTheBuildLog) {
   std::string m = message_of([&] { ctx_->build("broken_test", "__kernel void k(__global int* a) { a[0] = undeclared_thing; }"); });
   EXPECT_NE(m.find("clBuildProgram(broken_test): CL_BUILD_PROGRAM_FAILURE"), std::string::npos) << m;
