@@ -8,7 +8,7 @@
 Runs, on mesh M with the uniform target edge length L, in this order:
   tetcollapse           tetcollapse M OUT --target-length L            (default options, quality guard 0.1)
   tetcollapse_noimprove ... --no-improve                             (the collapse alone)
-  tetcollapse_bounded   ... --method sequential --max-boundary-error 0.001
+  tetcollapse_bounded   ... --max-boundary-error 0.001
                                                                        (the boundary error bound, as MMG's -hausd
                                                                         below: 0.001 x the bounding-box diagonal)
   tetcollapse_q0        ... --min-quality 0 --no-improve               (the paper: no quality guard, no
@@ -254,7 +254,7 @@ def main():
             if peer == "tetcollapse_noimprove":
                 cmd += ["--no-improve"]
             if peer == "tetcollapse_bounded":
-                cmd += ["--method", "sequential", "--max-boundary-error", "0.001"]
+                cmd += ["--max-boundary-error", "0.001"]
 
             def alg(stdout, stderr):  # the collapse and the improvement, without I/O
                 with open(stats) as f:

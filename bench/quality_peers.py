@@ -8,7 +8,7 @@ For each mesh of ../shared/meshes (top level), L = F x the input's median edge l
 bench/peers.py runs, in one process each and one after the other on the same machine:
   tetcollapse            tetcollapse M OUT --target-length L         (defaults: collapse + improvement)
   tetcollapse_noimprove  ... --no-improve                            (the collapse alone)
-  tetcollapse_bounded    ... --method sequential --max-boundary-error 0.001  (the bound, as -hausd)
+  tetcollapse_bounded    ... --max-boundary-error 0.001               (the bound, as -hausd)
   mmg3d_hmin             mmg3d_O3 M.mesh -hmin L                     (MMG3D, coarsening only)
   mmg3d_hmin_hausd       ... -hausd 0.001 x the bounding-box diagonal (MMG's default -hausd 0.01 is
                                                                       in mesh units)

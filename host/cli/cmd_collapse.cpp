@@ -221,11 +221,11 @@ void register_collapse(CLI::App& app, int& exit_code) {
   app.add_option("--eps-r", c->opt.eps_r, "Ridge-edge threshold on 1 - dot of normals (paper: 0.1)")
       ->capture_default_str();
   app.add_option("--max-boundary-error", c->opt.max_boundary_error,
-                 "Features mode, with --method sequential (the parallel method does not carry it yet):\n"
-                 "keep the boundary and the material interfaces within E x the input's bounding-box\n"
-                 "diagonal of where they were, both ways (a conservative bound on the two-sided Hausdorff\n"
-                 "distance, carried per vertex); smoothly curved faces then coarsen (--eps-f is not used).\n"
-                 "0 (default): no bound")
+                 "Features mode: keep the boundary and the material interfaces within E x the input's\n"
+                 "bounding-box diagonal of where they were, both ways (a conservative bound on the two-sided\n"
+                 "Hausdorff distance, carried per vertex); smoothly curved faces then coarsen (--eps-f is not\n"
+                 "used). The parallel method coarsens the interior on the device with the boundary frozen,\n"
+                 "then the boundary on the host within the bound. 0 (default): no bound")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_option("--max-boundary-error-abs", c->opt.max_boundary_error_abs,
@@ -346,9 +346,6 @@ void register_collapse(CLI::App& app, int& exit_code) {
       opt.tuning.priority_levels = c->priority_levels;
     }
     if (opt.bounds_boundary_error()) {
-      if (opt.method != CollapseOptions::Sequential)
-        throw CLI::ValidationError("--max-boundary-error",
-                                   "needs --method sequential (the parallel method does not carry the bound yet)");
       if (opt.boundary != CollapseOptions::Features)
         throw CLI::ValidationError("--max-boundary-error",
                                    "applies to --boundary features (strict keeps the boundary exactly, free does not bound it)");
@@ -420,22 +417,22 @@ void register_collapse(CLI::App& app, int& exit_code) {
     if (report_quality) quality_in = quality_summary(mesh);
     CollapseReport r;
     std::unique_ptr<Context> ctx;  // the improvement's too
+    // With a boundary error bound and the improvement phase, the collapse keeps a share of it
+    // for the improvement's boundary moves (which remove the slivers at a curved surface).
+    CollapseOptions co = opt;
+    const double bound = boundary_error_bound(mesh, opt);
+    if (bound > 0 && !c->no_improve) {
+      co.max_boundary_error_abs = kCollapseShareOfBound * bound;
+      co.max_boundary_error = 0;
+    }
     if (opt.method == CollapseOptions::Sequential) {
       if (!c->quiet) std::cerr << "method: sequential (CPU)\n";
-      // With a boundary error bound and the improvement phase, the collapse keeps a share of
-      // it for the improvement's boundary moves (which remove the slivers at a curved surface).
-      CollapseOptions co = opt;
-      const double bound = boundary_error_bound(mesh, opt);
-      if (bound > 0 && !c->no_improve) {
-        co.max_boundary_error_abs = kCollapseShareOfBound * bound;
-        co.max_boundary_error = 0;
-      }
       r = collapse_sequential(mesh, co);
-      if (bound > 0) r.boundary_error_bound = bound;
     } else {
       ctx = open_device(c->device, c->quiet);
-      r = collapse(mesh, opt, *ctx);
+      r = collapse(mesh, co, *ctx);
     }
+    if (bound > 0) r.boundary_error_bound = bound;
     if (!c->sizing_field.empty() || !c->preserve_field.empty())
       std::swap(mesh.vertex_fields[0], mesh.vertex_fields[sizing_index]);
     // A user's predicate or placement states rules the improvement cannot know: no phase then.

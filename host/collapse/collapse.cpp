@@ -1,6 +1,7 @@
 // The parallel method: the paper's Algorithm 1 over the stages of host/collapse/, one file each
 // (the header tetcollapse/collapse.hpp gives the algorithm in pseudocode).
 #include <algorithm>
+#include <stdexcept>
 #include <memory>
 
 #include "collapse/compact.hpp"
@@ -31,8 +32,55 @@ CollapseReport report_for(const Mesh& mesh, const Context& ctx) {
 
 }  // namespace
 
+namespace {
+
+// The boundary error bound on the parallel method: the device coarsens with S frozen (strict:
+// no change of S, so nothing to bound), then the sequential method, which carries the bound,
+// coarsens S and what its changes free. Why two phases: the bound's fan test and the per-vertex
+// bound are host code so far; the interior, most of the work, still runs on the device.
+CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
+  if (!options.vertex_mask.empty() || options.has_user_functions())
+    throw std::invalid_argument(
+        "the boundary error bound on the parallel method takes no vertex mask (--region, --labels) and no user "
+        "cost, placement or predicate yet: use the sequential method");
+  const double bound = boundary_error_bound(mesh, options);
+  CollapseOptions inner = options;
+  inner.boundary = CollapseOptions::Strict;
+  inner.max_boundary_error = inner.max_boundary_error_abs = 0;
+  CollapseReport report = collapse(mesh, inner, ctx);
+  CollapseOptions outer = options;
+  outer.method = CollapseOptions::Sequential;
+  outer.target_length = report.target_length;  // the input's, not the coarse mesh's median
+  outer.max_boundary_error = 0;
+  outer.max_boundary_error_abs = bound;
+  outer.max_iterations = std::max(0, options.max_iterations - int(report.iterations.size()));
+  const int offset = int(report.iterations.size());
+  if (options.progress)
+    outer.progress = [&options, offset](const IterationStats& it) {
+      IterationStats c = it;
+      c.iteration += offset;
+      c.on_host = true;
+      options.progress(c);
+    };
+  const CollapseReport tail = collapse_sequential(mesh, outer);
+  for (IterationStats it : tail.iterations) {
+    it.iteration += int(report.iterations.size());
+    it.on_host = true;
+    report.iterations.push_back(it);
+  }
+  report.vertices_out = tail.vertices_out;
+  report.tets_out = tail.tets_out;
+  report.seconds_total += tail.seconds_total;
+  report.boundary_error_bound = bound;
+  report.boundary_error = tail.boundary_error;
+  return report;
+}
+
+}  // namespace
+
 CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
   if (options.method == CollapseOptions::Sequential) return collapse_sequential(mesh, options);
+  if (options.bounds_boundary_error()) return collapse_bounded(mesh, options, ctx);
   check_options(options, ctx);
   CollapseReport report = report_for(mesh, ctx);
   StageParams p = params_from(options);

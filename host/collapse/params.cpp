@@ -49,10 +49,6 @@ void check_options(const CollapseOptions& o, const Context& ctx) {
     throw std::invalid_argument("a user cost (cost_cl_source) needs an explicit target_length > 0");
   if (!(o.target_length > 0) && !(o.target_factor > 0))
     throw std::invalid_argument("target_factor must be > 0 when target_length is not given");
-  if (o.bounds_boundary_error())
-    throw std::invalid_argument(
-        "the parallel method does not carry the boundary error bound yet (max_boundary_error, "
-        "--max-boundary-error): use the sequential method");
   if (o.conflicts == CollapseOptions::AtomicMin && !ctx.info().int64_atomics_extended)
     throw DeviceError("device '" + ctx.info().name +
                       "' lacks cl_khr_int64_extended_atomics (64-bit atomic min), which --conflicts atomic-min needs; "

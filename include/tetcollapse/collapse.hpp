@@ -196,14 +196,16 @@ struct CollapseOptions {
 
   double eps_f = 0.01;   // face threshold on 1 - dot(n_i, n_j)  (see topology.hpp)
   double eps_r = 0.1;    // ridge threshold on 1 - dot(n_1, n_2)
-  // Boundary error bound (features mode, the sequential method so far): a collapse that changes
+  // Boundary error bound (features mode): a collapse that changes
   // S (the boundary and the material interfaces) is made only while a bound on the two-sided
   // Hausdorff distance between the input's S and the result's stays within max_boundary_error
   // x the bounding-box diagonal of the input (or max_boundary_error_abs in mesh units, when
   // > 0). The bound is carried per vertex and grows by each change of S near it
   // (cl/collapse_surface_error.h); it is conservative, so the measured distance is smaller. With
   // a bound, eps_f is not used: a vertex of a smoothly curved face is a face vertex (ridges and
-  // corners as eps_r says), so curved faces coarsen within the bound. 0 (both): no bound.
+  // corners as eps_r says), so curved faces coarsen within the bound. The parallel method
+  // coarsens with S frozen on the device, then S with the sequential method's checks; not with a
+  // vertex mask or user functions (std::invalid_argument). 0 (both): no bound.
   double max_boundary_error = 0;
   double max_boundary_error_abs = 0;
   bool bounds_boundary_error() const { return max_boundary_error > 0 || max_boundary_error_abs > 0; }

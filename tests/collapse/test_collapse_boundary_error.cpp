@@ -162,12 +162,31 @@ TEST(BoundaryErrorRun, TheInterfaceOfTwoMaterialsKeepsItsShapeAndLabels) {
   EXPECT_LT(m.num_tets(), in.num_tets() / 2);
 }
 
+// The parallel method: the device with S frozen, then the host within the bound.
+TEST(BoundaryErrorRun, TheParallelMethodKeepsTheBoundToo) {
+  const Mesh in = ball(10);
+  CollapseOptions o;
+  o.target_factor = 2;
+  o.max_boundary_error = 0.002;
+  Context ctx;
+  Mesh m = in;
+  const CollapseReport r = collapse(m, o, ctx);
+  EXPECT_LE(r.boundary_error, r.boundary_error_bound);
+  EXPECT_GT(r.boundary_error, 0);
+  EXPECT_LE(hausdorff_rel(m, in), 0.002);
+  bool host = false, device = false;
+  for (const auto& it : r.iterations) (it.on_host ? host : device) = true;
+  EXPECT_TRUE(host && device) << "both phases ran";
+  EXPECT_LT(m.num_tets(), in.num_tets() / 3);
+  Mesh masked = in;
+  o.vertex_mask.assign(size_t(in.num_vertices()), 1);
+  EXPECT_THROW(collapse(masked, o, ctx), std::invalid_argument) << "no vertex mask with the bound on the device yet";
+}
+
 TEST(BoundaryErrorRun, RefusedWhereItCannotHold) {
   Mesh m = ball(4);
   CollapseOptions o;
   o.max_boundary_error = 0.001;
-  Context ctx;
-  EXPECT_THROW(collapse(m, o, ctx), std::invalid_argument) << "the parallel method does not carry it yet";
   o.method = CollapseOptions::Sequential;
   o.boundary = CollapseOptions::Free;
   EXPECT_THROW(collapse_sequential(m, o), std::invalid_argument) << "free mode does not bound the boundary";
