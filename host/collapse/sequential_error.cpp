@@ -45,35 +45,21 @@ double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vec
       }
     }
   }
-  // the new S faces (tcc_sg_new_tri, as guard_ok), on the owner's side
-  for (int side = 0; side < 2; ++side) {
-    const int32_t z = side == 0 ? x : y, w = side == 0 ? y : x;
-    const int32_t* rz = ring(z);
-    for (uint32_t i = 0; i < rlen_[z]; ++i) {
-      const int32_t t = rz[i];
-      const int32_t* q = tet(t);
-      if (has(q, w)) continue;  // removed by the collapse, or seen from ring(x)
-      for (int f = 0; f < 4; ++f) {
-        if (q[f] == z) continue;
-        const int32_t o = across(t, f);
-        int32_t other;  // the tet across the face after the collapse (-1: the boundary)
-        if (o >= 0 && has(tet(o), x) && has(tet(o), y)) {  // glued through the removed tet o
-          other = across(o, local(tet(o), z));
-        } else {
-          if (side == 1 && !moves_y) continue;  // unchanged
-          other = o;
-        }
-        const bool owned = other < 0 || (labels_ && label(t) < label(other));
-        if (!owned) continue;
-        if (nn == TCC_MAX_FAN) return INFINITY;
-        for (int k = 0; k < 3; ++k) {
-          const int32_t v = q[geo::TC_TET_FACES[f][k]];
-          news[3 * nn + k] = v == x || v == y ? p : point(v);
-        }
-        ++nn;
-      }
+  // the new S faces (as guard_ok finds them), on the owner's side
+  bool fits = true;
+  each_new_sface(x, y, moves_y, [&](int32_t t, const int32_t* q, int f, int32_t other) {
+    if (!(other < 0 || (labels_ && label(t) < label(other)))) return;
+    if (nn == TCC_MAX_FAN) {
+      fits = false;
+      return;
     }
-  }
+    for (int k = 0; k < 3; ++k) {
+      const int32_t v = q[geo::TC_TET_FACES[f][k]];
+      news[3 * nn + k] = v == x || v == y ? p : point(v);
+    }
+    ++nn;
+  });
+  if (!fits) return INFINITY;
   return geo::tcc_fan_distance(olds, no, news, nn);
 }
 

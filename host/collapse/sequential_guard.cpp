@@ -211,41 +211,17 @@ bool SeqMesh::guard_ok(int32_t a, int32_t b, uint8_t dir, bool scan_all) {
   if (!vflags_[x] && !(moves_y && vflags_[y])) return true;  // S is not touched
   // the new S triangles (tcc_sg_new_tri)
   newtris_.clear();
-  for (int side = 0; side < 2; ++side) {
-    const int32_t z = side == 0 ? x : y, w = side == 0 ? y : x;
-    const int32_t* rz = ring(z);
-    for (uint32_t i = 0; i < rlen_[z]; ++i) {
-      const int32_t t = rz[i];
-      const int32_t* q = tet(t);
-      if (has(q, w)) continue;  // removed by the collapse, or seen from ring(x)
-      for (int f = 0; f < 4; ++f) {
-        if (q[f] == z) continue;  // the face opposite z does not contain it
-        // a face taken below is on S now, or glued to one through a removed tet: either way its
-        // two vertices other than z are on S now (cheap, and it spares most ring scans)
-        bool others_on_s = true;
-        for (int j = 0; j < 4 && others_on_s; ++j) others_on_s = j == f || q[j] == z || vflags_[q[j]] != 0;
-        if (!others_on_s) continue;
-        const int32_t o = across(t, f);
-        bool take;
-        if (o >= 0 && has(tet(o), x) && has(tet(o), y)) {  // glued through the removed tet o
-          const int32_t ac = across(o, local(tet(o), z));
-          take = ac < 0 || (labels_ && label(t) != label(ac));
-        } else {
-          if (side == 1 && !moves_y) continue;  // unchanged
-          take = o < 0 || (labels_ && label(t) != label(o));
-        }
-        if (!take) continue;
-        NewTri nt;
-        for (int k = 0; k < 3; ++k) {
-          int32_t v = q[geo::TC_TET_FACES[f][k]];
-          if (v == x) v = y;
-          nt.id[k] = v;
-          nt.pos[k] = v == y ? p : point(v);
-        }
-        newtris_.push_back(nt);
-      }
+  each_new_sface(x, y, moves_y, [&](int32_t t, const int32_t* q, int f, int32_t other) {
+    if (!(other < 0 || (labels_ && label(t) != label(other)))) return;
+    NewTri nt;
+    for (int k = 0; k < 3; ++k) {
+      int32_t v = q[geo::TC_TET_FACES[f][k]];
+      if (v == x) v = y;
+      nt.id[k] = v;
+      nt.pos[k] = v == y ? p : point(v);
     }
-  }
+    newtris_.push_back(nt);
+  });
   // among themselves (S folded over itself around y)
   for (size_t i = 0; i < newtris_.size(); ++i)
     for (size_t j = i + 1; j < newtris_.size(); ++j)

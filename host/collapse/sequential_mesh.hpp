@@ -170,6 +170,36 @@ class SeqMesh {
     }
   }
   int32_t label(int32_t t) const { return labels_ ? (*labels_)[t] : 0; }
+  // fn(t, q, f, other) for every face f of a tet t = q that the collapse of x onto y keeps
+  // (through x, and through y when it moves) and that is on S after it, or may be:
+  // tcc_sg_new_tri's choice before its label test. other: the tet across the face after the
+  // collapse (-1: the boundary); the face is on S when other < 0 or the labels differ.
+  template <class Fn>
+  void each_new_sface(int32_t x, int32_t y, bool moves_y, Fn&& fn) const {
+    for (int side = 0; side < 2; ++side) {
+      const int32_t z = side == 0 ? x : y, w = side == 0 ? y : x;
+      const int32_t* rz = ring(z);
+      for (uint32_t i = 0; i < rlen_[z]; ++i) {
+        const int32_t t = rz[i];
+        const int32_t* q = tet(t);
+        if (has(q, w)) continue;  // removed by the collapse, or seen from ring(x)
+        for (int f = 0; f < 4; ++f) {
+          if (q[f] == z) continue;  // the face opposite z does not contain it
+          // a face on S after is on S now, or glued to one through a removed tet: either way its
+          // two vertices other than z are on S now (cheap, and it spares most ring scans)
+          bool others_on_s = true;
+          for (int j = 0; j < 4 && others_on_s; ++j) others_on_s = j == f || q[j] == z || vflags_[q[j]] != 0;
+          if (!others_on_s) continue;
+          const int32_t o = across(t, f);
+          if (o >= 0 && has(tet(o), x) && has(tet(o), y)) {  // glued through the removed tet o
+            fn(t, q, f, across(o, local(tet(o), z)));
+          } else if (side == 0 || moves_y) {  // (through y and y stays: unchanged)
+            fn(t, q, f, o);
+          }
+        }
+      }
+    }
+  }
 
   const int32_t* ring(int32_t v) const { return pool_.data() + roff_[v]; }
   uint32_t ring_size(int32_t v) const { return rlen_[v]; }
