@@ -62,9 +62,7 @@ def run(cmd, env_extra, stats):
 
 
 def main():
-    if len(sys.argv) == 3 and sys.argv[1] == "--table":
-        with open(sys.argv[2]) as f:
-            print(table(json.load(f)))
+    if peers.table_asked(table):
         return
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--tetcollapse", default=None)

@@ -101,6 +101,16 @@ def default_tetcollapse():
     return shutil.which("tetcollapse")
 
 
+def table_asked(table):
+    """`SCRIPT --table F.json`: prints the markdown table(s) `table` makes of a results file, and
+    says so (the script then stops)."""
+    if len(sys.argv) == 3 and sys.argv[1] == "--table":
+        with open(sys.argv[2]) as f:
+            print(table(json.load(f)))
+        return True
+    return False
+
+
 def provenance(script, tc):
     """What a results file records of its run: the command, the commit, the device (bench/make_tables.py
     prints them over the table)."""

@@ -86,9 +86,7 @@ def with_field(vtk, src, dst, name, fn):
 
 
 def main():
-    if len(sys.argv) == 3 and sys.argv[1] == "--table":
-        with open(sys.argv[2]) as f:
-            print(table(json.load(f)))
+    if peers.table_asked(table):
         return
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--tetcollapse", default=None)
