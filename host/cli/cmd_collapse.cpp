@@ -259,7 +259,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
                "input, after the improvement phase too)");
   app.add_option("--cost-cl", c->cost_cl,
                  "OpenCL C file defining double tc_user_cost(double3 p0, double3 p1, double f0, double f1);\n"
-                 "edges with a cost below --target-length are collapsed (see README)");
+                 "edges with a cost below --target-length are collapsed (see docs/cli.md)");
   app.add_option("--placement-cl", c->placement_cl,
                  "OpenCL C file defining double3 tc_user_placement(double3 p0, double3 p1, double f0, double f1);\n"
                  "where the survivor goes instead of the midpoint, on edges with both ends off the boundary\n"
