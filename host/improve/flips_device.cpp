@@ -6,7 +6,7 @@
 #include <algorithm>
 
 #include "collapse/launch.hpp"
-#include "improve/improve_mesh.hpp"
+#include "improve/device_mesh.hpp"
 #include "improve_flip.h"
 #include "stopwatch.hpp"
 
@@ -53,47 +53,37 @@ void flip_pass(ImpMesh& m, Context& ctx, const std::vector<int32_t>& bad, Improv
     const double t0 = Stopwatch::now();
     const int32_t nt = m.num_tet_slots();
     std::vector<int32_t> labels(static_cast<size_t>(nt));
-    std::vector<double> quality(static_cast<size_t>(nt)), max_cos(static_cast<size_t>(nt));
+    std::vector<double> max_cos(static_cast<size_t>(nt));
     for (int32_t t = 0; t < nt; ++t) {
       labels[size_t(t)] = m.label(t);
-      quality[size_t(t)] = m.quality(t);
       max_cos[size_t(t)] = m.max_cos(t);
     }
-    std::vector<uint32_t> offsets(size_t(nv) + 1, 0);
-    std::vector<int32_t> vt;
-    for (int32_t v = 0; v < nv; ++v) {
-      vt.insert(vt.end(), m.tets_of(v).begin(), m.tets_of(v).end());
-      offsets[size_t(v) + 1] = uint32_t(vt.size());
-    }
+    const ImpDeviceMesh dm(ctx, m);
     // The tags change with the boundary's flips: read each round.
     const std::vector<int32_t> face_records = m.tagged_face_records();
-    DeviceBuffer<int32_t> d_tets(ctx, 4 * size_t(nt)), d_labels(ctx, labels), d_vt(ctx, vt);
-    d_tets.upload(m.tet_data(), 4 * size_t(nt));
-    DeviceBuffer<int32_t> d_faces(ctx, face_records), d_flips(ctx, pending);
-    DeviceBuffer<double> d_quality(ctx, quality), d_max_cos(ctx, max_cos), d_pts(ctx, 3 * size_t(nv));
-    d_pts.upload(m.point_data(), 3 * size_t(nv));
-    DeviceBuffer<uint32_t> d_off(ctx, offsets);
+    DeviceBuffer<int32_t> d_labels(ctx, labels), d_faces(ctx, face_records), d_flips(ctx, pending);
+    DeviceBuffer<double> d_max_cos(ctx, max_cos);
     const size_t nf = pending.size();
     DeviceBuffer<int32_t> kind(ctx, nf), old(ctx, TCI_MAX_RING * nf), n_old(ctx, nf), added(ctx, 4 * kMaxNew * nf),
         n_new(ctx, nf), state(ctx, nf);
-    run(ctx, kFile, "flip_find", nf, arg("nf", nf), arg("flips2tet", d_flips), arg("tets", d_tets),
-        arg("tets2label", d_labels), arg("tets2quality", d_quality), arg("tets2max_cos", d_max_cos),
-        arg("verts2tets_offsets", d_off), arg("verts2tets", d_vt), arg("verts_are_selected", d_selected),
+    run(ctx, kFile, "flip_find", nf, arg("nf", nf), arg("flips2tet", d_flips), arg("tets", dm.tets),
+        arg("tets2label", d_labels), arg("tets2quality", dm.quality), arg("tets2max_cos", d_max_cos),
+        arg("verts2tets_offsets", dm.verts2tets_offsets), arg("verts2tets", dm.verts2tets), arg("verts_are_selected", d_selected),
         arg("tagged_edges", d_edges), arg("n_tagged_edges", edge_keys.size()), arg("tagged_faces", d_faces),
-        arg("n_tagged_faces", face_records.size() / 4), arg("pts", d_pts), arg("cos_threshold", m.cos_threshold()),
+        arg("n_tagged_faces", face_records.size() / 4), arg("pts", dm.pts), arg("cos_threshold", m.cos_threshold()),
         arg("flips2kind", kind), arg("flips2old", old), arg("flips2n_old", n_old), arg("flips2new", added),
         arg("flips2n_new", n_new), arg("flips2state", state));
     d_taken.fill(0);
     for (;;) {
       d_claim.fill(~uint32_t(0));
       counters.fill(0);
-      run(ctx, kFile, "flip_claim", nf, arg("nf", nf), arg("tets", d_tets), arg("flips2old", old),
+      run(ctx, kFile, "flip_claim", nf, arg("nf", nf), arg("tets", dm.tets), arg("flips2old", old),
           arg("flips2n_old", n_old), arg("verts_are_taken", d_taken), arg("flips2state", state),
           arg("verts2claim", d_claim), arg("counters", counters));
       uint32_t competing = 0;
       counters.download(&competing, 1);
       if (competing == 0) break;
-      run(ctx, kFile, "flip_won", nf, arg("nf", nf), arg("tets", d_tets), arg("flips2old", old),
+      run(ctx, kFile, "flip_won", nf, arg("nf", nf), arg("tets", dm.tets), arg("flips2old", old),
           arg("flips2n_old", n_old), arg("verts2claim", d_claim), arg("flips2state", state),
           arg("verts_are_taken", d_taken));
     }

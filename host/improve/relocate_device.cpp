@@ -5,7 +5,7 @@
 
 #include "collapse/launch.hpp"
 #include "stopwatch.hpp"
-#include "improve/improve_mesh.hpp"
+#include "improve/device_mesh.hpp"
 
 namespace tc::improve_detail {
 
@@ -22,7 +22,7 @@ constexpr const char* kFile = "improve_relocate.cl";
 
 void smooth_pass(ImpMesh& m, Context& ctx, const std::vector<int32_t>& bad, ImprovePassStats& stats) {
   const double t0 = Stopwatch::now();
-  const int32_t nv = m.num_vertices(), nt = m.num_tet_slots();
+  const int32_t nv = m.num_vertices();
   std::vector<int32_t> cands, on_host;
   for (int32_t v : smoothing_candidates(m, bad)) {
     if (m.settled(m.smooth_failed_at, v)) continue;
@@ -30,16 +30,10 @@ void smooth_pass(ImpMesh& m, Context& ctx, const std::vector<int32_t>& bad, Impr
     else cands.push_back(v);
   }
   if (!cands.empty()) {
-    // The mesh as the kernels read it: each vertex's tets in the host's order (the ascent sums
-    // gradients in that order); dead tets are in no vertex's list.
-    std::vector<double> quality(static_cast<size_t>(nt)), direction(3 * static_cast<size_t>(nv));
-    for (int32_t t = 0; t < nt; ++t) quality[size_t(t)] = m.quality(t);
-    std::vector<uint32_t> offsets(size_t(nv) + 1, 0);
-    std::vector<int32_t> vt;
+    ImpDeviceMesh dm(ctx, m);  // (the kernels move points and re-measure tets in it)
+    std::vector<double> direction(3 * static_cast<size_t>(nv));
     std::vector<uint8_t> motion(static_cast<size_t>(nv)), flags(static_cast<size_t>(nv), 0);
     for (int32_t v = 0; v < nv; ++v) {
-      vt.insert(vt.end(), m.tets_of(v).begin(), m.tets_of(v).end());
-      offsets[size_t(v) + 1] = uint32_t(vt.size());
       motion[size_t(v)] = m.motion(v);
       const tc_d3 d = m.motion_direction(v);
       direction[3 * size_t(v)] = d.x;
@@ -47,12 +41,10 @@ void smooth_pass(ImpMesh& m, Context& ctx, const std::vector<int32_t>& bad, Impr
       direction[3 * size_t(v) + 2] = d.z;
     }
     for (int32_t v : cands) flags[size_t(v)] = 1;
-    DeviceBuffer<double> d_pts(ctx, 3 * size_t(nv)), d_quality(ctx, quality), d_direction(ctx, direction);
-    d_pts.upload(m.point_data(), 3 * size_t(nv));
-    DeviceBuffer<int32_t> d_tets(ctx, 4 * size_t(nt)), d_vt(ctx, vt), d_cands(ctx, cands), d_round(ctx, size_t(nv));
-    d_tets.upload(m.tet_data(), 4 * size_t(nt));
+    DeviceBuffer<double> d_direction(ctx, direction);
+    DeviceBuffer<int32_t> d_cands(ctx, cands), d_round(ctx, size_t(nv));
     d_round.fill(0);
-    DeviceBuffer<uint32_t> d_off(ctx, offsets), counters(ctx, 1);
+    DeviceBuffer<uint32_t> counters(ctx, 1);
     DeviceBuffer<uint8_t> d_flags(ctx, flags), d_motion(ctx, motion);
     DeviceBuffer<uint64_t> verts2key(ctx, size_t(nv));
     verts2key.fill(~uint64_t(0));
@@ -61,14 +53,14 @@ void smooth_pass(ImpMesh& m, Context& ctx, const std::vector<int32_t>& bad, Impr
     const double t1 = Stopwatch::now();
     uint32_t round = 1;
     for (;; ++round) {
-      run(ctx, kFile, "relocate_keys", nc, arg("nc", nc), arg("cands", d_cands), arg("verts2tets_offsets", d_off),
-          arg("verts2tets", d_vt), arg("tets2quality", d_quality), arg("verts_are_cands", d_flags),
+      run(ctx, kFile, "relocate_keys", nc, arg("nc", nc), arg("cands", d_cands), arg("verts2tets_offsets", dm.verts2tets_offsets),
+          arg("verts2tets", dm.verts2tets), arg("tets2quality", dm.quality), arg("verts_are_cands", d_flags),
           arg("verts2key", verts2key));
       counters.fill(0);
       run(ctx, kFile, "relocate_chosen", nc, arg("nc", nc), arg("round", round), arg("cands", d_cands),
-          arg("verts2tets_offsets", d_off), arg("verts2tets", d_vt), arg("tets", d_tets), arg("verts2key", verts2key),
+          arg("verts2tets_offsets", dm.verts2tets_offsets), arg("verts2tets", dm.verts2tets), arg("tets", dm.tets), arg("verts2key", verts2key),
           arg("verts2motion", d_motion), arg("verts2direction", d_direction), arg("cos_threshold", m.cos_threshold()),
-          arg("pts", d_pts), arg("tets2quality", d_quality), arg("verts_are_cands", d_flags),
+          arg("pts", dm.pts), arg("tets2quality", dm.quality), arg("verts_are_cands", d_flags),
           arg("verts2round", d_round), arg("counters", counters));
       uint32_t left = 0;
       counters.download(&left, 1);
@@ -76,7 +68,7 @@ void smooth_pass(ImpMesh& m, Context& ctx, const std::vector<int32_t>& bad, Impr
     }
     profile_line(ctx, "relocation: rounds", round, t1);
     const double t2 = Stopwatch::now();
-    const std::vector<double> pts = d_pts.download();
+    const std::vector<double> pts = dm.pts.download();
     const std::vector<int32_t> rounds = d_round.download();
     // Round by round, as the device did them: a move interpolates the vertex fields in the star
     // as it was then, and a vertex that found nothing is settled only until a later move
