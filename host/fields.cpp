@@ -121,7 +121,8 @@ TetLocator::TetLocator(const Mesh& mesh) : mesh_(mesh) {
   for (int64_t t = 0; t < nt; ++t) each_cell(t, [&](int64_t c) { tets_[size_t(counts[size_t(c)]++)] = t; });
 }
 
-int64_t TetLocator::locate(const double p[3], double bary[4]) const {
+int64_t TetLocator::locate(const double p[3], double bary[4], bool* outside) const {
+  if (outside) *outside = true;
   if (offsets_.empty()) return -1;
   const tc_d3 q{p[0], p[1], p[2]};
   int64_t at[3];
@@ -146,6 +147,7 @@ int64_t TetLocator::locate(const double p[3], double bary[4]) const {
             barycentric(mesh_, t, q, b);
             if (std::min({b[0], b[1], b[2], b[3]}) >= -1e-12) {
               std::copy(b, b + 4, bary);
+              if (outside) *outside = false;
               return t;
             }
             const double d = distance_to_tet(mesh_, t, q, b);
@@ -176,10 +178,9 @@ int64_t resample_vertex_fields(const Mesh& original, Mesh& mesh) {
   int64_t outside = 0;
   for (int64_t v = 0; v < mesh.num_vertices(); ++v) {
     double bary[4];
-    const int64_t t = locator.locate(&mesh.points[3 * size_t(v)], bary);
-    double own[4];  // p's own coordinates in that tet: one negative when p is outside
-    barycentric(original, t, geo::tc_point(mesh.points.data(), int32_t(v)), own);
-    outside += std::min({own[0], own[1], own[2], own[3]}) < -1e-12;
+    bool out = false;
+    const int64_t t = locator.locate(&mesh.points[3 * size_t(v)], bary, &out);
+    outside += out;
     for (const Pair& p : pairs) {
       const size_t nc = size_t(p.to->components);
       for (size_t c = 0; c < nc; ++c) {

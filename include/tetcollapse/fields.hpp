@@ -25,8 +25,9 @@ class TetLocator {
 
   // The tet holding p (every barycentric coordinate >= -1e-12), else the tet nearest to p;
   // bary receives p's barycentric coordinates in it (for a point outside the mesh, those of
-  // the nearest point of the tet: all >= 0). -1 for a mesh without tets.
-  int64_t locate(const double p[3], double bary[4]) const;
+  // the nearest point of the tet: all >= 0). -1 for a mesh without tets. *outside (when given):
+  // whether p lies in no tet.
+  int64_t locate(const double p[3], double bary[4], bool* outside = nullptr) const;
 
  private:
   const Mesh& mesh_;
