@@ -30,14 +30,21 @@ py::array_t<T> to_numpy(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
   return py::array_t<T>(shape, owner->data(), free_when_done);
 }
 
-Mesh from_numpy(py::array_t<double, py::array::c_style | py::array::forcecast> points,
-                py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets, py::object labels,
-                py::object vertex_fields) {
+// The points and tets alone, unchecked but for their shapes (check() reads any mesh).
+Mesh raw_mesh(const py::array_t<double, py::array::c_style | py::array::forcecast>& points,
+              const py::array_t<int32_t, py::array::c_style | py::array::forcecast>& tets) {
   if (points.ndim() != 2 || points.shape(1) != 3) throw InputError("<points>", "points must be an (N, 3) array");
   if (tets.ndim() != 2 || tets.shape(1) != 4) throw InputError("<tets>", "tets must be an (M, 4) array");
   Mesh m;
   m.points.assign(points.data(), points.data() + points.size());
   m.tets.assign(tets.data(), tets.data() + tets.size());
+  return m;
+}
+
+Mesh from_numpy(py::array_t<double, py::array::c_style | py::array::forcecast> points,
+                py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets, py::object labels,
+                py::object vertex_fields) {
+  Mesh m = raw_mesh(points, tets);
   if (!labels.is_none()) {
     auto l = py::array_t<int32_t, py::array::c_style | py::array::forcecast>::ensure(labels);
     if (!l || l.ndim() != 1 || l.shape(0) != tets.shape(0))
@@ -180,12 +187,7 @@ py::dict improve_py(py::array_t<double, py::array::c_style | py::array::forcecas
 
 py::dict check_py(py::array_t<double, py::array::c_style | py::array::forcecast> points,
                   py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets) {
-  Mesh m;
-  m.points.assign(points.data(), points.data() + points.size());
-  m.tets.assign(tets.data(), tets.data() + tets.size());
-  if (points.ndim() != 2 || points.shape(1) != 3 || tets.ndim() != 2 || tets.shape(1) != 4)
-    throw InputError("<arrays>", "points must be (N, 3) and tets (M, 4)");
-  const CheckReport r = check_mesh(m, {}, nullptr);
+  const CheckReport r = check_mesh(raw_mesh(points, tets), {}, nullptr);
   py::module_ json = py::module_::import("json");
   return json.attr("loads")(check_report_json(r)).cast<py::dict>();
 }
