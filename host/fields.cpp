@@ -7,6 +7,7 @@
 #include <limits>
 #include <random>
 
+#include "fields_detail.hpp"
 #include "geometry.h"
 
 namespace tc {
@@ -17,15 +18,34 @@ namespace {
 
 tc_d3 corner(const Mesh& m, int64_t t, int k) { return geo::tc_point(m.points.data(), m.tets[size_t(4 * t + k)]); }
 
-// Barycentric coordinates of p in tet t (signed volumes; a flat tet gives non-finite ones).
-void barycentric(const Mesh& m, int64_t t, tc_d3 p, double b[4]) {
-  const tc_d3 c[4] = {corner(m, t, 0), corner(m, t, 1), corner(m, t, 2), corner(m, t, 3)};
+void corners(const Mesh& m, int64_t t, tc_d3 c[4]) {
+  for (int k = 0; k < 4; ++k) c[k] = corner(m, t, k);
+}
+
+// The distance from p to the bounding box of the corners: at most p's distance to the tet.
+double box_distance(const tc_d3 c[4], tc_d3 p) {
+  auto axis = [&](double x, double a, double b, double e, double f) {
+    const double lo = std::min({a, b, e, f}), hi = std::max({a, b, e, f});
+    return x < lo ? lo - x : x > hi ? x - hi : 0.0;
+  };
+  const double dx = axis(p.x, c[0].x, c[1].x, c[2].x, c[3].x), dy = axis(p.y, c[0].y, c[1].y, c[2].y, c[3].y),
+               dz = axis(p.z, c[0].z, c[1].z, c[2].z, c[3].z);
+  return std::sqrt(dx * dx + dy * dy + dz * dz);
+}
+
+}  // namespace
+
+namespace fields_detail {
+
+void barycentric(const tc_d3 c[4], tc_d3 p, double b[4]) {
   const double v = geo::tc_orient3d(c[0], c[1], c[2], c[3]);
   b[0] = geo::tc_orient3d(p, c[1], c[2], c[3]) / v;
   b[1] = geo::tc_orient3d(c[0], p, c[2], c[3]) / v;
   b[2] = geo::tc_orient3d(c[0], c[1], p, c[3]) / v;
   b[3] = 1.0 - b[0] - b[1] - b[2];
 }
+
+namespace {
 
 // The point of triangle (a, b, c) nearest to p, with its barycentric coordinates (Ericson,
 // Real-Time Collision Detection, 5.1.5).
@@ -58,15 +78,15 @@ tc_d3 closest_on_triangle(tc_d3 p, tc_d3 a, tc_d3 b, tc_d3 c, double w[3]) {
   return w[0] = 1 - v - u, w[1] = v, w[2] = u, a + ab * v + ac * u;
 }
 
-// The distance from p to tet t (0 inside) and the barycentric coordinates of the tet's point
-// nearest to p.
-double distance_to_tet(const Mesh& m, int64_t t, tc_d3 p, double b[4]) {
-  barycentric(m, t, p, b);
+}  // namespace
+
+double distance_to_tet(const tc_d3 c[4], tc_d3 p, double b[4]) {
+  barycentric(c, p, b);
   if (b[0] >= 0 && b[1] >= 0 && b[2] >= 0 && b[3] >= 0) return 0;
   double best = std::numeric_limits<double>::infinity();
   for (const auto& F : geo::TC_TET_FACES) {
     double w[3];
-    const tc_d3 q = closest_on_triangle(p, corner(m, t, F[0]), corner(m, t, F[1]), corner(m, t, F[2]), w);
+    const tc_d3 q = closest_on_triangle(p, c[F[0]], c[F[1]], c[F[2]], w);
     const double d = geo::length(q - p);
     if (d < best) {
       best = d;
@@ -77,7 +97,10 @@ double distance_to_tet(const Mesh& m, int64_t t, tc_d3 p, double b[4]) {
   return best;
 }
 
-}  // namespace
+}  // namespace fields_detail
+
+using fields_detail::barycentric;
+using fields_detail::distance_to_tet;
 
 TetLocator::TetLocator(const Mesh& mesh) : mesh_(mesh) {
   const int64_t nt = mesh.num_tets();
@@ -130,10 +153,24 @@ int64_t TetLocator::locate(const double p[3], double bary[4], bool* outside) con
     const double x = std::floor((p[c] - lo_[c]) / cell_);
     at[c] = !(x > 0) ? 0 : x >= double(dim_[c]) ? dim_[c] - 1 : int64_t(x);
   }
-  // Shells of cells around p's, until a tet holds p or no cell further out can hold a nearer
-  // one than the nearest found.
+  // A tet that holds p has p in its box, so it is listed in p's cell: look there first.
+  double b[4];
+  tc_d3 c[4];
+  const int64_t home = cell_index(at[0], at[1], at[2]);
+  for (int64_t e = offsets_[size_t(home)]; e < offsets_[size_t(home) + 1]; ++e) {
+    const int64_t t = tets_[size_t(e)];
+    corners(mesh_, t, c);
+    barycentric(c, q, b);
+    if (std::min({b[0], b[1], b[2], b[3]}) >= -1e-12) {
+      std::copy(b, b + 4, bary);
+      if (outside) *outside = false;
+      return t;
+    }
+  }
+  // Outside every tet: shells of cells around p's, until no cell further out can hold a tet
+  // nearer than the nearest found.
   int64_t best = -1;
-  double best_d = std::numeric_limits<double>::infinity(), b[4];
+  double best_d = std::numeric_limits<double>::infinity();
   const int64_t max_r = std::max({dim_[0], dim_[1], dim_[2]});
   for (int64_t r = 0; r <= max_r; ++r) {
     for (int64_t k = at[2] - r; k <= at[2] + r; ++k)
@@ -141,16 +178,12 @@ int64_t TetLocator::locate(const double p[3], double bary[4], bool* outside) con
         for (int64_t i = at[0] - r; i <= at[0] + r; ++i) {
           if (std::max({std::abs(i - at[0]), std::abs(j - at[1]), std::abs(k - at[2])}) != r) continue;
           if (i < 0 || j < 0 || k < 0 || i >= dim_[0] || j >= dim_[1] || k >= dim_[2]) continue;
-          const int64_t c = cell_index(i, j, k);
-          for (int64_t e = offsets_[size_t(c)]; e < offsets_[size_t(c) + 1]; ++e) {
+          const int64_t cell = cell_index(i, j, k);
+          for (int64_t e = offsets_[size_t(cell)]; e < offsets_[size_t(cell) + 1]; ++e) {
             const int64_t t = tets_[size_t(e)];
-            barycentric(mesh_, t, q, b);
-            if (std::min({b[0], b[1], b[2], b[3]}) >= -1e-12) {
-              std::copy(b, b + 4, bary);
-              if (outside) *outside = false;
-              return t;
-            }
-            const double d = distance_to_tet(mesh_, t, q, b);
+            corners(mesh_, t, c);
+            if (box_distance(c, q) >= best_d) continue;  // cheaper than the distance, and a bound of it
+            const double d = distance_to_tet(c, q, b);
             if (d < best_d) {
               best_d = d;
               best = t;
@@ -220,6 +253,7 @@ std::vector<FieldError> field_errors(const Mesh& reference, const Mesh& mesh, in
     s.bary[vertex_corner[size_t(v)]] = 1;
     samples.push_back(s);
   }
+  const size_t at_vertices = samples.size();  // the first samples: the reference's vertices
   std::vector<double> cumulative(size_t(reference.num_tets()));
   double total = 0;
   for (int64_t t = 0; t < reference.num_tets(); ++t)
@@ -261,12 +295,14 @@ std::vector<FieldError> field_errors(const Mesh& reference, const Mesh& mesh, in
       }
       const double d = std::fabs(a - b);
       fe.max_abs = std::max(fe.max_abs, d);
+      if (i < at_vertices) fe.max_vertex_abs = std::max(fe.max_vertex_abs, d);
       sq += d * d;
     }
     fe.samples = int64_t(samples.size());
     fe.rms_abs = std::sqrt(sq / double(samples.size()));
     fe.max_rel = fe.range > 0 ? fe.max_abs / fe.range : 0;
     fe.rms_rel = fe.range > 0 ? fe.rms_abs / fe.range : 0;
+    fe.max_vertex_rel = fe.range > 0 ? fe.max_vertex_abs / fe.range : 0;
     out.push_back(fe);
   }
   return out;

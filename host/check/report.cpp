@@ -119,6 +119,8 @@ std::string check_report_json(const CheckReport& r) {
           .field("rms_abs", f.rms_abs)
           .field("max_rel", f.max_rel)
           .field("rms_rel", f.rms_rel)
+          .field("max_vertex_abs", f.max_vertex_abs)
+          .field("max_vertex_rel", f.max_vertex_rel)
           .field("samples", f.samples)
           .end_object();
     w.end_array();
@@ -169,7 +171,8 @@ std::string check_report_text(const CheckReport& r) {
     for (const FieldError& f : c.fields)
       o << "field '" << f.name << "': max difference " << num(f.max_abs) << " (" << num(100 * f.max_rel)
         << "% of its range), RMS " << num(f.rms_abs) << " (" << num(100 * f.rms_rel) << "%) at " << f.samples
-        << " points\n";
+        << " points; at the reference's vertices max " << num(f.max_vertex_abs) << " (" << num(100 * f.max_vertex_rel)
+        << "%)\n";
   }
   return o.str();
 }

@@ -49,6 +49,7 @@ struct CollapseCli {
        average_fields = false;
   std::string preserve_field;
   double field_tolerance = 0.02;
+  CLI::Option* field_tolerance_option = nullptr;
   ImproveCli improve;
 };
 
@@ -136,6 +137,8 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, const Impr
       .field("eps_v", r.eps_v)
       .field("boundary_error_bound", r.boundary_error_bound)
       .field("boundary_error", r.boundary_error)
+      .field("field_error_bound", r.field_error_bound)
+      .field("field_error", r.field_error)
       .field("min_quality", c.opt.min_quality)
       .field("boundary", c.boundary)
       .field("method", c.method)
@@ -250,8 +253,16 @@ void register_collapse(CLI::App& app, int& exit_code) {
                  "Coarsen for volume rendering of this per-vertex field (the paper's Section 4.5): an\n"
                  "edge is collapsed when its ends' values differ by less than --field-tolerance x the\n"
                  "field's range (replaces --target-*; use --boundary free for the paper's setting)");
-  app.add_option("--field-tolerance", c->field_tolerance, "With --preserve-field: T (the paper: 0.02)")
-      ->capture_default_str()
+  c->field_tolerance_option =
+      app.add_option("--field-tolerance", c->field_tolerance, "With --preserve-field: T (the paper: 0.02)")
+          ->capture_default_str()
+          ->check(CLI::PositiveNumber);
+  app.add_option("--max-field-error", c->opt.max_field_error,
+                 "With --preserve-field NAME, in place of --field-tolerance: collapse every edge (up to\n"
+                 "--target-length or --target-factor when given) while each input vertex keeps its value of\n"
+                 "NAME, in the output's piecewise linear field, within E x the field's range. The error is\n"
+                 "measured at the input vertices the collapse's tets hold, not estimated. The collapses run\n"
+                 "on the host; the improvement phase does not run (its moves would change the values)")
       ->check(CLI::PositiveNumber);
   app.add_flag("--average-fields", c->average_fields,
                "Vertex fields at a survivor: the average of the collapsed edge's ends (default: the\n"
@@ -352,10 +363,13 @@ void register_collapse(CLI::App& app, int& exit_code) {
     }
     if (opt.method == CollapseOptions::Sequential && !c->device.empty())
       throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
+    if (opt.max_field_error > 0 && c->preserve_field.empty())
+      throw CLI::ValidationError("--max-field-error", "needs --preserve-field NAME (the field it bounds)");
+    static const std::string kNoField;  // --preserve-field with --max-field-error: host code
     if (opt.method == CollapseOptions::Sequential)
       for (const auto& [name, value] : {std::pair<const char*, const std::string*>{"--cost-cl", &c->cost_cl},
                                         {"--sizing-field", &c->sizing_field},
-                                        {"--preserve-field", &c->preserve_field},
+                                        {"--preserve-field", opt.max_field_error > 0 ? &kNoField : &c->preserve_field},
                                         {"--placement-cl", &c->placement_cl},
                                         {"--predicate-cl", &c->predicate_cl}})
         if (!value->empty())
@@ -373,6 +387,17 @@ void register_collapse(CLI::App& app, int& exit_code) {
         throw CLI::ValidationError("--cost-cl", "cannot be combined with --sizing-field or --preserve-field");
       opt.cost_cl_source = cl_file(c->cost_cl);
       if (opt.target_length <= 0) throw CLI::ValidationError("--cost-cl", "needs --target-length");
+    } else if (!c->preserve_field.empty() && opt.max_field_error > 0) {
+      if (!c->sizing_field.empty())
+        throw CLI::ValidationError("--preserve-field", "cannot be combined with --sizing-field");
+      if (c->field_tolerance_option->count() > 0)
+        throw CLI::ValidationError("--field-tolerance", "cannot be combined with --max-field-error (the bound decides)");
+      if (!mesh.find_vertex_field(c->preserve_field))
+        throw InputError(c->in, "no vertex field named '" + c->preserve_field + "'");
+      opt.bounded_field = c->preserve_field;
+      if (opt.target_length <= 0 && c->target_factor > 0)
+        opt.target_length = c->target_factor * median_edge_length(mesh);
+      c->no_improve = true;
     } else if (!c->preserve_field.empty()) {
       if (!c->sizing_field.empty())
         throw CLI::ValidationError("--preserve-field", "cannot be combined with --sizing-field");
@@ -490,6 +515,9 @@ void register_collapse(CLI::App& app, int& exit_code) {
                    seconds_read, seconds_write, seconds_total);
       std::fprintf(stderr, "  quality in:             %s\n  quality after collapse: %s\n", quality_line(quality_in).c_str(),
                    quality_line(quality_collapsed).c_str());
+      if (r.field_error_bound > 0)
+        std::fprintf(stderr, "  field error at the input's vertices: %.4g%% of the range (bound %.4g%%)\n",
+                     100 * r.field_error, 100 * r.field_error_bound);
       if (!c->no_improve)
         std::fprintf(stderr, "  quality after improve:  %s (%.3f s)\n", quality_line(ir.after).c_str(), ir.seconds_total);
     }

@@ -79,7 +79,10 @@ CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Cont
 }  // namespace
 
 CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
-  if (options.method == CollapseOptions::Sequential) return collapse_sequential(mesh, options);
+  // The field error bound's check reads the input vertices of the region a collapse changes,
+  // which live on the host (CollapseOptions::max_field_error).
+  if (options.method == CollapseOptions::Sequential || options.max_field_error > 0)
+    return collapse_sequential(mesh, options);
   if (options.bounds_boundary_error()) return collapse_bounded(mesh, options, ctx);
   check_options(options, ctx);
   CollapseReport report = report_for(mesh, ctx);

@@ -40,6 +40,8 @@ SeqParams checked_params(const Mesh& mesh, const CollapseOptions& o) {
     throw std::invalid_argument(
         "max_boundary_error applies to the features boundary mode (strict keeps the boundary exactly, free "
         "does not bound it)");
+  if (!(o.max_field_error >= 0) || std::isinf(o.max_field_error))
+    throw std::invalid_argument("max_field_error must be finite and >= 0");
   SeqParams p = seq_params_from(o);
   p.eps_v = volume_threshold(mesh, o);  // as collapse() computes it
   // With a bound, a smoothly curved face's vertices are face vertices: the bound decides.
@@ -99,6 +101,10 @@ SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const T
   mask_ = options.vertex_mask;
   bound_ = boundary_error_bound(mesh, options);
   if (bound_ > 0) eps_.assign(size_t(sm_.num_vertices()), 0.0);
+  if (options.max_field_error > 0) {
+    field_ = std::make_unique<FieldBound>(mesh, options, sm_);
+    report_.field_error_bound = field_->bound();
+  }
   if (!mesh.tris.empty() || !mesh.edges.empty()) {
     origin_.resize(size_t(mesh.num_vertices()));
     for (size_t i = 0; i < origin_.size(); ++i) origin_[i] = int32_t(i);
@@ -166,7 +172,7 @@ bool SequentialRun::step() {
   }
   s.edges = int64_t(edges_.size());
   const double t1 = seconds_since(t0);
-  if (it_ == 0 && !(target_ > 0)) {
+  if (it_ == 0 && !(target_ > 0 && std::isfinite(target_))) {
     // the median edge length of the input (the lower median, as tc::median_edge_length)
     std::vector<double> len(edges_.size());
     for (size_t i = 0; i < edges_.size(); ++i) len[i] = edges_[i].cost;
@@ -175,9 +181,10 @@ bool SequentialRun::step() {
       std::nth_element(len.begin(), len.begin() + m, len.end());
       report_.median_edge_length = len[m];
     }
-    target_ = o_.target_factor * report_.median_edge_length;
+    // with the field bound and no target, every edge is a candidate: the bound decides
+    if (!(target_ > 0)) target_ = field_ ? INFINITY : o_.target_factor * report_.median_edge_length;
   }
-  if (it_ == 0) sm_.build_guard(target_);
+  if (it_ == 0) sm_.build_guard(std::isfinite(target_) ? target_ : report_.median_edge_length);
   // marking, Q, link and volume; the admissible edges into the queue
   const bool reuse = o_.tuning.reuse_across_iterations;
   const uint32_t prev = uint32_t(it_);  // touched_ value of the previous iteration (0: the input)
@@ -254,7 +261,12 @@ bool SequentialRun::step() {
       }
       if (change > 0) eps_after = base + change;
     }
+    if (field_ && !field_->admits(sm_, mesh_, e.a, e.b, dir)) {
+      ++s.refused_by_bound;
+      continue;  // (as the boundary bound: the verdict changes only with the star)
+    }
     const int32_t survivor = sm_.collapse(e.a, e.b, dir);
+    if (field_) field_->apply(mesh_, survivor);
     if (eps_after > 0) eps_[size_t(survivor)] = std::max(eps_[size_t(survivor)], eps_after);
     ++s.collapsed;
     for (int32_t u : sm_.touched()) touched_[u] = cur;
@@ -292,7 +304,13 @@ bool SequentialRun::step() {
         refused_[kept_refused++] = refused_[i + 1];
       }
     refused_.resize(kept_refused);
+    if (field_) {
+      tmap_.assign(size_t(sm_.num_tets()), -1);
+      for (int32_t t = 0, m = 0; t < sm_.num_tets(); ++t)
+        if (sm_.tet_alive(t)) tmap_[size_t(t)] = m++;
+    }
     sm_.compact(vmap_, kept_);
+    if (field_) field_->compact(tmap_);
     // per-vertex data of the survivors; origin composed with the vertex map
     for (size_t i = 0; i < kept_.size(); ++i) touched_[i] = touched_[kept_[i]];
     touched_.resize(kept_.size());
@@ -335,6 +353,7 @@ CollapseReport SequentialRun::finish() {
   report_.boundary_error_bound = bound_;
   for (size_t v = 0; v < eps_.size(); ++v)
     if (sm_.alive(int32_t(v))) report_.boundary_error = std::max(report_.boundary_error, eps_[v]);
+  if (field_) report_.field_error = field_->max_error(sm_, mesh_);
   report_.vertices_out = mesh_.num_vertices();
   report_.tets_out = mesh_.num_tets();
   report_.seconds_total = seconds_since(t_start_);

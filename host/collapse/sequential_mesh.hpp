@@ -129,6 +129,17 @@ class SeqMesh {
   // carries eps per vertex: the survivor's becomes *base + the bound.
   double surface_change(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base);
 
+  // The tets the collapse of (a, b) in direction dir removes or reshapes (those of ring(a) U
+  // ring(b), each once), in `tets`; in `after` four vertices per tet as the collapse leaves it
+  // (the removed vertex renamed to the survivor; -1s for a removed tet); the survivor and its
+  // place. A reshaped tet keeps its index through collapse().
+  void collapse_region(int32_t a, int32_t b, uint8_t dir, std::vector<int32_t>& tets, std::vector<int32_t>& after,
+                       int32_t* survivor, geo::tc_d3* place);
+  bool tet_alive(int32_t t) const { return talive_[t] != 0; }
+  const int32_t* tet_vertices(int32_t t) const { return tet(t); }
+  // A tet through v (-1: none).
+  int32_t some_tet(int32_t v) const { return rlen_[v] > 0 ? ring(v)[0] : -1; }
+
   // Surface guard (the device's: cl/collapse_guard.cl). build_guard() indexes the current
   // S faces in a grid of cells of the mean extent of an S face (h when there is none);
   // collapses keep it current and compact() renumbers it (rebuilds it once the collapses

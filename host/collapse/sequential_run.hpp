@@ -46,7 +46,10 @@
 #include <cstdint>
 #include <vector>
 
+#include <memory>
+
 #include "collapse/edge_key_set.hpp"
+#include "collapse/field_bound.hpp"
 #include "collapse/sequential_mesh.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/mesh.hpp"
@@ -115,6 +118,8 @@ class SequentialRun {
   // S near it has moved from the input's (SeqMesh::surface_change).
   double bound_ = 0;
   std::vector<double> eps_;
+  std::unique_ptr<FieldBound> field_;  // the field error bound (null: none)
+  std::vector<int32_t> tmap_;
   std::vector<int32_t> origin_;    // input vertex -> current vertex (only with tris or edges)
   std::vector<uint32_t> touched_;  // per vertex: 1 + the last iteration that touched its star (0: none)
   std::vector<QueueEntry> edges_, heap_;

@@ -78,7 +78,8 @@ struct IterationStats {
   // Chosen collapses the surface guard refused, over all its runs (the selection then runs
   // again, or with the matching selection the collapse and those that saw it are undone).
   int64_t refused_by_guard = 0;
-  // Collapses refused because they would take S beyond the boundary error bound.
+  // Collapses refused because they would take S beyond the boundary error bound (or a field
+  // beyond the field error bound).
   int64_t refused_by_bound = 0;
   int64_t collapsed = 0;
   int64_t tets_after = 0, vertices_after = 0;
@@ -101,6 +102,10 @@ struct CollapseReport {
   // With a boundary error bound: the bound in mesh units, and the largest bound the run's
   // changes of S reached (the result's S is within it of the input's, both ways).
   double boundary_error_bound = 0, boundary_error = 0;
+  // With a field error bound: the bound (a share of the field's range), and the largest
+  // difference, as a share of the range, between an input vertex's value and the result's
+  // piecewise linear field at it (over the bounded field's components).
+  double field_error_bound = 0, field_error = 0;
 };
 
 // How the parallel method goes about its work: choices of speed and memory that a user rarely
@@ -209,6 +214,21 @@ struct CollapseOptions {
   double max_boundary_error = 0;
   double max_boundary_error_abs = 0;
   bool bounds_boundary_error() const { return max_boundary_error > 0 || max_boundary_error_abs > 0; }
+  // Field error bound (beyond the paper, after Cignoni et al. 2000): a collapse is made only
+  // while every input vertex keeps, in the result's piecewise linear vertex field
+  // `bounded_field` (empty: the first vertex field), its input value within max_field_error x
+  // the field's range over the input (per component). Each current tet carries the input
+  // vertices inside it; a collapse locates those of the tets it changes in the tets it makes and
+  // evaluates the field there, so the bound is checked, not estimated. A collapse that would
+  // leave an input vertex outside the result is refused too (its value would depend on which
+  // tet is nearest), so no input vertex falls outside, in any boundary mode. The survivor's
+  // vertex fields are the input's fields at its place.
+  // Every edge up to target_length is a candidate (+infinity when target_length <= 0: the
+  // bound alone decides). The check needs the input vertices of the region a collapse changes,
+  // which the device does not hold: both methods run the sequential method's collapses. Not
+  // with user functions (std::invalid_argument). 0: no bound.
+  double max_field_error = 0;
+  std::string bounded_field;
   // Tets of the collapsed neighbourhood must keep a volume >= eps_v. With eps_v_relative the
   // threshold is eps_v x (bounding-box diagonal of the input)^3.
   double eps_v = 2e-12;

@@ -46,12 +46,14 @@ int64_t resample_vertex_fields(const Mesh& original, Mesh& mesh);
 // How far a mesh's piecewise linear vertex field is from the reference's, per field both have
 // (first component), measured at every reference vertex and at `random_points` points drawn
 // uniformly in the reference's volume (fixed seed): the largest and the root-mean-square
-// difference, and both as a share of the reference field's range.
+// difference, and both as a share of the reference field's range; and the largest difference at
+// the reference's vertices alone (what CollapseOptions::max_field_error bounds).
 struct FieldError {
   std::string name;
   double range = 0;
   double max_abs = 0, rms_abs = 0;
   double max_rel = 0, rms_rel = 0;
+  double max_vertex_abs = 0, max_vertex_rel = 0;
   int64_t samples = 0;
 };
 std::vector<FieldError> field_errors(const Mesh& reference, const Mesh& mesh, int64_t random_points = 100000);

@@ -170,6 +170,107 @@ TEST(FieldsCli, PreserveFieldCoarsensAndChecksTheField) {
   EXPECT_NE(log.find("nope"), std::string::npos) << log;
 }
 
+Mesh with_bump(int n, unsigned seed) {
+  Mesh m = jiggled(n, seed);
+  m.vertex_fields.push_back({"rho", 1, {}});
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    const double* p = &m.points[3 * size_t(v)];
+    m.vertex_fields[0].values.push_back(std::exp(-10 * (std::pow(p[0] - 0.4, 2) + std::pow(p[1] - 0.6, 2))) + p[2]);
+  }
+  return m;
+}
+
+// The field error bound holds at every input vertex, by the locator's own measurement of the
+// output (not the run's), in both boundary modes, and the run does coarsen.
+TEST(FieldBound, EveryInputVertexKeepsItsValueWithinTheBound) {
+  const Mesh in = with_bump(10, 3);
+  for (auto boundary : {CollapseOptions::Features, CollapseOptions::Free}) {
+    for (double bound : {0.01, 0.05}) {
+      Mesh m = in;
+      CollapseOptions o;
+      o.method = CollapseOptions::Sequential;
+      o.boundary = boundary;
+      o.max_field_error = bound;
+      o.bounded_field = "rho";
+      const CollapseReport r = collapse_sequential(m, o);
+      EXPECT_LT(m.num_vertices(), in.num_vertices() * 3 / 4) << "the bound alone decides: it coarsens";
+      EXPECT_EQ(r.field_error_bound, bound);
+      EXPECT_LE(r.field_error, bound);
+      EXPECT_GT(r.field_error, bound / 4) << "it coarsens up to the bound";
+      const FieldError e = field_errors(in, m, 0)[0];
+      EXPECT_LE(e.max_vertex_rel, bound * (1 + 1e-9));
+      EXPECT_NEAR(e.max_vertex_rel, r.field_error, 1e-9) << "the run measures what the locator measures";
+      // every input vertex stays inside the output
+      const TetLocator loc(m);
+      int64_t outside = 0;
+      for (int64_t v = 0; v < in.num_vertices(); ++v) {
+        double b[4];
+        bool out = false;
+        loc.locate(&in.points[3 * size_t(v)], b, &out);
+        outside += out;
+      }
+      EXPECT_EQ(outside, 0);
+      // the survivors carry the input's field at their places
+      resample_vertex_fields(in, m);
+      EXPECT_LE(field_errors(in, m, 0)[0].max_vertex_rel, bound * (1 + 1e-9));
+    }
+  }
+}
+
+// A linear field is exact in any coarsening, so the bound refuses nothing on its account; a
+// bumpy one under a small bound keeps more vertices. (A check that admitted everything would
+// coarsen both alike.)
+TEST(FieldBound, ALinearFieldCoarsensFurtherThanABumpyOne) {
+  Mesh lin = jiggled(10, 5);
+  add_linear_field(lin);
+  Mesh bumpy = with_bump(10, 5);
+  CollapseOptions o;
+  o.method = CollapseOptions::Sequential;
+  o.max_field_error = 0.002;
+  const CollapseReport rl = collapse_sequential(lin, o);
+  const CollapseReport rb = collapse_sequential(bumpy, o);
+  EXPECT_LT(rl.field_error, 1e-9);
+  int64_t refused = 0;
+  for (const IterationStats& it : rb.iterations) refused += it.refused_by_bound;
+  EXPECT_GT(refused, 0);
+  EXPECT_LT(lin.num_vertices() * 3, bumpy.num_vertices() * 2) << lin.num_vertices() << " vs " << bumpy.num_vertices();
+}
+
+TEST(FieldBound, ANamedFieldMustExistAndTheBoundBeFinite) {
+  Mesh m = with_bump(4, 1);
+  CollapseOptions o;
+  o.method = CollapseOptions::Sequential;
+  o.max_field_error = 0.01;
+  o.bounded_field = "nope";
+  EXPECT_THROW(collapse_sequential(m, o), std::invalid_argument);
+  o.bounded_field.clear();
+  o.max_field_error = INFINITY;
+  EXPECT_THROW(collapse_sequential(m, o), std::invalid_argument);
+  Mesh bare = jiggled(4, 1);
+  o.max_field_error = 0.01;
+  EXPECT_THROW(collapse_sequential(bare, o), std::invalid_argument) << "no vertex field";
+}
+
+TEST(FieldsCli, MaxFieldErrorBoundsTheNamedFieldAtTheInputVertices) {
+  const Mesh in = with_bump(8, 17);
+  TempDir dir;
+  const std::string src = dir.file("in.vtu"), out = dir.file("out.vtu"), stats = dir.file("s.json");
+  write_mesh(src, in);
+  std::string log;
+  const std::string cmd = std::string("'") + TC_CLI + "' '" + src + "' '" + out + "'";
+  ASSERT_EQ(run_command(cmd + " --preserve-field rho --max-field-error 0.02 --stats '" + stats + "'", &log), 0) << log;
+  EXPECT_NE(log.find("field error at the input's vertices"), std::string::npos) << log;
+  EXPECT_EQ(log.find("quality after improve"), std::string::npos) << "no improvement phase under the bound";
+  const Mesh m = read_mesh(out);
+  EXPECT_LT(m.num_vertices(), in.num_vertices());
+  EXPECT_LE(field_errors(in, m, 0)[0].max_vertex_rel, 0.02 * (1 + 1e-9));
+  EXPECT_NE(read_text(stats).find("\"field_error_bound\":0.02"), std::string::npos);
+  EXPECT_EQ(run_command(cmd + " --max-field-error 0.02", &log), 2) << "which field?";
+  EXPECT_NE(log.find("--preserve-field"), std::string::npos) << log;
+  EXPECT_EQ(run_command(cmd + " --preserve-field rho --max-field-error 0.02 --field-tolerance 0.1", &log), 2);
+  EXPECT_EQ(run_command(cmd + " --preserve-field rho --max-field-error 0.02 --method sequential", &log), 0) << log;
+}
+
 // scripts/render_dvr.py renders a small mesh and its coarsened copy (when VTK and Xvfb are
 // installed: scripts/setup.sh --with-tools).
 TEST(FieldsCli, TheRenderingScriptComparesTwoMeshes) {
