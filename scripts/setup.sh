@@ -17,6 +17,7 @@ packages=(
   python3 python3-meshio          # independent reader used by the cross-read tests
   python3-dev pybind11-dev python3-numpy  # the Python module and its tests
   gmsh tetgen                     # the tests that read files these programs write, and vice versa
+  libopenmpi-dev openmpi-bin libmetis-dev  # tetcollapse-mpi (mpi/) and its tests
 )
 if [[ "${1:-}" == "--with-tools" ]]; then
   packages+=(python3-gmsh python3-matplotlib python3-vtk9 xvfb clang libclang-rt-14-dev llvm-14)

@@ -1,0 +1,37 @@
+// One rank's work in a round: coarsen or improve its part with the interface vertices frozen,
+// and find the frozen vertices again in the library's output.
+#pragma once
+
+#include <cstdint>
+
+#include "part.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/improve.hpp"
+
+namespace tc::mpi {
+
+// What every rank runs with, in absolute units computed on rank 0 from the whole mesh.
+struct Settings {
+  CollapseOptions collapse;   // target_length and eps_v absolute (eps_v_relative false)
+  ImproveOptions improve;     // max_boundary_move relative to the whole mesh's diagonal
+  double whole_diagonal = 0;  // bounding-box diagonal of the whole input
+  double collapse_length = 0;  // the improvement's collapse step: 1.5 x the coarse mesh's median
+};
+
+struct RankReport {
+  int64_t tets_in = 0, tets_out = 0, vertices_in = 0, vertices_out = 0, frozen = 0;
+  double seconds_collapse = 0, seconds_improve = 0;
+};
+
+// What a round does to each part: the rounds of the collapse phase coarsen, then those of the
+// improvement phase improve, as `tetcollapse` collapses everything before it improves (an
+// improved mesh coarsens further when collapsed again, so interleaving them would coarsen more).
+enum class Phase { Collapse, Improve };
+
+// Coarsens (or improves) part.mesh in place. The frozen vertices keep their positions bit for bit and are
+// found again by a vertex field carrying their global id; on return part.gid holds that id for
+// them and -1 for every other vertex, part.frozen says which are which. Throws what the
+// library throws, and std::runtime_error when a frozen vertex was lost (a library fault).
+RankReport coarsen_part(Part& part, Phase phase, const Settings& settings, Context& ctx);
+
+}  // namespace tc::mpi

@@ -1,0 +1,153 @@
+#include "driver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "agree.hpp"
+#include "io/io_util.hpp"
+#include "report.hpp"
+#include "rounds.hpp"
+#include "stopwatch.hpp"
+#include "tetcollapse/fields.hpp"
+
+namespace tc::mpi {
+
+namespace {
+
+void bcast(double* values, int n, MPI_Comm comm) { MPI_Bcast(values, n, MPI_DOUBLE, 0, comm); }
+
+// The settings every rank runs with; rank 0 fills the absolute values from the whole mesh.
+Settings make_settings(const Options& o) {
+  Settings s;
+  CollapseOptions& c = s.collapse;
+  c.boundary = cli::boundary_mode(o.boundary);
+  c.use_labels = !o.no_labels;
+  c.eps_f = o.eps_f;
+  c.eps_r = o.eps_r;
+  c.eps_v = o.eps_v;
+  c.eps_v_relative = o.eps_v_relative;
+  c.min_quality = o.min_quality;
+  if (o.target_factor > 0) c.target_factor = o.target_factor;
+  ImproveOptions& i = s.improve;
+  i.boundary = c.boundary;
+  i.eps_f = c.eps_f;
+  i.eps_r = c.eps_r;
+  i.use_labels = c.use_labels;
+  i.max_boundary_move = o.max_boundary_move;
+  return s;
+}
+
+double bbox_diagonal(const Mesh& m) {
+  if (m.num_vertices() == 0) return 0;
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = m.points[size_t(k)];
+  for (int64_t v = 0; v < m.num_vertices(); ++v)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], m.points[size_t(3 * v + k)]);
+      hi[k] = std::max(hi[k], m.points[size_t(3 * v + k)]);
+    }
+  return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+}
+
+void write_text(const std::string& path, const std::string& text) {
+  if (path == "-") {
+    std::cout << text << "\n";
+    return;
+  }
+  io::AtomicFile f(path, false);
+  f.stream() << text << "\n";
+  f.commit();
+}
+
+}  // namespace
+
+int run(Options& o, MPI_Comm comm) {
+  int rank = 0, nranks = 1;
+  MPI_Comm_rank(comm, &rank);
+  MPI_Comm_size(comm, &nranks);
+  const bool talk = rank == 0 && !o.quiet;
+  const Stopwatch total;
+  Settings s = make_settings(o);
+  RunStats stats;
+  stats.input = o.in, stats.output = o.out, stats.ranks = nranks, stats.boundary = o.boundary;
+  Mesh whole, input;  // rank 0: the mesh of the round; the input for --check and the fields
+
+  // Rank 0 reads the input and turns every bound relative to the whole mesh into an absolute one.
+  int code = guarded(rank, [&] {
+    validate(o);
+    if (rank != 0) return;
+    cli::check_output_path(o.out, &o.output);
+    cli::check_output_path(o.stats, nullptr);
+    Stopwatch clock;
+    whole = cli::read_input(o.in, o.input, o.quiet);
+    stats.seconds_read = clock.lap();
+    if (o.check || (!whole.vertex_fields.empty() && !o.average_fields)) input = whole;
+    stats.vertices_in = whole.num_vertices(), stats.tets_in = whole.num_tets();
+    stats.median_edge_length = median_edge_length(whole);
+    s.collapse.target_length = o.target_length > 0 ? o.target_length : s.collapse.target_factor * stats.median_edge_length;
+    if (!(s.collapse.target_length > 0)) throw InputError(o.in, "the mesh has no edges: nothing to coarsen");
+    s.collapse.eps_v = volume_threshold(whole, s.collapse);
+    s.whole_diagonal = bbox_diagonal(whole);
+  });
+  if ((code = agree(code, comm))) return code;
+  double shared[3] = {s.collapse.target_length, s.collapse.eps_v, s.whole_diagonal};
+  bcast(shared, 3, comm);
+  s.collapse.target_length = shared[0], s.collapse.eps_v = shared[1], s.whole_diagonal = shared[2];
+  s.collapse.eps_v_relative = false;
+  stats.target_length = s.collapse.target_length;
+
+  // Every rank its own device context.
+  std::unique_ptr<Context> ctx;
+  code = guarded(rank, [&] { ctx = cli::open_device(o.device, !talk); });
+  if ((code = agree(code, comm))) return code;
+  stats.device = ctx->info().name;
+  if (talk)
+    std::fprintf(stderr, "%d ranks, target length %.6g (median edge length %.6g)\n", nranks, s.collapse.target_length,
+                 stats.median_edge_length);
+
+  // The collapse phase, then the improvement phase, each in rounds until nothing is left to do.
+  Round state{whole, {}, 0};
+  code = run_phase(Phase::Collapse, state, s, o, *ctx, stats, comm);
+  if (code == cli::kOk && !o.no_improve) {
+    // the improvement's collapse step reaches as far as tc::improve's default on the whole mesh
+    if (rank == 0) s.collapse_length = 1.5 * median_edge_length(whole);
+    bcast(&s.collapse_length, 1, comm);
+    code = run_phase(Phase::Improve, state, s, o, *ctx, stats, comm);
+  }
+  if (code) return code;
+
+  // Peak memory per rank over the run, then rank 0 finishes: fields, check, write, stats.
+  int64_t peak = peak_rss_kb();
+  stats.peak_rss_kb.resize(size_t(nranks));
+  MPI_Gather(&peak, 1, MPI_INT64_T, stats.peak_rss_kb.data(), 1, MPI_INT64_T, 0, comm);
+  int exit_code = cli::kOk;
+  code = guarded(rank, [&] {
+    if (rank != 0) return;
+    if (!whole.vertex_fields.empty() && !o.average_fields) {
+      const int64_t outside = resample_vertex_fields(input, whole);
+      if (outside > 0 && talk)
+        std::fprintf(stderr, "note: %lld vertices lie outside the input; their fields come from the nearest tet\n",
+                     (long long)outside);
+    }
+    if (o.check)
+      stats.check = cli::check_result(whole, input, s.collapse.boundary == CollapseOptions::Strict, o.quiet, exit_code);
+    Stopwatch clock;
+    if (exit_code == cli::kOk) write_mesh(o.out, whole, cli::write_options(o.output));
+    stats.seconds_write = clock.lap();
+    stats.vertices_out = whole.num_vertices(), stats.tets_out = whole.num_tets();
+    stats.seconds_total = total.peek();
+    if (talk)
+      std::fprintf(stderr, "%s -> %s: tets %lld -> %lld (%.1f%% fewer) in %zu rounds, %.2f s\n", o.in.c_str(),
+                   o.out.c_str(), (long long)stats.tets_in, (long long)stats.tets_out,
+                   stats.tets_in ? 100.0 * (1.0 - double(stats.tets_out) / double(stats.tets_in)) : 0.0,
+                   stats.rounds.size(), stats.seconds_total);
+    if (!o.stats.empty()) write_text(o.stats, stats_json(stats));
+  });
+  if (code == cli::kOk) code = exit_code;
+  return agree(code, comm);
+}
+
+}  // namespace tc::mpi

@@ -1,0 +1,83 @@
+#include "options.hpp"
+
+namespace tc::mpi {
+
+void add_options(CLI::App& app, Options& o) {
+  app.add_option("IN", o.in, "Input mesh (any format tetcollapse reads), read by rank 0")->required();
+  app.add_option("OUT", o.out, "Output mesh, written by rank 0 to a temporary file and renamed")->required();
+  auto* tl = app.add_option("--target-length", o.target_length, "Collapse edges shorter than L (mesh units)");
+  auto* tf = app.add_option("--target-factor", o.target_factor,
+                            "Collapse edges shorter than F x the whole input's median edge length (default 1)");
+  tl->excludes(tf);
+  app.add_option("--boundary", o.boundary,
+                 "strict: boundary vertices never move; features (default): face vertices move along faces,\n"
+                 "ridge vertices along ridges, corners never; free: no protection")
+      ->check(CLI::IsMember({"strict", "features", "free"}));
+  app.add_flag("--no-labels", o.no_labels, "Do not protect material interfaces between labels");
+  app.add_option("--eps-f", o.eps_f, "Face-vertex threshold on 1 - dot of normals")->capture_default_str();
+  app.add_option("--eps-r", o.eps_r, "Ridge-edge threshold on 1 - dot of normals")->capture_default_str();
+  app.add_option("--eps-v", o.eps_v, "Refuse collapses leaving a tet with volume below this")->capture_default_str();
+  app.add_flag("--eps-v-relative", o.eps_v_relative,
+               "Read --eps-v relative to the cube of the whole input's bounding-box diagonal");
+  app.add_option("--min-quality", o.min_quality,
+                 "Quality guard: refuse a collapse that makes the worst reshaped tet's mean ratio fall below\n"
+                 "min(its value before, Q); 0 = off")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--max-boundary-error", o.max_boundary_error,
+                 "Not supported here (the library's boundary error bound does not take the vertex mask that\n"
+                 "freezes the partition interfaces): refused; use tetcollapse");
+  app.add_option("--max-boundary-error-abs", o.max_boundary_error_abs, "Not supported here, as --max-boundary-error");
+  app.add_flag("--no-improve", o.no_improve,
+               "Coarsen only (default: each rank improves its part after coarsening it, the interface\n"
+               "frozen; the improvement's collapse step does not run, as with any vertex mask)");
+  app.add_option("--max-boundary-move", o.max_boundary_move,
+                 "Improvement, features and free modes: how far the boundary may move, as a share of the\n"
+                 "whole input's bounding-box diagonal")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--average-fields", o.average_fields,
+               "Vertex fields at a survivor: the average of the collapsed edge's ends (default: the\n"
+               "input's piecewise linear field at the vertex's final place, on rank 0 at the end)");
+  app.add_option("--rounds", o.max_rounds,
+                 "At most N rounds of partition, coarsening and gathering; each round after the first cuts\n"
+                 "elsewhere, so the faces frozen before are coarsened")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
+  app.add_option("--round-threshold", o.round_threshold,
+                 "Stop after a round that removed fewer than this share of its tets")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--rings", o.rings,
+                 "After the first round, coarsen and improve only within N tets of the vertices frozen in\n"
+                 "the round before (coarsening again what is done would coarsen more than tetcollapse does)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
+  app.add_option("--seed", o.seed, "METIS seed of the first round (round r uses seed + r - 1)")->capture_default_str();
+  app.add_option("--avoid-weight", o.avoid_weight,
+                 "Weight in METIS's cut of a face touching the band still to coarsen (other faces: 1);\n"
+                 "higher keeps the next cut further from the last")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000000));
+  app.add_option("--device", o.device,
+                 "OpenCL device of every rank: index or name substring (see 'tetcollapse devices');\n"
+                 "default: $TETCOLLAPSE_DEVICE, else the first GPU, else the first CPU");
+  app.add_option("--stats", o.stats,
+                 "Write the run's statistics as JSON to this file ('-' for stdout): per round and per rank\n"
+                 "the seconds, tets and peak resident memory (VmHWM)");
+  app.add_flag("--check", o.check,
+               "Check the result on rank 0 against the input (validity, unchanged boundary topology; in\n"
+               "strict mode the boundary distance too) and fail (exit 1, nothing written) if invalid");
+  app.add_flag("-q,--quiet", o.quiet, "No progress lines, only errors");
+  cli::add_input_options(app, o.input);
+  cli::add_output_options(app, o.output);
+}
+
+void validate(const Options& o) {
+  if (o.max_boundary_error > 0 || o.max_boundary_error_abs > 0)
+    throw CLI::ValidationError("--max-boundary-error",
+                               "not supported by tetcollapse-mpi: the library's boundary error bound cannot be "
+                               "combined with the vertex mask that freezes the partition interfaces; use tetcollapse");
+}
+
+}  // namespace tc::mpi

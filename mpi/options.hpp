@@ -1,0 +1,32 @@
+// The command line of tetcollapse-mpi: the options of `tetcollapse IN OUT` it supports, under
+// the same names, and those of the rounds.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+#include "cli/common.hpp"
+
+namespace tc::mpi {
+
+struct Options {
+  std::string in, out, stats, device, boundary = "features";
+  double target_length = 0, target_factor = 0;
+  double eps_f = 0.01, eps_r = 0.1, eps_v = 2e-12, min_quality = 0.1;
+  double max_boundary_error = 0, max_boundary_error_abs = 0;  // refused: see validate()
+  double max_boundary_move = 0.001;
+  bool eps_v_relative = false, no_labels = false, no_improve = false, quiet = false, check = false,
+       average_fields = false;
+  int max_rounds = 5;
+  double round_threshold = 0.01;
+  int seed = 1, avoid_weight = 50, rings = 2;
+  cli::InputOptions input;
+  cli::OutputOptions output;
+};
+
+void add_options(CLI::App& app, Options& o);
+// What CLI11 cannot check alone; throws CLI::ValidationError.
+void validate(const Options& o);
+
+}  // namespace tc::mpi

@@ -1,0 +1,30 @@
+// A phase of tetcollapse-mpi in rounds (see driver.hpp): partition, scatter, coarsen or improve
+// with the interface frozen, gather, until nothing is left to do.
+#pragma once
+
+#include <mpi.h>
+
+#include <cstdint>
+#include <vector>
+
+#include "coarsen.hpp"
+#include "options.hpp"
+#include "report.hpp"
+
+namespace tc::mpi {
+
+// Rank 0's state between rounds.
+struct Round {
+  Mesh& whole;  // the mesh of the round (moved out while the parts are away)
+  // Per vertex: where the round is to work, which its cut avoids (empty: everywhere). After a
+  // phase's first round, the vertices within o.rings tets of one the round before froze in its
+  // band.
+  std::vector<uint8_t> band;
+  int number;  // rounds so far, over both phases
+};
+
+// Runs on every rank; returns the agreed exit code. Rank 0 appends each round to stats.rounds.
+int run_phase(Phase phase, Round& state, const Settings& settings, const Options& options, Context& ctx,
+              RunStats& stats, MPI_Comm comm);
+
+}  // namespace tc::mpi
