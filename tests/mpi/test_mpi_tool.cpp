@@ -1,0 +1,224 @@
+// tetcollapse-mpi under mpirun with 1, 2 and 3 ranks: a valid result close to what tetcollapse
+// gives, the boundary kept in strict mode, labels and fields carried, the same output twice, and
+// the documented exit codes.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "tetcollapse/check.hpp"
+#include "tetcollapse/io.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using tc::Mesh;
+using tc::test::TempDir;
+
+// mpirun -n RANKS tetcollapse-mpi ARGS; the exit code, the output in *log. More ranks than
+// cores are fine here; CI runs as root, which Open MPI refuses unless told (a value the
+// environment gives is kept).
+int run_mpi(int ranks, const std::string& args, std::string* log) {
+  setenv("OMPI_ALLOW_RUN_AS_ROOT", "1", 0);
+  setenv("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1", 0);
+  setenv("OMPI_MCA_rmaps_base_oversubscribe", "1", 0);
+  const std::string cmd = std::string(TC_MPIEXEC) + " --oversubscribe -n " + std::to_string(ranks) + " " +
+                          TC_MPI_TOOL + " " + args;
+  return tc::test::run_command(cmd, log);
+}
+
+int run_single(const std::string& args, std::string* log) {
+  return tc::test::run_command(std::string(TC_CLI) + " " + args, log);
+}
+
+// The boundary faces (in one tet) as sorted triples of vertex positions.
+std::set<std::array<std::array<double, 3>, 3>> boundary_faces(const Mesh& m) {
+  std::map<std::array<int32_t, 3>, int> count;
+  for (int64_t t = 0; t < m.num_tets(); ++t)
+    for (int skip = 0; skip < 4; ++skip) {
+      std::array<int32_t, 3> f;
+      for (int k = 0, j = 0; k < 4; ++k)
+        if (k != skip) f[size_t(j++)] = m.tets[size_t(4 * t + k)];
+      std::sort(f.begin(), f.end());
+      ++count[f];
+    }
+  std::set<std::array<std::array<double, 3>, 3>> out;
+  for (const auto& [f, n] : count) {
+    if (n != 1) continue;
+    std::array<std::array<double, 3>, 3> p;
+    for (int k = 0; k < 3; ++k) p[size_t(k)] = m.point(f[size_t(k)]);
+    std::sort(p.begin(), p.end());
+    out.insert(p);
+  }
+  return out;
+}
+
+std::string shared_or_skip(const std::string& name) { return tc::test::shared_mesh(name); }
+
+class MpiTool : public ::testing::TestWithParam<int> {};
+
+// Valid by the checker (exact orientation, conforming faces, closed boundary without
+// self-intersection, the boundary's topology as the input's) and within 5% of the tets
+// tetcollapse leaves with the same options.
+TEST_P(MpiTool, ValidAndWithinFivePercentOfSingleDevice) {
+  const int ranks = GetParam();
+  int tested = 0;
+  for (const std::string name : {"ipc_hammer.msh", "gen_gmsh_wrenchnut_27k.msh"}) {
+    const std::string in = shared_or_skip(name);
+    if (in.empty()) continue;
+    ++tested;
+    TempDir dir;
+    std::string log;
+    ASSERT_EQ(run_single(in + " " + dir.file("single.msh") + " --target-factor 2 -q", &log), 0) << log;
+    ASSERT_EQ(run_mpi(ranks, in + " " + dir.file("mpi.msh") + " --target-factor 2 -q", &log), 0) << log;
+    const Mesh input = tc::read_mesh(in);
+    const Mesh single = tc::read_mesh(dir.file("single.msh"));
+    const Mesh out = tc::read_mesh(dir.file("mpi.msh"));
+    tc::CheckOptions co;
+    co.hausdorff = false;
+    const tc::CheckReport r = tc::check_mesh(out, co, &input);
+    EXPECT_TRUE(r.valid) << name << "\n" << tc::check_report_text(r);
+    EXPECT_FALSE(r.reference.topology_changed) << name;
+    EXPECT_LT(out.num_tets(), input.num_tets() * 7 / 10) << name << ": hardly coarsened";
+    const double ratio = double(out.num_tets()) / double(single.num_tets());
+    EXPECT_NEAR(ratio, 1.0, 0.05) << name << ": " << out.num_tets() << " tets with " << ranks << " ranks, "
+                                  << single.num_tets() << " with tetcollapse";
+  }
+  if (tested == 0) GTEST_SKIP() << "../shared/meshes (ipc_hammer.msh, gen_gmsh_wrenchnut_27k.msh) not present";
+}
+
+// Strict mode: no boundary vertex moves or goes, so the boundary faces are the input's, bit for
+// bit, across the partition interfaces too.
+TEST_P(MpiTool, StrictModeKeepsTheBoundaryBitForBit) {
+  TempDir dir;
+  const std::string in = tc::test::project_mesh("bracket.msh");
+  std::string log;
+  ASSERT_EQ(run_mpi(GetParam(), in + " " + dir.file("out.msh") + " --target-factor 2 --boundary strict --check -q", &log),
+            0)
+      << log;
+  const Mesh input = tc::read_mesh(in), out = tc::read_mesh(dir.file("out.msh"));
+  EXPECT_LT(out.num_tets(), input.num_tets() / 2);
+  const auto a = boundary_faces(input), b = boundary_faces(out);
+  EXPECT_EQ(a.size(), b.size());
+  EXPECT_TRUE(a == b) << "the boundary changed";
+}
+
+// Two labels with an interface plane, a linear vertex field and a tet field: the labels' volumes
+// stay (material interfaces are kept), the vertex field is the input's at every output vertex
+// (the linear field resampled), the tet field goes with its tets.
+TEST_P(MpiTool, KeepsLabelsAndFields) {
+  TempDir dir;
+  Mesh m = tc::read_mesh(tc::test::project_mesh("bracket.msh"));
+  m.tet_labels.clear();
+  m.tet_fields.clear();
+  m.vertex_fields.clear();
+  double cx = 0;
+  for (int64_t v = 0; v < m.num_vertices(); ++v) cx += m.points[size_t(3 * v)] / double(m.num_vertices());
+  tc::Labels lab{"material", {}};
+  tc::Field tf{"heat", 1, {}};
+  for (int64_t t = 0; t < m.num_tets(); ++t) {
+    double x = 0;
+    for (int k = 0; k < 4; ++k) x += m.points[size_t(3 * m.tets[size_t(4 * t + k)])] / 4;
+    lab.values.push_back(x < cx ? 7 : 9);
+    tf.values.push_back(x < cx ? 1.5 : 2.5);
+  }
+  tc::Field vf{"potential", 1, {}};
+  for (int64_t v = 0; v < m.num_vertices(); ++v) vf.values.push_back(m.points[size_t(3 * v)] + 2 * m.points[size_t(3 * v + 1)]);
+  m.tet_labels.push_back(lab);
+  m.tet_fields.push_back(tf);
+  m.vertex_fields.push_back(vf);
+  tc::write_mesh(dir.file("in.vtu"), m);
+  const Mesh input = tc::read_mesh(dir.file("in.vtu"));
+
+  std::string log;
+  ASSERT_EQ(run_mpi(GetParam(), dir.file("in.vtu") + " " + dir.file("out.vtu") + " --target-factor 2 -q", &log), 0) << log;
+  const Mesh out = tc::read_mesh(dir.file("out.vtu"));
+  EXPECT_LT(out.num_tets(), input.num_tets() / 2);
+  ASSERT_NE(out.find_labels("material"), nullptr);
+  std::set<int32_t> labels(out.find_labels("material")->values.begin(), out.find_labels("material")->values.end());
+  EXPECT_EQ(labels, (std::set<int32_t>{7, 9}));
+  const tc::CheckReport r = tc::check_mesh(out, {}, &input);
+  EXPECT_TRUE(r.valid) << tc::check_report_text(r);
+  ASSERT_EQ(r.reference.labels.size(), 2u);
+  for (const tc::LabelVolume& l : r.reference.labels)
+    EXPECT_LT(std::abs(l.change_rel), 0.01) << "label " << l.label << " changed its volume by " << l.change_rel;
+  ASSERT_EQ(out.vertex_fields.size(), 1u) << "only the input's field (the tool's own id field is gone)";
+  const tc::Field* pot = out.find_vertex_field("potential");
+  ASSERT_NE(pot, nullptr);
+  ASSERT_EQ(pot->values.size(), size_t(out.num_vertices()));
+  // Exact (to rounding) inside; a boundary vertex on a curved face may lie a little off the
+  // input's surface (the improvement moves it by up to 0.001 x the diagonal) and takes the value
+  // at the nearest point of the input.
+  const auto range = std::minmax_element(vf.values.begin(), vf.values.end());
+  const double boundary_tol = 0.01 * (*range.second - *range.first);
+  std::set<std::array<double, 3>> boundary_points;
+  for (const auto& f : boundary_faces(out)) boundary_points.insert(f.begin(), f.end());
+  std::vector<uint8_t> on_boundary(size_t(out.num_vertices()), 0);
+  for (int64_t v = 0; v < out.num_vertices(); ++v) on_boundary[size_t(v)] = boundary_points.count(out.point(v));
+  for (int64_t v = 0; v < out.num_vertices(); ++v)
+    ASSERT_NEAR(pot->values[size_t(v)], out.points[size_t(3 * v)] + 2 * out.points[size_t(3 * v + 1)],
+                on_boundary[size_t(v)] ? boundary_tol : 1e-9)
+        << "vertex " << v << (on_boundary[size_t(v)] ? " (boundary)" : " (interior)");
+  ASSERT_EQ(out.tet_fields.size(), 1u);
+  ASSERT_EQ(out.tet_fields[0].values.size(), size_t(out.num_tets()));
+  const auto& mat = out.find_labels("material")->values;
+  for (int64_t t = 0; t < out.num_tets(); ++t)
+    ASSERT_EQ(out.tet_fields[0].values[size_t(t)], mat[size_t(t)] == 7 ? 1.5 : 2.5) << "tet " << t;
+}
+
+// The same input, options and ranks: the same file, byte for byte.
+TEST_P(MpiTool, SameOutputTwice) {
+  TempDir dir;
+  const std::string in = tc::test::project_mesh("bracket.msh");
+  std::string log;
+  for (const char* out : {"a.msh", "b.msh"})
+    ASSERT_EQ(run_mpi(GetParam(), in + " " + dir.file(out) + " --target-factor 2 -q", &log), 0) << log;
+  const std::string a = tc::test::read_text(dir.file("a.msh")), b = tc::test::read_text(dir.file("b.msh"));
+  EXPECT_GT(a.size(), 1000u);
+  EXPECT_TRUE(a == b) << "two runs with " << GetParam() << " ranks differ";
+}
+
+INSTANTIATE_TEST_SUITE_P(Ranks, MpiTool, ::testing::Values(2, 3), [](const auto& info) {
+  return std::to_string(info.param) + "ranks";
+});
+
+// One rank: the whole mesh is the part, nothing is frozen: what tetcollapse gives, bit for bit.
+TEST(MpiToolOneRank, SameAsSingleDevice) {
+  TempDir dir;
+  const std::string in = tc::test::project_mesh("bracket.msh");
+  std::string log;
+  ASSERT_EQ(run_single(in + " " + dir.file("single.msh") + " --target-factor 2 -q", &log), 0) << log;
+  ASSERT_EQ(run_mpi(1, in + " " + dir.file("mpi.msh") + " --target-factor 2 -q", &log), 0) << log;
+  tc::test::expect_same_mesh(tc::read_mesh(dir.file("single.msh")), tc::read_mesh(dir.file("mpi.msh")), "one rank");
+}
+
+// Exit codes as the README's, on every rank; nothing written on failure.
+TEST(MpiToolErrors, ExitCodesAndNothingWritten) {
+  TempDir dir;
+  const std::string in = tc::test::project_mesh("bracket.msh");
+  std::string log;
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --max-boundary-error 0.001", &log), 2);
+  EXPECT_NE(log.find("--max-boundary-error: not supported by tetcollapse-mpi"), std::string::npos) << log;
+  EXPECT_EQ(run_mpi(2, dir.file("missing.msh") + " " + dir.file("o.msh") + " -q", &log), 2);
+  EXPECT_NE(log.find("missing.msh"), std::string::npos) << log;
+  tc::test::write_text(dir.file("bad.msh"), "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n2\n1 0 0\n");
+  EXPECT_EQ(run_mpi(2, dir.file("bad.msh") + " " + dir.file("o.msh") + " -q", &log), 2);
+  EXPECT_NE(log.find("bad.msh:5:"), std::string::npos) << "the file and line: " << log;
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --device no-such-device -q", &log), 3);
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("nowhere/o.msh") + " -q", &log), 4);
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --no-such-option", &log), 2);
+  EXPECT_EQ(run_mpi(2, "--help", &log), 0);
+  EXPECT_NE(log.find("--round-threshold"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("o.msh")));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1)
+      << "only bad.msh is left";
+}
+
+}  // namespace
