@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "tetcollapse/check.hpp"
+#include "tetcollapse/coarsen.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/device.hpp"
 #include "tetcollapse/error.hpp"
@@ -101,39 +102,39 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
                      py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets, double target_factor,
                      py::object target_length, const std::string& boundary, py::object labels,
                      py::object vertex_fields, py::object device, const std::string& method, bool improve_phase,
-                     double min_quality, double max_boundary_error, bool average_fields) {
+                     double min_quality, double max_boundary_error, bool average_fields,
+                     const std::string& preserve_field, double field_tolerance, double max_field_error,
+                     const std::string& sizing_field) {
   Mesh mesh = from_numpy(points, tets, labels, vertex_fields);
-  Mesh input;  // the fields' values at new places come from it
-  if (!mesh.vertex_fields.empty() && !average_fields) input = mesh;
-  CollapseOptions o;
+  CoarsenOptions co;
+  CollapseOptions& o = co.collapse;
   o.target_factor = target_factor;
   if (!target_length.is_none()) o.target_length = target_length.cast<double>();
   o.boundary = boundary_of(boundary);
   o.min_quality = min_quality;
   o.max_boundary_error = max_boundary_error;
+  o.max_field_error = max_field_error;
+  co.improve = improve_phase;
+  co.resample_fields = !average_fields;
+  co.preserve_field = preserve_field;
+  co.field_tolerance = field_tolerance;
+  co.sizing_field = sizing_field;
   if (method != "parallel" && method != "sequential")
     throw InputError("<method>", "method must be 'parallel' or 'sequential', not '" + method + "'");
   std::unique_ptr<Context> ctx;
-  CollapseReport r;
-  ImproveReport ir;
+  CoarsenReport cr;
   {
     py::gil_scoped_release release;
     if (method == "sequential") {
       o.method = CollapseOptions::Sequential;
-      r = collapse_sequential(mesh, o);
     } else {
       ctx = std::make_unique<Context>(device.is_none() ? std::string() : device.cast<std::string>());
-      r = collapse(mesh, o, *ctx);
     }
-    if (improve_phase) {
-      ImproveOptions io;
-      io.boundary = o.boundary;
-      if (r.boundary_error_bound > 0)
-        io.max_boundary_error_abs = std::max(r.boundary_error_bound - r.boundary_error, 1e-300);
-      ir = ctx ? improve(mesh, io, *ctx) : improve(mesh, io);
-    }
-    if (!average_fields && !mesh.vertex_fields.empty()) resample_vertex_fields(input, mesh);
+    cr = coarsen(mesh, co, ctx.get());
   }
+  const CollapseReport& r = cr.collapse;
+  const ImproveReport& ir = cr.improvement;
+  improve_phase = cr.improved;
   py::dict stats;
   stats["vertices_in"] = r.vertices_in;
   stats["tets_in"] = r.tets_in;
@@ -145,6 +146,8 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
   stats["seconds_collapse"] = r.seconds_total;
   stats["boundary_error_bound"] = r.boundary_error_bound;
   stats["boundary_error"] = r.boundary_error;
+  stats["field_error_bound"] = r.field_error_bound;
+  stats["field_error"] = r.field_error;
   if (improve_phase) {
     stats["seconds_improve"] = ir.seconds_total;
     stats["quality_before_improve"] = quality_dict(ir.before);
@@ -214,7 +217,8 @@ PYBIND11_MODULE(_core, mod) {
           py::arg("target_length") = py::none(), py::arg("boundary") = "features", py::arg("labels") = py::none(),
           py::arg("vertex_fields") = py::none(), py::arg("device") = py::none(), py::arg("method") = "parallel",
           py::arg("improve") = true, py::arg("min_quality") = 0.1, py::arg("max_boundary_error") = 0.0,
-          py::arg("average_fields") = false,
+          py::arg("average_fields") = false, py::arg("preserve_field") = "", py::arg("field_tolerance") = 0.02,
+          py::arg("max_field_error") = 0.0, py::arg("sizing_field") = "",
           "Coarsens a tet mesh; returns a dict: points, tets, labels (if given), vertex_fields, stats.");
   mod.def("improve", &improve_py, py::arg("points"), py::arg("tets"), py::kw_only(), py::arg("boundary") = "features",
           py::arg("labels") = py::none(), py::arg("vertex_fields") = py::none(), py::arg("device") = py::none(),

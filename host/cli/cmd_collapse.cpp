@@ -12,6 +12,7 @@
 #include "io/io_util.hpp"
 #include "json.hpp"
 #include "stopwatch.hpp"
+#include "tetcollapse/coarsen.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/fields.hpp"
 
@@ -19,18 +20,7 @@ namespace tc::cli {
 
 namespace {
 // Moves the vertex field `name` to the front (the user cost sees the first); returns where it was.
-size_t field_first(Mesh& mesh, const std::string& file, const std::string& name) {
-  for (size_t i = 0; i < mesh.vertex_fields.size(); ++i)
-    if (mesh.vertex_fields[i].name == name) {
-      std::swap(mesh.vertex_fields[0], mesh.vertex_fields[i]);
-      return i;
-    }
-  throw InputError(file, "no vertex field named '" + name + "'");
-}
 }  // namespace
-
-// The share of a boundary error bound the collapse may use when the improvement phase follows.
-constexpr double kCollapseShareOfBound = 0.75;
 
 void write_report(const std::string& path, const std::string& text);  // cmd_check.cpp
 
@@ -381,50 +371,28 @@ void register_collapse(CLI::App& app, int& exit_code) {
     if (c->target_factor > 0) opt.target_factor = c->target_factor;
     if (!c->region.empty()) combine(opt.vertex_mask, region_mask(mesh, c->region));
     if (!c->labels.empty()) combine(opt.vertex_mask, label_mask(mesh, c->labels));
-    size_t sizing_index = 0;
+    CoarsenOptions co;
+    co.preserve_field = c->preserve_field;
+    co.sizing_field = c->sizing_field;
+    co.field_tolerance = c->field_tolerance;
+    co.resample_fields = !c->average_fields;
     if (!c->cost_cl.empty()) {
       if (!c->sizing_field.empty() || !c->preserve_field.empty())
         throw CLI::ValidationError("--cost-cl", "cannot be combined with --sizing-field or --preserve-field");
       opt.cost_cl_source = cl_file(c->cost_cl);
       if (opt.target_length <= 0) throw CLI::ValidationError("--cost-cl", "needs --target-length");
-    } else if (!c->preserve_field.empty() && opt.max_field_error > 0) {
-      if (!c->sizing_field.empty())
-        throw CLI::ValidationError("--preserve-field", "cannot be combined with --sizing-field");
+    }
+    if (!c->preserve_field.empty() && !c->sizing_field.empty())
+      throw CLI::ValidationError("--preserve-field", "cannot be combined with --sizing-field");
+    for (const std::string* name : {&c->preserve_field, &c->sizing_field})
+      if (!name->empty() && !mesh.find_vertex_field(*name))
+        throw InputError(c->in, "no vertex field named '" + *name + "'");
+    if (opt.max_field_error > 0) {
       if (c->field_tolerance_option->count() > 0)
         throw CLI::ValidationError("--field-tolerance", "cannot be combined with --max-field-error (the bound decides)");
-      if (!mesh.find_vertex_field(c->preserve_field))
-        throw InputError(c->in, "no vertex field named '" + c->preserve_field + "'");
-      opt.bounded_field = c->preserve_field;
+      // the bound alone decides, unless a target is given
       if (opt.target_length <= 0 && c->target_factor > 0)
         opt.target_length = c->target_factor * median_edge_length(mesh);
-      c->no_improve = true;
-    } else if (!c->preserve_field.empty()) {
-      if (!c->sizing_field.empty())
-        throw CLI::ValidationError("--preserve-field", "cannot be combined with --sizing-field");
-      // The paper's cost for volume rendering, |Phi(v0) - Phi(v1)|, on the named field, which
-      // goes first (the cost sees the first vertex field) for the run; edges below
-      // T x (max Phi - min Phi) are collapsed.
-      sizing_index = field_first(mesh, c->in, c->preserve_field);
-      const std::vector<double>& phi = mesh.vertex_fields[0].values;
-      const size_t nc = size_t(mesh.vertex_fields[0].components);
-      double lo = INFINITY, hi = -INFINITY;
-      for (size_t i = 0; i < phi.size(); i += nc) {
-        lo = std::min(lo, phi[i]);
-        hi = std::max(hi, phi[i]);
-      }
-      opt.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return fabs(f0 - f1); }\n";
-      opt.target_length = c->field_tolerance * (hi - lo);
-      if (!(opt.target_length > 0))
-        throw InputError(c->in, "vertex field '" + c->preserve_field + "' is constant: nothing bounds a collapse");
-    } else if (!c->sizing_field.empty()) {
-      // The user cost sees the first vertex field: move the sizing field there for the run.
-      sizing_index = field_first(mesh, c->in, c->sizing_field);
-      opt.cost_cl_source =
-          "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) {\n"
-          "  double h = 0.5 * (f0 + f1);\n"
-          "  return h > 0.0 ? length(p1 - p0) / h : INFINITY;\n"
-          "}\n";
-      opt.target_length = 1.0;
     }
     if (!c->quiet)
       opt.progress = [](const IterationStats& it) {
@@ -440,54 +408,30 @@ void register_collapse(CLI::App& app, int& exit_code) {
     const bool report_quality = !c->quiet || !c->stats.empty();
     QualitySummary quality_in, quality_collapsed;
     if (report_quality) quality_in = quality_summary(mesh);
-    CollapseReport r;
-    std::unique_ptr<Context> ctx;  // the improvement's too
-    // With a boundary error bound and the improvement phase, the collapse keeps a share of it
-    // for the improvement's boundary moves (which remove the slivers at a curved surface).
-    CollapseOptions co = opt;
-    const double bound = boundary_error_bound(mesh, opt);
-    if (bound > 0 && !c->no_improve) {
-      co.max_boundary_error_abs = kCollapseShareOfBound * bound;
-      co.max_boundary_error = 0;
-    }
+    std::unique_ptr<Context> ctx;
     if (opt.method == CollapseOptions::Sequential) {
       if (!c->quiet) std::cerr << "method: sequential (CPU)\n";
-      r = collapse_sequential(mesh, co);
     } else {
       ctx = open_device(c->device, c->quiet);
-      r = collapse(mesh, co, *ctx);
     }
-    if (bound > 0) r.boundary_error_bound = bound;
-    if (!c->sizing_field.empty() || !c->preserve_field.empty())
-      std::swap(mesh.vertex_fields[0], mesh.vertex_fields[sizing_index]);
-    // A user's predicate or placement states rules the improvement cannot know: no phase then.
-    if (!opt.predicate_cl_source.empty() || !opt.placement_cl_source.empty()) c->no_improve = true;
-    if (report_quality && c->no_improve) quality_collapsed = quality_summary(mesh);
-    ImproveReport ir;
-    if (!c->no_improve) {
-      ImproveOptions& io = c->improve.opt;
-      io.boundary = opt.boundary;
-      io.eps_f = opt.eps_f;
-      io.eps_r = opt.eps_r;
-      io.use_labels = opt.use_labels;
-      // what the collapse left of the boundary error bound (DBL_MIN: only exact changes)
-      if (r.boundary_error_bound > 0)
-        io.max_boundary_error_abs =
-            std::max(r.boundary_error_bound - r.boundary_error, std::numeric_limits<double>::min());
-      // --region, --labels: improve there only (the masks of the coarse mesh)
-      if (!c->region.empty()) combine(io.vertex_mask, region_mask(mesh, c->region));
-      if (!c->labels.empty()) combine(io.vertex_mask, label_mask(mesh, c->labels));
-      ir = run_improve(mesh, c->improve, c->quiet, ctx.get());
-      quality_collapsed = ir.before;
-      // the output's counts (the improvement's collapse step may remove a few more)
-      r.vertices_out = mesh.num_vertices();
-      r.tets_out = mesh.num_tets();
-    }
-    int64_t outside = 0;
-    if (resample) outside = resample_vertex_fields(input, mesh);
-    if (outside > 0 && !c->quiet)
+    co.collapse = opt;
+    co.improve = !c->no_improve;
+    co.improvement = improve_options(c->improve, c->quiet);
+    // --region, --labels: improve there only (the masks of the coarse mesh)
+    co.improve_mask = [c](const Mesh& coarse) {
+      std::vector<uint8_t> mask;
+      if (!c->region.empty()) combine(mask, region_mask(coarse, c->region));
+      if (!c->labels.empty()) combine(mask, label_mask(coarse, c->labels));
+      return mask;
+    };
+    const CoarsenReport cr = coarsen(mesh, co, ctx.get(), input.num_tets() > 0 ? &input : nullptr);
+    const CollapseReport& r = cr.collapse;
+    const ImproveReport& ir = cr.improvement;
+    c->no_improve = !cr.improved;
+    if (report_quality) quality_collapsed = cr.improved ? ir.before : quality_summary(mesh);
+    if (cr.outside > 0 && !c->quiet)
       std::fprintf(stderr, "note: %lld vertices lie outside the input; their fields come from the nearest tet\n",
-                   (long long)outside);
+                   (long long)cr.outside);
 
     const std::string verdict =
         c->check ? check_result(mesh, input, opt.boundary == CollapseOptions::Strict, c->quiet, exit_code) : "";

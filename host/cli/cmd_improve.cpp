@@ -42,7 +42,7 @@ std::string quality_line(const QualitySummary& q) {
   return buf;
 }
 
-ImproveReport run_improve(Mesh& mesh, ImproveCli& c, bool quiet, Context* ctx) {
+const ImproveOptions& improve_options(ImproveCli& c, bool quiet) {
   c.opt.flips = !c.no_flips;
   c.opt.smoothing = !c.no_smoothing;
   c.opt.collapse = !c.no_collapse;
@@ -56,7 +56,12 @@ ImproveReport run_improve(Mesh& mesh, ImproveCli& c, bool quiet, Context* ctx) {
                    (long long)s.relocated, (long long)s.collapsed, s.min_dihedral_deg, (long long)s.below_10_deg,
                    (long long)s.below_13_deg, s.seconds);
     };
-  return ctx ? improve(mesh, c.opt, *ctx) : improve(mesh, c.opt);
+  return c.opt;
+}
+
+ImproveReport run_improve(Mesh& mesh, ImproveCli& c, bool quiet, Context* ctx) {
+  const ImproveOptions& o = improve_options(c, quiet);
+  return ctx ? improve(mesh, o, *ctx) : improve(mesh, o);
 }
 
 void write_quality(JsonWriter& w, std::string_view key, const QualitySummary& q) {

@@ -14,6 +14,8 @@ struct ImproveCli {
   bool no_flips = false, no_smoothing = false, no_collapse = false;
 };
 void add_improve_options(CLI::App& cmd, ImproveCli& c);
+// The options the flags give, with progress lines on stderr unless quiet.
+const ImproveOptions& improve_options(ImproveCli& c, bool quiet);
 // Runs the phase with progress lines on stderr unless quiet.
 // With a context, the relocation runs on its device (tc::improve's overloads).
 ImproveReport run_improve(Mesh& mesh, ImproveCli& c, bool quiet, Context* ctx);

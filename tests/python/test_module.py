@@ -51,6 +51,26 @@ class Module(unittest.TestCase):
             self.assertEqual(out["stats"]["tets_out"], out["tets"].shape[0])
             self.assertTrue(tetcollapse.check(out["points"], out["tets"])["valid"])
 
+    def test_field_options_of_the_command_line(self):
+        points, tets = cube(8)
+        rng = np.random.default_rng(5)
+        inner = (points > 0) & (points < 1)
+        points = points + np.where(inner, rng.uniform(-0.03, 0.03, points.shape), 0)
+        bump = np.exp(-10 * ((points[:, 0] - 0.4) ** 2 + (points[:, 1] - 0.6) ** 2)) + points[:, 2]
+        out = tetcollapse.collapse(points, tets, vertex_fields={"rho": bump}, preserve_field="rho",
+                                   max_field_error=0.02)
+        st = out["stats"]
+        self.assertLess(out["points"].shape[0], points.shape[0])
+        self.assertEqual(st["field_error_bound"], 0.02)
+        self.assertLessEqual(st["field_error"], 0.02)
+        self.assertGreater(st["field_error"], 0.0)
+        self.assertNotIn("quality_before_improve", st, "no improvement phase under the field bound")
+        tol = tetcollapse.collapse(points, tets, vertex_fields={"rho": bump}, preserve_field="rho",
+                                   field_tolerance=0.05)
+        self.assertLess(tol["points"].shape[0], points.shape[0])
+        with self.assertRaises(ValueError):
+            tetcollapse.collapse(points, tets, vertex_fields={"rho": bump}, preserve_field="nope")
+
     def test_improve_and_check(self):
         points, tets = cube(5)
         rng = np.random.default_rng(3)

@@ -1,0 +1,117 @@
+// The coarsening command as one library call (tetcollapse/coarsen.hpp).
+#include "tetcollapse/coarsen.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <utility>
+
+#include "tetcollapse/fields.hpp"
+
+namespace tc {
+
+namespace {
+
+size_t field_index(const Mesh& mesh, const std::string& name, const char* option) {
+  for (size_t i = 0; i < mesh.vertex_fields.size(); ++i)
+    if (mesh.vertex_fields[i].name == name) return i;
+  throw std::invalid_argument(std::string(option) + ": no vertex field named '" + name + "'");
+}
+
+// The user cost sees the first vertex field: the one that drives the cost goes first for the
+// run (and back after it).
+struct FieldFirst {
+  Mesh& mesh;
+  size_t index = 0;
+  FieldFirst(Mesh& m, size_t i) : mesh(m), index(i) { std::swap(mesh.vertex_fields[0], mesh.vertex_fields[index]); }
+  ~FieldFirst() { std::swap(mesh.vertex_fields[0], mesh.vertex_fields[index]); }
+};
+
+}  // namespace
+
+CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, const Mesh* original) {
+  CollapseOptions co = options.collapse;
+  if (!ctx && co.method != CollapseOptions::Sequential)
+    throw std::invalid_argument("coarsen: the parallel method needs a device context");
+  const bool by_field = !options.preserve_field.empty() || !options.sizing_field.empty();
+  if (!options.preserve_field.empty() && !options.sizing_field.empty())
+    throw std::invalid_argument("preserve_field and sizing_field cannot be combined");
+  if (by_field && !co.cost_cl_source.empty())
+    throw std::invalid_argument("preserve_field and sizing_field replace the cost: not with cost_cl_source");
+  if (co.max_field_error > 0 && options.preserve_field.empty() && co.bounded_field.empty())
+    throw std::invalid_argument("max_field_error needs preserve_field (the field it bounds)");
+
+  // the vertex fields' values at new places come from the input
+  const bool resample = options.resample_fields && !mesh.vertex_fields.empty();
+  Mesh copy;
+  if (resample && !original) copy = mesh;
+  const Mesh& input = original ? *original : copy;
+  size_t first = 0;
+  if (!options.preserve_field.empty() && co.max_field_error > 0) {
+    field_index(mesh, options.preserve_field, "preserve_field");
+    co.bounded_field = options.preserve_field;
+  } else if (!options.preserve_field.empty()) {
+    // the paper's cost |Phi(v0) - Phi(v1)| below T x (max Phi - min Phi)
+    first = field_index(mesh, options.preserve_field, "preserve_field");
+    const Field& f = mesh.vertex_fields[first];
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < f.values.size(); i += size_t(f.components)) {
+      lo = std::min(lo, f.values[i]);
+      hi = std::max(hi, f.values[i]);
+    }
+    co.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return fabs(f0 - f1); }\n";
+    co.target_length = options.field_tolerance * (hi - lo);
+    if (!(co.target_length > 0))
+      throw std::invalid_argument("vertex field '" + options.preserve_field + "' is constant: nothing bounds a collapse");
+  } else if (!options.sizing_field.empty()) {
+    first = field_index(mesh, options.sizing_field, "sizing_field");
+    co.cost_cl_source =
+        "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) {\n"
+        "  double h = 0.5 * (f0 + f1);\n"
+        "  return h > 0.0 ? length(p1 - p0) / h : INFINITY;\n"
+        "}\n";
+    co.target_length = 1.0;
+  }
+  // A user's predicate or placement states rules the improvement cannot know; the improvement's
+  // moves are not checked against a field error bound.
+  const bool improve_phase = options.improve && co.predicate_cl_source.empty() && co.placement_cl_source.empty() &&
+                             !(co.max_field_error > 0);
+  const double bound = boundary_error_bound(mesh, co);
+  if (bound > 0 && improve_phase) {
+    co.max_boundary_error_abs = kCollapseShareOfBound * bound;
+    co.max_boundary_error = 0;
+  }
+
+  CoarsenReport r;
+  {
+    const bool cost_by_field = !co.cost_cl_source.empty() && by_field && !(co.max_field_error > 0);
+    std::optional<FieldFirst> front;
+    if (cost_by_field) front.emplace(mesh, first);
+    r.collapse = co.method == CollapseOptions::Sequential ? collapse_sequential(mesh, co) : collapse(mesh, co, *ctx);
+  }
+  if (bound > 0) r.collapse.boundary_error_bound = bound;
+
+  if (improve_phase) {
+    ImproveOptions io = options.improvement;
+    io.boundary = co.boundary;
+    io.eps_f = co.eps_f;
+    io.eps_r = co.eps_r;
+    io.use_labels = co.use_labels;
+    // what the collapse left of the boundary error bound (DBL_MIN: only exact changes)
+    if (bound > 0)
+      io.max_boundary_error_abs =
+          std::max(bound - r.collapse.boundary_error, std::numeric_limits<double>::min());
+    if (options.improve_mask) io.vertex_mask = options.improve_mask(mesh);
+    r.improvement = ctx ? improve(mesh, io, *ctx) : improve(mesh, io);
+    r.improved = true;
+    // the output's counts (the improvement's collapse step may remove a few more)
+    r.collapse.vertices_out = mesh.num_vertices();
+    r.collapse.tets_out = mesh.num_tets();
+  }
+  if (resample) r.outside = resample_vertex_fields(input, mesh);
+  return r;
+}
+
+}  // namespace tc

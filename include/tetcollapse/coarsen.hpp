@@ -1,0 +1,66 @@
+// What `tetcollapse IN OUT` does, in one call (the command line and the Python module call it):
+//
+//   coarsen(mesh, options, ctx):
+//     a field named by preserve_field or sizing_field drives the collapse's cost (or, with
+//       collapse.max_field_error, the field error bound)
+//     collapse (collapse.hpp), keeping a share of a boundary error bound for the next phase
+//     improve (improve.hpp) with the boundary mode, thresholds and what is left of the bound,
+//       unless improve is false, a user predicate or placement states rules the improvement
+//       cannot know, or the field error bound is on (the improvement's moves are not checked
+//       against it)
+//     every vertex field from the input at each vertex's final place (fields.hpp)
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/improve.hpp"
+#include "tetcollapse/mesh.hpp"
+
+namespace tc {
+
+struct CoarsenOptions {
+  CollapseOptions collapse;
+  // The improvement phase after the collapse. Its boundary mode, eps_f, eps_r and use_labels are
+  // the collapse's, and its boundary error bound what the collapse left of the bound.
+  bool improve = true;
+  ImproveOptions improvement;
+  // The vertices of the coarse mesh the improvement may change (non-zero = yes), e.g. those of
+  // a region; unset: every vertex.
+  std::function<std::vector<uint8_t>(const Mesh&)> improve_mask;
+  // Vertex fields at the end: the input's piecewise linear field at each vertex's final place
+  // (true), or the average of a collapsed edge's ends (false).
+  bool resample_fields = true;
+  // Volume rendering (the paper's Section 4.5): an edge is collapsed when this vertex field
+  // differs between its ends by less than field_tolerance x its range, or, with
+  // collapse.max_field_error, while the field stays within that bound at every input vertex.
+  std::string preserve_field;
+  double field_tolerance = 0.02;
+  // A vertex field giving the wanted edge length: an edge is collapsed when shorter than the
+  // field's mean at its ends.
+  std::string sizing_field;
+};
+
+struct CoarsenReport {
+  CollapseReport collapse;
+  bool improved = false;      // whether the improvement phase ran
+  ImproveReport improvement;  // its report, when it ran
+  int64_t outside = 0;        // vertices outside the input whose fields came from the nearest tet
+};
+
+// The share of a boundary error bound the collapse may use when the improvement phase follows
+// (the rest is for the improvement's boundary moves, which remove the slivers at a curved
+// surface).
+constexpr double kCollapseShareOfBound = 0.75;
+
+// Coarsens `mesh` in place as described above. With ctx null, the collapse must use the
+// sequential method (CollapseOptions::Sequential) and the improvement runs on the CPU.
+// Throws as collapse() and improve() do; std::invalid_argument for a field option naming no
+// vertex field or combined with a user cost. `input`: the mesh as it was before the call, when
+// the caller keeps a copy anyway (the fields are resampled from it instead of a copy of its own).
+CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, const Mesh* input = nullptr);
+
+}  // namespace tc
