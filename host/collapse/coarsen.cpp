@@ -61,7 +61,7 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
       lo = std::min(lo, f.values[i]);
       hi = std::max(hi, f.values[i]);
     }
-    co.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return fabs(f0 - f1); }\n";
+    co.field_difference_cost = true;
     co.target_length = options.field_tolerance * (hi - lo);
     if (!(co.target_length > 0))
       throw std::invalid_argument("vertex field '" + options.preserve_field + "' is constant: nothing bounds a collapse");
@@ -86,7 +86,7 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
 
   CoarsenReport r;
   {
-    const bool cost_by_field = !co.cost_cl_source.empty() && by_field && !(co.max_field_error > 0);
+    const bool cost_by_field = by_field && !(co.max_field_error > 0);
     std::optional<FieldFirst> front;
     if (cost_by_field) front.emplace(mesh, first);
     r.collapse = co.method == CollapseOptions::Sequential ? collapse_sequential(mesh, co) : collapse(mesh, co, *ctx);

@@ -25,7 +25,11 @@ StageParams params_from(const CollapseOptions& o) {
   static_cast<CheckParams&>(p) = check_params_from(o);
   p.priority_levels = o.tuning.priority_levels;
   p.mask_mode = o.vertex_mask.empty() ? 0 : o.mask_either ? 2 : 1;
-  p.cost_source = o.cost_cl_source;
+  // the field difference is the user cost's slot filled by the library (sequential.cpp has its
+  // host twin)
+  p.cost_source = o.field_difference_cost
+                      ? "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return fabs(f0 - f1); }\n"
+                      : o.cost_cl_source;
   // (#line: the compiler's messages give the line in the user's source, under its option's name)
   if (!o.placement_cl_source.empty()) {
     p.user_source += "#line 1 \"placement_cl_source\"\n" + o.placement_cl_source + "\n";
@@ -45,6 +49,10 @@ void check_options(const CollapseOptions& o, const Context& ctx) {
     throw std::invalid_argument("selection_rounds > 1 needs the two-pass conflict detection");
   if (!(o.tuning.priority_levels >= 0) || !std::isfinite(o.tuning.priority_levels))
     throw std::invalid_argument("priority_levels must be finite and >= 0");
+  if (o.field_difference_cost && !o.cost_cl_source.empty())
+    throw std::invalid_argument("field_difference_cost and cost_cl_source are two costs: choose one");
+  if (o.field_difference_cost && !(o.target_length > 0))
+    throw std::invalid_argument("field_difference_cost needs an explicit target_length > 0");
   if (!o.cost_cl_source.empty() && !(o.target_length > 0))
     throw std::invalid_argument("a user cost (cost_cl_source) needs an explicit target_length > 0");
   if (!(o.target_length > 0) && !(o.target_factor > 0))

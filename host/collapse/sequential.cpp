@@ -42,6 +42,8 @@ SeqParams checked_params(const Mesh& mesh, const CollapseOptions& o) {
         "does not bound it)");
   if (!(o.max_field_error >= 0) || std::isinf(o.max_field_error))
     throw std::invalid_argument("max_field_error must be finite and >= 0");
+  if (o.field_difference_cost && (!(o.target_length > 0) || mesh.vertex_fields.empty()))
+    throw std::invalid_argument("field_difference_cost needs an explicit target_length > 0 and a vertex field");
   SeqParams p = seq_params_from(o);
   p.eps_v = volume_threshold(mesh, o);  // as collapse() computes it
   // With a bound, a smoothly curved face's vertices are face vertices: the bound decides.
@@ -148,7 +150,7 @@ bool SequentialRun::step() {
     // renumbered by the compaction; an edge gone since is dropped by is_edge).
     for (size_t i = 0; i + 1 < refused_.size(); i += 2) {
       const int32_t a = std::min(refused_[i], refused_[i + 1]), b = std::max(refused_[i], refused_[i + 1]);
-      if (sm_.is_edge(a, b)) edges_.push_back({sm_.length(a, b), a, b, 0});
+      if (sm_.is_edge(a, b)) edges_.push_back({cost(a, b), a, b, 0});
     }
     std::sort(edges_.begin(), edges_.end(), [](const QueueEntry& x, const QueueEntry& y) {
       return x.a != y.a ? x.a < y.a : x.b < y.b;
@@ -160,14 +162,14 @@ bool SequentialRun::step() {
     edges_.reserve(seed_edges_.size() / 2);
     for (size_t i = 0; i + 1 < seed_edges_.size(); i += 2) {
       const int32_t a = seed_edges_[i], b = seed_edges_[i + 1];
-      edges_.push_back({sm_.length(a, b), a, b, 0});
+      edges_.push_back({cost(a, b), a, b, 0});
     }
     seed_edges_ = {};
   } else {
     const int32_t nv = sm_.num_vertices();
     for (int32_t v = 0; v < nv; ++v) {
       sm_.neighbours(v, nb_, true);
-      for (int32_t u : nb_) edges_.push_back({sm_.length(v, u), v, u, 0});
+      for (int32_t u : nb_) edges_.push_back({cost(v, u), v, u, 0});
     }
   }
   s.edges = int64_t(edges_.size());
@@ -189,9 +191,9 @@ bool SequentialRun::step() {
   const bool reuse = o_.tuning.reuse_across_iterations;
   const uint32_t prev = uint32_t(it_);  // touched_ value of the previous iteration (0: the input)
   const int mask_mode = mask_.empty() ? 0 : o_.mask_either ? 2 : 1;
-  auto marked = [&](int32_t a, int32_t b, double cost) {
+  auto marked = [&](int32_t a, int32_t b, double c) {
     const bool allowed = mask_mode == 0 ? true : mask_mode == 1 ? (mask_[a] && mask_[b]) : (mask_[a] || mask_[b]);
-    return allowed && cost < target_;
+    return allowed && c < target_;
   };
   heap_.clear();
   for (const QueueEntry& e : edges_) {
@@ -229,11 +231,11 @@ bool SequentialRun::step() {
     if (invalidated && o_.sequential_skip_invalidated && !greedy_) continue;
     if (!reuse || invalidated) {
       if (!sm_.is_edge(e.a, e.b)) continue;
-      const double cost = sm_.length(e.a, e.b);
-      if (!marked(e.a, e.b, cost)) continue;
-      if (cost != e.cost) {  // an end point moved: back into the queue at its new place
+      const double c = cost(e.a, e.b);
+      if (!marked(e.a, e.b, c)) continue;
+      if (c != e.cost) {  // an end point moved: back into the queue at its new place
         if (greedy_) queued_.insert(key(e.a, e.b));
-        heap_.push_back({cost, e.a, e.b, 0});
+        heap_.push_back({c, e.a, e.b, 0});
         std::push_heap(heap_.begin(), heap_.end(), later);
         continue;
       }
@@ -283,10 +285,10 @@ bool SequentialRun::step() {
           // each edge once per collapse: from its lower end point when both are touched
           if (w < u && greedy_mark_[w] == greedy_stamp_) continue;
           const int32_t a = std::min(u, w), b = std::max(u, w);
-          const double cost = sm_.length(a, b);
-          if (!marked(a, b, cost)) continue;
+          const double c = cost(a, b);
+          if (!marked(a, b, c)) continue;
           if (!queued_.insert(key(a, b))) continue;  // already queued (popped: tested again)
-          heap_.push_back({cost, a, b, 0});
+          heap_.push_back({c, a, b, 0});
           std::push_heap(heap_.begin(), heap_.end(), later);
         }
       }

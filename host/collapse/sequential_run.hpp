@@ -43,6 +43,7 @@
 #pragma once
 
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -98,6 +99,14 @@ class SequentialRun {
   double target() const { return target_; }
 
  private:
+  // The edge's cost: its length, or CollapseOptions::field_difference_cost's |f0 - f1| (the
+  // device's, params.cpp: the first component of the first vertex field).
+  double cost(int32_t a, int32_t b) const {
+    if (!o_.field_difference_cost) return sm_.length(a, b);
+    const Field& f = mesh_.vertex_fields[0];
+    return std::fabs(f.values[size_t(a) * size_t(f.components)] - f.values[size_t(b) * size_t(f.components)]);
+  }
+
   struct QueueEntry {
     double cost;
     int32_t a, b;  // a < b

@@ -250,6 +250,12 @@ struct CollapseOptions {
   std::vector<uint8_t> vertex_mask;
   bool mask_either = false;
 
+  // The paper's cost for volume rendering (Section 4.5): |f0 - f1|, the first component of the
+  // first vertex field at the two ends, instead of the length; edges below target_length (> 0,
+  // required) are marked. Unlike the same cost as a cost_cl_source, the host tail and the
+  // sequential method evaluate it too. Not with cost_cl_source.
+  bool field_difference_cost = false;
+
   // Optional user cost, OpenCL C source defining
   //     double tc_user_cost(double3 p0, double3 p1, double f0, double f1);
   // p0, p1: end points; f0, f1: first component of the first vertex field at them (0 without

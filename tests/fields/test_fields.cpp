@@ -10,6 +10,7 @@
 #include "geometry.h"
 #include "test_support.hpp"
 #include "tetcollapse/collapse.hpp"
+#include "tetcollapse/device.hpp"
 #include "tetcollapse/fields.hpp"
 #include "tetcollapse/io.hpp"
 
@@ -249,6 +250,41 @@ TEST(FieldBound, ANamedFieldMustExistAndTheBoundBeFinite) {
   Mesh bare = jiggled(4, 1);
   o.max_field_error = 0.01;
   EXPECT_THROW(collapse_sequential(bare, o), std::invalid_argument) << "no vertex field";
+}
+
+// The paper's field cost, built in: both methods (and so the parallel method's host tail)
+// collapse where the field is flat and keep every vertex where it is steep.
+TEST(FieldCost, CollapsesWhereTheFieldIsFlatOnBothMethods) {
+  Mesh in = jiggled(8, 21);
+  in.vertex_fields.push_back({"phi", 1, {}});
+  for (int64_t v = 0; v < in.num_vertices(); ++v) {
+    const double x = in.points[3 * size_t(v)];
+    in.vertex_fields[0].values.push_back(x < 0.5 ? 0.0 : 10 * (x - 0.5));
+  }
+  auto count = [](const Mesh& m, double lo, double hi) {
+    int64_t n = 0;
+    for (int64_t v = 0; v < m.num_vertices(); ++v) n += m.points[3 * size_t(v)] > lo && m.points[3 * size_t(v)] < hi;
+    return n;
+  };
+  Context ctx;
+  for (auto method : {CollapseOptions::Sequential, CollapseOptions::Parallel}) {
+    Mesh m = in;
+    CollapseOptions o;
+    o.method = method;
+    o.field_difference_cost = true;
+    o.target_length = 1e-6;  // only the flat half (and the face x = 1) has ends this close
+    collapse(m, o, ctx);
+    EXPECT_LT(count(m, 0, 0.45), count(in, 0, 0.45) / 2) << "the flat half coarsens";
+    // (the face x = 1 is a level set of the field: it coarsens)
+    EXPECT_EQ(count(m, 0.62, 0.97), count(in, 0.62, 0.97)) << "no vertex inside the steep half goes";
+  }
+  CollapseOptions bad;
+  bad.field_difference_cost = true;
+  Mesh m = in;
+  EXPECT_THROW(collapse(m, bad, ctx), std::invalid_argument) << "no target";
+  bad.target_length = 0.01;
+  bad.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return 0.0; }";
+  EXPECT_THROW(collapse(m, bad, ctx), std::invalid_argument) << "two costs";
 }
 
 TEST(FieldsCli, MaxFieldErrorBoundsTheNamedFieldAtTheInputVertices) {
