@@ -355,11 +355,9 @@ void register_collapse(CLI::App& app, int& exit_code) {
       throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
     if (opt.max_field_error > 0 && c->preserve_field.empty())
       throw CLI::ValidationError("--max-field-error", "needs --preserve-field NAME (the field it bounds)");
-    static const std::string kNoField;  // --preserve-field with --max-field-error: host code
     if (opt.method == CollapseOptions::Sequential)
       for (const auto& [name, value] : {std::pair<const char*, const std::string*>{"--cost-cl", &c->cost_cl},
                                         {"--sizing-field", &c->sizing_field},
-                                        {"--preserve-field", opt.max_field_error > 0 ? &kNoField : &c->preserve_field},
                                         {"--placement-cl", &c->placement_cl},
                                         {"--predicate-cl", &c->predicate_cl}})
         if (!value->empty())
