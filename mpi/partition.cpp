@@ -3,7 +3,6 @@
 #include <metis.h>
 
 #include <algorithm>
-#include <array>
 #include <stdexcept>
 #include <string>
 
@@ -16,54 +15,57 @@ struct DualGraph {
   std::vector<idx_t> xadj, adjncy, adjwgt;
 };
 
+// Tets around each vertex (CSR), to find the tet across each face without a table of all faces:
+// 4 ints per tet where sorting the faces took 16 bytes per face (rank 0's peak memory).
+struct Incidence {
+  std::vector<int64_t> offset;
+  std::vector<int32_t> tets;
+};
+
+Incidence incidence(const Mesh& mesh) {
+  const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
+  Incidence inc;
+  inc.offset.assign(size_t(nv + 1), 0);
+  for (int32_t v : mesh.tets) ++inc.offset[size_t(v) + 1];
+  for (int64_t v = 0; v < nv; ++v) inc.offset[size_t(v + 1)] += inc.offset[size_t(v)];
+  inc.tets.resize(mesh.tets.size());
+  std::vector<int64_t> fill(inc.offset.begin(), inc.offset.end() - 1);
+  for (int64_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 4; ++k) inc.tets[size_t(fill[size_t(mesh.tets[size_t(4 * t + k)])]++)] = int32_t(t);
+  return inc;
+}
+
+bool has(const int32_t* q, int32_t v) { return q[0] == v || q[1] == v || q[2] == v || q[3] == v; }
+
 DualGraph dual_graph(const Mesh& mesh, const std::vector<uint8_t>& avoid, int avoid_weight) {
   const int64_t nt = mesh.num_tets();
-  // Every face by its sorted vertices; equal neighbours in sorted order are the shared faces.
-  struct Face {
-    std::array<int32_t, 3> v;
-    int32_t tet;
-    bool operator<(const Face& o) const { return v < o.v || (v == o.v && tet < o.tet); }
-  };
-  std::vector<Face> faces;
-  faces.reserve(size_t(4 * nt));
-  for (int64_t t = 0; t < nt; ++t) {
-    std::array<int32_t, 4> q;
-    for (int k = 0; k < 4; ++k) q[size_t(k)] = mesh.tets[size_t(4 * t + k)];
-    std::sort(q.begin(), q.end());
-    for (int skip = 0; skip < 4; ++skip) {
-      Face f{{}, int32_t(t)};
-      for (int k = 0, j = 0; k < 4; ++k)
-        if (k != skip) f.v[size_t(j++)] = q[size_t(k)];
-      faces.push_back(f);
-    }
-  }
-  std::sort(faces.begin(), faces.end());
-  // Pairs (a, b, weight), counted per tet first, then placed.
-  std::vector<std::array<int32_t, 3>> pairs;
-  for (size_t i = 0; i + 1 < faces.size(); ++i) {
-    if (faces[i].v != faces[i + 1].v) continue;
-    bool near = false;
-    for (int32_t v : faces[i].v) near = near || (!avoid.empty() && avoid[size_t(v)]);
-    pairs.push_back({faces[i].tet, faces[i + 1].tet, near ? avoid_weight : 1});
-    ++i;  // a face in more than two tets (a defective input) links its first two only
-  }
-  faces = {};
+  const Incidence inc = incidence(mesh);
   DualGraph g;
   g.xadj.assign(size_t(nt + 1), 0);
-  for (const auto& p : pairs) {
-    ++g.xadj[size_t(p[0]) + 1];
-    ++g.xadj[size_t(p[1]) + 1];
-  }
-  for (int64_t t = 0; t < nt; ++t) g.xadj[size_t(t + 1)] += g.xadj[size_t(t)];
-  g.adjncy.resize(size_t(g.xadj.back()));
-  g.adjwgt.resize(size_t(g.xadj.back()));
-  std::vector<idx_t> fill(g.xadj.begin(), g.xadj.end() - 1);
-  for (const auto& p : pairs)
-    for (int s = 0; s < 2; ++s) {
-      const size_t at = size_t(fill[size_t(p[size_t(s)])]++);
-      g.adjncy[at] = p[size_t(1 - s)];
-      g.adjwgt[at] = p[2];
+  g.adjncy.reserve(size_t(4 * nt));
+  g.adjwgt.reserve(size_t(4 * nt));
+  for (int64_t t = 0; t < nt; ++t) {
+    const int32_t* q = &mesh.tets[size_t(4 * t)];
+    for (int skip = 0; skip < 4; ++skip) {
+      int32_t f[3];
+      for (int k = 0, j = 0; k < 4; ++k)
+        if (k != skip) f[j++] = q[k];
+      // The first two tets around f[0] (in tet order) that have f[1] and f[2] too: t and its
+      // neighbour (a face in more than two tets, a defective input, links its first two only,
+      // the same from both sides).
+      int32_t pair[2] = {-1, -1}, n = 0;
+      for (int64_t i = inc.offset[size_t(f[0])]; i < inc.offset[size_t(f[0]) + 1] && n < 2; ++i) {
+        const int32_t s = inc.tets[size_t(i)];
+        const int32_t* r = &mesh.tets[size_t(4 * s)];
+        if (has(r, f[1]) && has(r, f[2])) pair[n++] = s;
+      }
+      if (n < 2 || (pair[0] != t && pair[1] != t)) continue;
+      const bool near = !avoid.empty() && (avoid[size_t(f[0])] || avoid[size_t(f[1])] || avoid[size_t(f[2])]);
+      g.adjncy.push_back(pair[0] == t ? pair[1] : pair[0]);
+      g.adjwgt.push_back(near ? avoid_weight : 1);
     }
+    g.xadj[size_t(t + 1)] = idx_t(g.adjncy.size());
+  }
   return g;
 }
 
