@@ -6,7 +6,8 @@
 #   scripts/setup.sh --with-tools also what scripts/ and bench/ use (gmsh's Python module,
 #                                 matplotlib, VTK and Xvfb for the renderings, clang for fuzzing;
 #                                 MMG3D, which Debian does not
-#                                 package, from PyPI's mmgpy wheel for the peers benchmark)
+#                                 package, from PyPI's mmgpy wheel for the peers benchmark; PyVista,
+#                                 which Debian does not package either, from PyPI over Debian's VTK)
 set -euo pipefail
 
 packages=(
@@ -40,9 +41,20 @@ install_mmg() {
     echo "setup: MMG3D not installed (the peers benchmark will skip it)" >&2
 }
 
+# PyVista (the Python module's from_pyvista / to_pyvista): pure Python over Debian's VTK, so
+# without its dependencies from PyPI (Debian's numpy, matplotlib, pillow serve)
+install_pyvista() {
+  [[ "${1:-}" == "--with-tools" ]] || return 0
+  /usr/bin/python3 -c "import pyvista" 2>/dev/null && return 0
+  echo "setup: installing PyVista (PyPI pyvista 0.44.0, scooby, pooch) for /usr/bin/python3"
+  /usr/bin/python3 -m pip install -q --break-system-packages --no-deps pyvista==0.44.0 scooby==0.12.1 pooch==1.9.0 ||
+    echo "setup: PyVista not installed (its test will skip)" >&2
+}
+
 if ((${#missing[@]} == 0)); then
   echo "setup: all ${#packages[@]} packages present"
   install_mmg "${1:-}"
+  install_pyvista "${1:-}"
   exit 0
 fi
 
@@ -56,4 +68,5 @@ export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 install_mmg "${1:-}"
+install_pyvista "${1:-}"
 echo "setup: done"

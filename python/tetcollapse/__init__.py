@@ -6,11 +6,17 @@
 
 The option names are those of the command line, with underscores (--target-factor ->
 target_factor). Errors: ValueError for bad input, tetcollapse.DeviceError (a RuntimeError) for
-the OpenCL device. With meshio installed, from_meshio / to_meshio convert meshio.Mesh objects.
+the OpenCL device. With meshio installed, from_meshio / to_meshio convert meshio.Mesh objects;
+with PyVista, from_pyvista / to_pyvista convert pyvista.UnstructuredGrid objects:
+
+    points, tets, labels, fields = tetcollapse.from_pyvista(grid)
+    out = tetcollapse.collapse(points, tets, labels=labels, vertex_fields=fields, target_factor=2)
+    tetcollapse.to_pyvista(out).plot()
 """
 from ._core import DeviceError, __version__, check, collapse, devices, improve, read, write  # noqa: F401
 
-__all__ = ["collapse", "improve", "check", "read", "write", "devices", "from_meshio", "to_meshio", "DeviceError"]
+__all__ = ["collapse", "improve", "check", "read", "write", "devices", "from_meshio", "to_meshio", "from_pyvista",
+           "to_pyvista", "DeviceError"]
 
 
 def from_meshio(mesh):
@@ -37,3 +43,38 @@ def to_meshio(result):
     cell_data = {"label": [result["labels"]]} if "labels" in result else {}
     return meshio.Mesh(result["points"], [("tetra", result["tets"])], point_data=dict(result["vertex_fields"]),
                        cell_data=cell_data)
+
+
+def from_pyvista(grid):
+    """(points, tets, labels, vertex_fields) of a pyvista.UnstructuredGrid (or any PyVista
+    dataset cast to one): its tetra cells, their first integer cell data as labels, its point
+    data as vertex fields. Other cells are left out."""
+    import numpy as np
+    import pyvista
+    if not isinstance(grid, pyvista.UnstructuredGrid):
+        grid = grid.cast_to_unstructured_grid()
+    is_tet = np.asarray(grid.celltypes) == pyvista.CellType.TETRA
+    if not is_tet.any():
+        raise ValueError("the PyVista grid has no tetra cells")
+    tets = np.asarray(grid.cells_dict[pyvista.CellType.TETRA], dtype=np.int32)
+    labels = None
+    for name in grid.cell_data.keys():
+        values = np.asarray(grid.cell_data[name])
+        if values.ndim == 1 and np.issubdtype(values.dtype, np.integer):
+            labels = values[is_tet].astype(np.int32)
+            break
+    fields = {name: np.asarray(grid.point_data[name], dtype=float) for name in grid.point_data.keys()}
+    return np.asarray(grid.points, dtype=float), tets, labels, fields
+
+
+def to_pyvista(result):
+    """A pyvista.UnstructuredGrid of a result of collapse() or improve(): point data the vertex
+    fields, cell data "label" the labels."""
+    import numpy as np
+    import pyvista
+    grid = pyvista.UnstructuredGrid({pyvista.CellType.TETRA: np.asarray(result["tets"])}, np.asarray(result["points"]))
+    for name, values in result["vertex_fields"].items():
+        grid.point_data[name] = values
+    if "labels" in result:
+        grid.cell_data["label"] = result["labels"]
+    return grid

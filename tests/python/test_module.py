@@ -118,6 +118,29 @@ class Module(unittest.TestCase):
         back = tetcollapse.to_meshio(out)
         self.assertEqual(len(back.cells[0].data), out["tets"].shape[0])
 
+    def test_pyvista(self):
+        try:
+            import pyvista
+        except ImportError:
+            self.skipTest("PyVista is not installed (scripts/setup.sh --with-tools installs it)")
+        points, tets = cube(5)
+        labels = np.where(points[tets].mean(axis=1)[:, 0] < 0.5, 3, 7).astype(np.int32)
+        grid = pyvista.UnstructuredGrid({pyvista.CellType.TETRA: tets}, points)
+        grid.cell_data["mat"] = labels
+        grid.point_data["f"] = points[:, 2]
+        p, t, lab, fields = tetcollapse.from_pyvista(grid)
+        np.testing.assert_array_equal(t, tets)
+        np.testing.assert_array_equal(lab, labels)
+        out = tetcollapse.collapse(p, t, labels=lab, vertex_fields=fields, target_factor=2)
+        back = tetcollapse.to_pyvista(out)
+        self.assertEqual(back.n_cells, out["tets"].shape[0])
+        self.assertLess(back.n_cells, tets.shape[0])
+        self.assertEqual(set(np.unique(back.cell_data["label"])), {3, 7})
+        np.testing.assert_allclose(back.point_data["f"], back.points[:, 2], atol=1e-12)
+        self.assertGreater(back.volume, 0.999)  # the unit cube, whole
+        with self.assertRaises(ValueError):
+            tetcollapse.from_pyvista(pyvista.UnstructuredGrid({pyvista.CellType.TRIANGLE: tets[:, :3]}, points))
+
 
 if __name__ == "__main__":
     unittest.main(argv=[sys.argv[0], "-v"])
