@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <malloc.h>
 
 #include "agree.hpp"
 #include "exchange.hpp"
@@ -49,6 +50,10 @@ int run_round(Phase phase, Round& st, const Settings& s, const Options& o, Conte
     mine = recv_part(0, comm);
   }
   tet_part = {};
+  // The whole mesh, the cut and METIS's work are gone: give their pages back before the part
+  // is coarsened (glibc keeps freed heap memory, and raises its mmap threshold after the reader's
+  // large buffers are freed, so they would count in rank 0's peak twice).
+  malloc_trim(0);
   rs.seconds_scatter = clock.lap();
 
   // Every rank works on its part.
