@@ -53,6 +53,10 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
   ensure(c.nb_edge, ctx, nnb);
   ensure(c.edges, ctx, size_t(c.ne) * 2);
   run(ctx, F, "conn_write_neighbours", nv, arg("nv", nv), arg("vt_off", c.vt_off), arg("scratch", c.scratch), arg("nb_off", c.nb_off), arg("edge_off", c.edge_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("edges", c.edges));
+  // The candidates' 12 slots per tet are read only above: released (the queue holds the buffer
+  // until the kernel is done) so that the selection's and the compaction's buffers do not come on
+  // top of them; the next build allocates them again, at its smaller mesh's size.
+  c.scratch = DeviceBuffer<int32_t>();
   run(ctx, F, "conn_lower_edges", nv, arg("nv", nv), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("edge_off", c.edge_off), arg("nb_edge", c.nb_edge), arg("carry", ci), arg("verts_are_dirty", nd), arg("verts2prev", vo), arg("prev_nb_off", pno), arg("prev_edge_off", cy ? s->carry.prev_edge_off.buffer() : c.count.buffer()), arg("prev_nb_edge", cy ? s->carry.prev_nb_edge.buffer() : c.count.buffer()));
   ensure(c.eflags, ctx, c.ne);
   ensure(c.vflags, ctx, nv);

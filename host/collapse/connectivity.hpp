@@ -24,7 +24,7 @@ struct Connectivity {
   DeviceBuffer<uint32_t> owns_s;   // per tet: 1 when it owns an S face (the surface guard's tets)
   DeviceBuffer<uint8_t> smask;     // per tet: which faces it owns on S (bit f: the face opposite local vertex f)
   uint64_t generation = 0;         // new (process-wide unique) at every build_connectivity
-  // scratch
+  // scratch (scratch itself is released at the end of build_connectivity)
   DeviceBuffer<uint32_t> count, cursor, up_count;
   DeviceBuffer<int32_t> scratch;
   DeviceBuffer<uint32_t> dirty_list;  // vertices recomputed when carrying (build_connectivity)
