@@ -124,6 +124,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     s.marked = cost_and_mark(ctx, dm, conn, st, p);
     s.seconds_cost = clock.lap();
     s.collapsed = selection->select(ctx, dm, conn, st, p, s);
+    selection->release(st);
     clock.lap();
     if (s.collapsed > 0) collapse_and_carry();
     s.seconds_collapse = clock.lap();

@@ -53,6 +53,12 @@ static_assert(kMaxCellsPerAxis + 1 < 1024, "sguard_vertex_cells packs a cell in 
 
 }  // namespace
 
+void SurfaceGuard::release() {
+  const bool pairs_once = each_pair_once;
+  *this = SurfaceGuard{};
+  each_pair_once = pairs_once;
+}
+
 uint32_t SurfaceGuard::run(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                            uint32_t chosen) {
   last_queries = 0;

@@ -55,6 +55,8 @@ struct SurfaceGuard {
   // After the matching selection undid the collapses of `undone` (after a run_applied that
   // refused some): the next run_applied tests only the queries that the undo may concern
   // (cl/collapse_guard_applied.cl, sguard_undone_boxes).
+  // Frees the buffers (Selection::release); the next run allocates them again.
+  void release();
   void restrict_to_undone(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s,
                           const std::vector<uint32_t>& undone);
   // After a run that refused collapses: their edges flagged in flag (1) and listed in list (from

@@ -148,6 +148,10 @@ class MatchingSelection final : public Selection {
     return refused;
   }
   bool guard_leaves_final() const override { return true; }
+  void release(EdgeState& s) override {
+    Selection::release(s);
+    state_ = MatchingState{};
+  }
 
   MatchingState state_;
 };

@@ -226,6 +226,10 @@ class TwoPassSelection final : public Selection {
     }
     return r;
   }
+  void release(EdgeState& s) override {
+    Selection::release(s);
+    state_ = TwoPassState{};
+  }
   int rounds_;
   TwoPassState state_;
 };

@@ -34,6 +34,15 @@ uint32_t Selection::guard(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSta
   return guard_.run(ctx, dm, c, s, p, chosen);
 }
 
+void Selection::release(EdgeState& s) {
+  s.lazy = LazyState{};
+  s.cost.edges2cost = DeviceBuffer<double>();
+  s.cost.edges_are_marked = DeviceBuffer<uint32_t>();
+  s.result.edges_are_final = s.result.edges_are_admissible = s.result.edges_pass1 = DeviceBuffer<uint32_t>();
+  s.result.edges2state = s.result.edges2reason = DeviceBuffer<uint8_t>();
+  guard_.release();
+}
+
 std::unique_ptr<Selection> make_selection(const CollapseOptions& o) {
   switch (o.conflicts) {
     case CollapseOptions::TwoPass: return make_two_pass_selection(o.selection_rounds);

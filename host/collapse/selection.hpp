@@ -33,6 +33,12 @@ class Selection {
   // refused_by_guard, seconds_select and seconds_guard.
   uint32_t select(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                   IterationStats& stats);
+  // Frees what only the selection reads (its rounds' lists and flags, the cost and priorities,
+  // the surface guard's queries and its own state), keeping what the compaction, the verdict
+  // carry and the host tail read (edges2dir, verts2collapse, tets_are_dead, the verdicts). The
+  // next select allocates them again, at its smaller mesh's size: at scale, the compaction's
+  // buffers would otherwise come on top of these.
+  virtual void release(EdgeState& s);
 
  protected:
   // What one run of the selection chose and counted: the collapses, the marked edges passing
