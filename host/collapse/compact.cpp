@@ -72,6 +72,9 @@ void collapse_and_compact(Context& ctx, const StageParams& p, DeviceMesh& dm, De
     s.compact.has_update = true;
   }
   std::swap(dm, next);
+  // The mesh before the compaction is not read again: released rather than kept for the next
+  // compaction, whose mesh is smaller.
+  next = DeviceMesh{};
 }
 
 }  // namespace tc::collapse_detail

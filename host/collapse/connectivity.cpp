@@ -23,6 +23,9 @@ void build_connectivity(Context& ctx, DeviceMesh& dm, Connectivity& c, const Sta
     std::swap(c.vt, s->compact.upd_vt);
     std::swap(c.tet_nbr, s->compact.upd_tet_nbr);
     s->compact.has_update = false;
+    // what was swapped out is the previous mesh's: released (the compaction allocates anew)
+    s->compact.upd_vt_off = s->compact.upd_count = DeviceBuffer<uint32_t>();
+    s->compact.upd_vt = s->compact.upd_tet_nbr = DeviceBuffer<int32_t>();
   } else if (dm.has_rings) {
     std::swap(c.vt_off, dm.vt_off);
     std::swap(c.vt, dm.vt);

@@ -40,6 +40,16 @@ void carry_verdicts(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s)
   if (!s.carry.has_prev) return;
   run(ctx, "collapse_verdicts.cl", "verdict_carry", dm.nv, arg("nv", dm.nv), arg("nb_off", c.nb_off), arg("nb", c.nb), arg("edge_off", c.edge_off), arg("verts2prev", s.carry.verts2prev), arg("prev_verts_are_dirty", s.carry.prev_verts_are_dirty), arg("prev_nb_off", s.carry.prev_nb_off), arg("prev_nb_edge", s.carry.prev_nb_edge), arg("prev_edges2verdict", s.carry.prev_edges2verdict), arg("edges2verdict", s.carry.edges2verdict));
   s.carry.has_prev = false;
+  // The previous iteration's connectivity and maps are read only by the carried
+  // build_connectivity and the kernel above: released, so that this iteration's stages do not
+  // hold two meshes' connectivity (note_compaction hands the next ones over).
+  CarryState& k = s.carry;
+  k.prev_nb_off = k.prev_edge_off = DeviceBuffer<uint32_t>();
+  k.prev_nb = k.prev_nb_edge = k.prev_tet_nbr = DeviceBuffer<int32_t>();
+  k.prev_vclass = k.prev_eflags = k.prev_edges2verdict = DeviceBuffer<uint8_t>();
+  k.tets2prev = k.verts2prev = DeviceBuffer<int32_t>();
+  s.compact.prev_verts2new = DeviceBuffer<int32_t>();
+  s.compact.prev_tets_are_kept = s.compact.prev_tets2new = DeviceBuffer<uint32_t>();
 }
 
 std::vector<uint8_t> tail_touched(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
