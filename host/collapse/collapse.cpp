@@ -85,6 +85,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
     return collapse_sequential(mesh, options);
   if (options.bounds_boundary_error()) return collapse_bounded(mesh, options, ctx);
   check_options(options, ctx);
+  check_device_memory(ctx, mesh, options);
   CollapseReport report = report_for(mesh, ctx);
   StageParams p = params_from(options);
   p.eps_v = report.eps_v = volume_threshold(mesh, options);

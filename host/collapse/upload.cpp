@@ -1,6 +1,7 @@
 // The mesh to the device and back.
 #include "collapse/upload.hpp"
 
+#include <algorithm>
 #include <exception>
 #include <numeric>
 #include <limits>
@@ -35,6 +36,41 @@ void check_collapse_input(const Mesh& mesh) {
     if (l.values.size() != size_t(nt))
       throw InputError("<mesh>", "label array '" + l.name + "' has " + std::to_string(l.values.size()) +
                                      " values for " + std::to_string(nt) + " tets");
+}
+
+uint64_t device_bytes_estimate(const Mesh& mesh, const CollapseOptions& o) {
+  const uint64_t nv = uint64_t(mesh.num_vertices()), nt = uint64_t(mesh.num_tets()), ne = nv + nt;
+  uint64_t vcomps = 0, tcomps = 0;
+  for (const Field& f : mesh.vertex_fields) vcomps += uint64_t(std::max(f.components, 0));
+  for (const Field& f : mesh.tet_fields) tcomps += uint64_t(std::max(f.components, 0));
+  const uint64_t labels = std::max<uint64_t>(mesh.tet_labels.size(), 1);
+  // Bytes per entity of the buffers alive through the first iteration's selection:
+  // per tet: the tets, rings, tet neighbours, S-face flags, qualities, the matching's dead and
+  // killer tets, the surface guard's S-tet lists; plus the labels and tet fields;
+  const uint64_t quality = o.min_quality > 0 ? 8 : 0;
+  const uint64_t per_tet = 16 + 16 + 16 + 4 + 1 + quality + 1 + 4 + 4 + 4 + 4 + 1 + 4 * labels + 8 * tcomps;
+  // per vertex: points, origin, mask, offsets and counts, flags, the selection's claims and
+  // lists, the matching's backup of the points, the guard's cells; plus the vertex fields (twice:
+  // the backup);
+  const uint64_t per_vertex = 24 + 4 + 1 + 6 * 4 + 2 + 4 + 5 * 4 + 8 + 24 + 4 + 4 + 6 + 16 * vcomps;
+  // per edge: N(v) and its edge ids, the edges, flags and verdicts, the cost and marks, the
+  // selection's result, priorities, turn lists, queues and waiting lists, the matching's rounds.
+  const uint64_t per_edge = 8 + 8 + 8 + 1 + 1 + 8 + 4 + 1 + 1 + 4 + 4 + 1 + 4 + 8 + 4 + 4 + 4 + 8 + 4 + 4 + 4 + 3 + 1;
+  const uint64_t selection = nt * per_tet + nv * per_vertex + ne * per_edge;
+  // the connectivity build: the mesh, its rings and neighbours, and 12 candidate slots per tet
+  const uint64_t connectivity = nt * (16 + 16 + 16 + 4 * labels + 8 * tcomps + 48) + nv * (24 + 4 + 1 + 6 * 4 + 2 + 8 * vcomps) +
+                                ne * (8 + 8 + 8 + 1 + 1);
+  const uint64_t peak = std::max(selection, connectivity);
+  return peak + peak / 10;
+}
+
+void check_device_memory(const Context& ctx, const Mesh& mesh, const CollapseOptions& o) {
+  const uint64_t need = device_bytes_estimate(mesh, o), have = ctx.info().global_mem_bytes;
+  if (have > 0 && need > have)
+    throw DeviceError("the mesh is too large for device '" + ctx.info().name + "': coarsening its " +
+                      std::to_string(mesh.num_tets()) + " tets needs about " + std::to_string(need >> 20) +
+                      " MiB of device memory, and the device has " + std::to_string(have >> 20) +
+                      " MiB (CL_DEVICE_GLOBAL_MEM_SIZE); use a larger device or --method sequential");
 }
 
 namespace {

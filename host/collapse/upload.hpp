@@ -35,6 +35,15 @@ struct DeviceMesh {
 // the wrong length.
 void check_collapse_input(const Mesh& mesh);
 
+// An estimate of the device memory the parallel method's busiest stage (the first iteration's
+// selection, or its connectivity build) holds for `mesh`, from the counts (the edges taken as
+// vertices + tets, as in a mesh with few boundary faces) and the buffers each stage allocates,
+// plus a tenth for what depends on the surface and the collapses (the surface guard's queries).
+uint64_t device_bytes_estimate(const Mesh& mesh, const CollapseOptions& o);
+// Refuses (DeviceError, with the sizes) a mesh whose estimate exceeds the device's global memory
+// (CL_DEVICE_GLOBAL_MEM_SIZE), before any work on the device.
+void check_device_memory(const Context& ctx, const Mesh& mesh, const CollapseOptions& o);
+
 // With vertex_new, the device mesh is renumbered in spatial order (spatial_order.hpp) and
 // *vertex_new receives the map input vertex -> device vertex; else it keeps the input's order.
 void upload_mesh(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm,

@@ -340,6 +340,15 @@ void Context::init(const DeviceInfo&) {
       throw DeviceError("TETCOLLAPSE_TUNING must be 'gpu' or 'cpu', not '" + v + "'");
     cpu_tuning_ = v == "cpu";
   }
+  // TETCOLLAPSE_TEST_GLOBAL_MEM=BYTES: the device's global memory as if it were at most BYTES,
+  // so that the tests can reach the refusal of a mesh too large for the device (docs/cli.md)
+  if (const char* m = std::getenv("TETCOLLAPSE_TEST_GLOBAL_MEM"); m && *m) {
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(m, &end, 10);
+    if (end == m || *end != '\0')
+      throw DeviceError("TETCOLLAPSE_TEST_GLOBAL_MEM must be a number of bytes, not '" + std::string(m) + "'");
+    info_.global_mem_bytes = std::min<uint64_t>(info_.global_mem_bytes, v);
+  }
   detail::cl_call("clCreateContext", [&] { context_ = cl::Context(device_); });
   detail::cl_call("clCreateCommandQueue", [&] { queue_ = cl::CommandQueue(context_, device_); });
 }

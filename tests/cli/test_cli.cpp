@@ -357,6 +357,34 @@ TEST(Cli, DeviceErrorsExitWithThree) {
   EXPECT_NE(out.find("\"fp64\":true"), std::string::npos) << out;
 }
 
+// A mesh whose estimated device memory exceeds the device's global memory is refused before the
+// collapse starts, with both sizes (the device's memory lowered by TETCOLLAPSE_TEST_GLOBAL_MEM).
+TEST(Cli, AMeshTooLargeForTheDeviceIsRefusedWithTheSizes) {
+  tc::test::TempDir dir;
+  std::string out;
+  const std::string mesh = q(tc::test::project_mesh("bracket.msh"));
+  EXPECT_EQ(run_command("TETCOLLAPSE_TEST_GLOBAL_MEM=3000000 " + cli() + " " + mesh + " " + q(dir.file("o.msh")), &out), 3)
+      << out;
+  EXPECT_NE(out.find("too large for device"), std::string::npos) << out;
+  EXPECT_NE(out.find("MiB of device memory, and the device has 2 MiB (CL_DEVICE_GLOBAL_MEM_SIZE)"), std::string::npos)
+      << out;
+  EXPECT_EQ(out.find("iteration"), std::string::npos) << out;  // before any work
+  EXPECT_FALSE(std::filesystem::exists(dir.file("o.msh")));
+  // the sequential method needs no device memory; a device with enough runs it
+  EXPECT_EQ(run_command("TETCOLLAPSE_TEST_GLOBAL_MEM=3000000 " + cli() + " " + mesh + " " + q(dir.file("s.msh")) +
+                            " --method sequential --no-improve -q",
+                        &out),
+            0)
+      << out;
+  EXPECT_EQ(run_command("TETCOLLAPSE_TEST_GLOBAL_MEM=1000000000 " + cli() + " " + mesh + " " + q(dir.file("p.msh")) +
+                            " --no-improve -q",
+                        &out),
+            0)
+      << out;
+  EXPECT_EQ(run_command("TETCOLLAPSE_TEST_GLOBAL_MEM=lots " + cli() + " " + mesh + " " + q(dir.file("x.msh")), &out), 3)
+      << out;
+}
+
 TEST(Cli, FeaturesWritesTheClassificationAsFields) {
   tc::test::TempDir dir;
   std::string out, vtu = dir.file("features.vtu");
