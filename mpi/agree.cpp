@@ -1,8 +1,10 @@
 #include "agree.hpp"
 
+#include <chrono>
 #include <iostream>
 #include <new>
 #include <string>
+#include <thread>
 
 #include "cli/common.hpp"
 
@@ -34,7 +36,22 @@ int guarded(int rank, const std::function<void()>& fn) {
   }
 }
 
+void wait_politely(MPI_Request& request) {
+  for (int done = 0;;) {
+    MPI_Test(&request, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+}
+
+void wait_politely(MPI_Comm comm) {
+  MPI_Request request;
+  MPI_Ibarrier(comm, &request);
+  wait_politely(request);
+}
+
 int agree(int code, MPI_Comm comm) {
+  wait_politely(comm);
   int worst = 0;
   MPI_Allreduce(&code, &worst, 1, MPI_INT, MPI_MAX, comm);
   return worst;

@@ -1,5 +1,7 @@
 #include "exchange.hpp"
 
+#include "agree.hpp"
+
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
@@ -140,17 +142,25 @@ Part unpack(const std::vector<char>& bytes) {
 void send_part(const Part& part, int dest, MPI_Comm comm) {
   const std::vector<char> bytes = pack(part);
   const uint64_t n = bytes.size();
-  MPI_Send(&n, 1, MPI_UINT64_T, dest, kTagSize, comm);
-  for (size_t off = 0; off < n; off += kChunk)
-    MPI_Send(bytes.data() + off, int(std::min(kChunk, n - off)), MPI_BYTE, dest, kTagData, comm);
+  MPI_Request request;
+  MPI_Isend(&n, 1, MPI_UINT64_T, dest, kTagSize, comm, &request);
+  wait_politely(request);
+  for (size_t off = 0; off < n; off += kChunk) {
+    MPI_Isend(bytes.data() + off, int(std::min(kChunk, n - off)), MPI_BYTE, dest, kTagData, comm, &request);
+    wait_politely(request);
+  }
 }
 
 Part recv_part(int source, MPI_Comm comm) {
   uint64_t n = 0;
-  MPI_Recv(&n, 1, MPI_UINT64_T, source, kTagSize, comm, MPI_STATUS_IGNORE);
+  MPI_Request request;
+  MPI_Irecv(&n, 1, MPI_UINT64_T, source, kTagSize, comm, &request);
+  wait_politely(request);
   std::vector<char> bytes(static_cast<size_t>(n));
-  for (size_t off = 0; off < n; off += kChunk)
-    MPI_Recv(bytes.data() + off, int(std::min(kChunk, n - off)), MPI_BYTE, source, kTagData, comm, MPI_STATUS_IGNORE);
+  for (size_t off = 0; off < n; off += kChunk) {
+    MPI_Irecv(bytes.data() + off, int(std::min(kChunk, n - off)), MPI_BYTE, source, kTagData, comm, &request);
+    wait_politely(request);
+  }
   return unpack(bytes);
 }
 

@@ -15,7 +15,8 @@ namespace tc::mpi {
 std::vector<char> pack(const Part& part);
 Part unpack(const std::vector<char>& bytes);  // throws std::runtime_error on a short buffer
 
-// Blocking; the receiver must call recv_part with the sender's rank.
+// Blocking (sleeping while they wait, see wait_politely); the receiver must call recv_part with
+// the sender's rank.
 void send_part(const Part& part, int dest, MPI_Comm comm);
 Part recv_part(int source, MPI_Comm comm);
 
