@@ -30,6 +30,9 @@ void add_improve_options(CLI::App& cmd, ImproveCli& c) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--no-smoothing", c.no_smoothing, "Improvement: no vertex relocation");
+  cmd.add_flag("--no-harmonic-collapse", c.no_harmonic,
+               "Improvement: the collapse step without the paper's part (edges of the bad tets by the drop\n"
+               "of the harmonic index, the survivor placed by a line search): the shortest edges only");
   cmd.add_flag("--no-improve-collapse", c.no_collapse,
                "Improvement: no collapse of the short edges of the tets still below 13 degrees after\n"
                "the flips and relocation (that step removes a few vertices)");
@@ -46,6 +49,7 @@ const ImproveOptions& improve_options(ImproveCli& c, bool quiet) {
   c.opt.flips = !c.no_flips;
   c.opt.smoothing = !c.no_smoothing;
   c.opt.collapse = !c.no_collapse;
+  c.opt.harmonic_collapse = !c.no_harmonic;
   if (!quiet)
     c.opt.progress = [](const ImprovePassStats& s) {
       std::fprintf(stderr,

@@ -127,6 +127,62 @@ SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const T
     if (!ok) throw std::invalid_argument("SequentialRun: the seed's edges need pairs a < b of vertices of the mesh");
   }
   target_ = options.target_length;
+  if (options.harmonic_cost) {
+    if (!o_.placement_cl_source.empty()) throw std::invalid_argument("harmonic_cost has its own placement");
+    sm_.set_free_placement([this](int32_t a, int32_t b, geo::tc_d3* p) {
+      harmonic_place(a, b, p);
+      return true;
+    });
+  }
+}
+
+double SequentialRun::harmonic_place(int32_t a, int32_t b, geo::tc_d3* place) {
+  const geo::tc_d3 pa = geo::tc_point(mesh_.points.data(), a), pb = geo::tc_point(mesh_.points.data(), b);
+  auto at = [&](double t) { return pa + (pb - pa) * t; };
+  auto sum = [&](double t) {
+    const geo::tc_d3 p = at(t);
+    return sm_.harmonic_sum(a, b, &p);
+  };
+  // samples, then a golden-section search in the best one's bracket (the sum need not be
+  // convex along the edge; deterministic, so the checks and the collapse see the same place)
+  constexpr int kSamples = 8;
+  int best = 0;
+  double best_sum = INFINITY;
+  for (int i = 0; i <= kSamples; ++i) {
+    const double s = sum(double(i) / kSamples);
+    if (s < best_sum) best_sum = s, best = i;
+  }
+  double lo = double(std::max(best - 1, 0)) / kSamples, hi = double(std::min(best + 1, kSamples)) / kSamples;
+  const double g = (std::sqrt(5.0) - 1) / 2;
+  double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo), f1 = sum(x1), f2 = sum(x2);
+  for (int it = 0; it < 16; ++it) {
+    if (f1 < f2) {
+      hi = x2, x2 = x1, f2 = f1, x1 = hi - g * (hi - lo), f1 = sum(x1);
+    } else {
+      lo = x1, x1 = x2, f1 = f2, x2 = lo + g * (hi - lo), f2 = sum(x2);
+    }
+  }
+  double t = double(best) / kSamples;
+  if (std::min(f1, f2) < best_sum) best_sum = std::min(f1, f2), t = f1 < f2 ? x1 : x2;
+  *place = at(t);
+  return best_sum;
+}
+
+double SequentialRun::harmonic_cost(int32_t a, int32_t b) {
+  if (!mask_.empty() && !(o_.mask_either ? (mask_[a] || mask_[b]) : (mask_[a] && mask_[b]))) return INFINITY;
+  uint8_t fe = 0;
+  const int dir = sm_.predicate(a, b, fe);
+  if (dir < 0) return INFINITY;
+  geo::tc_d3 p;
+  if (dir & TCC_DIR_MIDPOINT) harmonic_place(a, b, &p);
+  else p = geo::tc_point(mesh_.points.data(), (dir & TCC_DIR_REMOVE_V1) ? a : b);
+  // and, as every operation of the improvement, only if the worst tet of the region (by its
+  // smallest dihedral angle's sine) is no worse after
+  double worst_before, worst_after;
+  const double before = sm_.harmonic_sum(a, b, nullptr, &worst_before);
+  const double after = sm_.harmonic_sum(a, b, &p, &worst_after);
+  const double gain = before - after;
+  return gain > 0 && worst_after >= worst_before ? -gain : INFINITY;
 }
 
 bool SequentialRun::step() {
@@ -174,7 +230,8 @@ bool SequentialRun::step() {
   }
   s.edges = int64_t(edges_.size());
   const double t1 = seconds_since(t0);
-  if (it_ == 0 && !(target_ > 0 && std::isfinite(target_))) {
+  if (it_ == 0 && o_.harmonic_cost) target_ = 0;  // every edge whose collapse lowers the sum
+  if (it_ == 0 && !o_.harmonic_cost && !(target_ > 0 && std::isfinite(target_))) {
     // the median edge length of the input (the lower median, as tc::median_edge_length)
     std::vector<double> len(edges_.size());
     for (size_t i = 0; i < edges_.size(); ++i) len[i] = edges_[i].cost;
@@ -186,7 +243,10 @@ bool SequentialRun::step() {
     // with the field bound and no target, every edge is a candidate: the bound decides
     if (!(target_ > 0)) target_ = field_ ? INFINITY : o_.target_factor * report_.median_edge_length;
   }
-  if (it_ == 0) sm_.build_guard(std::isfinite(target_) ? target_ : report_.median_edge_length);
+  if (it_ == 0) {
+    double h = std::isfinite(target_) && target_ > 0 ? target_ : report_.median_edge_length;
+    sm_.build_guard(h > 0 ? h : 1.0);  // (h: the cell size when there is no S face)
+  }
   // marking, Q, link and volume; the admissible edges into the queue
   const bool reuse = o_.tuning.reuse_across_iterations;
   const uint32_t prev = uint32_t(it_);  // touched_ value of the previous iteration (0: the input)

@@ -59,7 +59,11 @@ Verdict SeqMesh::check(int32_t a, int32_t b) {
 
 tc_d3 SeqMesh::placement(int32_t a, int32_t b, unsigned dir) const {
   tc_d3 p0 = point(a), p1 = point(b);
-  if (dir & TCC_DIR_MIDPOINT) return (p0 + p1) * 0.5;
+  if (dir & TCC_DIR_MIDPOINT) {
+    tc_d3 p;
+    if (free_placement_ && free_placement_(std::min(a, b), std::max(a, b), &p)) return p;
+    return (p0 + p1) * 0.5;
+  }
   return (dir & TCC_DIR_REMOVE_V1) ? p0 : p1;
 }
 

@@ -30,6 +30,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "collapse/params.hpp"
@@ -136,6 +137,13 @@ class SeqMesh {
   void collapse_region(int32_t a, int32_t b, uint8_t dir, std::vector<int32_t>& tets, std::vector<int32_t>& after,
                        int32_t* survivor, geo::tc_d3* place);
   bool tet_alive(int32_t t) const { return talive_[t] != 0; }
+  // The sum of the harmonic indices of the tets of ring(a) U ring(b) (place null), or of those
+  // the collapse of (a, b) leaves with the survivor at *place (infinity if one is flat or
+  // inverted); *worst_sine (when given): the smallest tc_tet_min_sine of those tets.
+  double harmonic_sum(int32_t a, int32_t b, const geo::tc_d3* place, double* worst_sine = nullptr);
+  // Where the survivor goes when both ends may move (TCC_DIR_MIDPOINT): fn(a, b, &p) sets p,
+  // or returns false for the midpoint. The checks and the collapse all see it.
+  void set_free_placement(std::function<bool(int32_t, int32_t, geo::tc_d3*)> fn) { free_placement_ = std::move(fn); }
   const int32_t* tet_vertices(int32_t t) const { return tet(t); }
   // A tet through v (-1: none).
   int32_t some_tet(int32_t v) const { return rlen_[v] > 0 ? ring(v)[0] : -1; }
@@ -297,6 +305,7 @@ class SeqMesh {
   uint8_t volume_and_quality(int32_t a, int32_t b, int dir) const;
   geo::tc_d3 placement(int32_t a, int32_t b, unsigned dir) const;
 
+  std::function<bool(int32_t, int32_t, geo::tc_d3*)> free_placement_;
   Mesh& mesh_;
   std::vector<double>* points_;
   std::vector<int32_t>* tets_;

@@ -100,12 +100,20 @@ class SequentialRun {
 
  private:
   // The edge's cost: its length, or CollapseOptions::field_difference_cost's |f0 - f1| (the
-  // device's, params.cpp: the first component of the first vertex field).
-  double cost(int32_t a, int32_t b) const {
+  // device's, params.cpp: the first component of the first vertex field), or harmonic_cost's.
+  double cost(int32_t a, int32_t b) {
+    if (o_.harmonic_cost) return harmonic_cost(a, b);
     if (!o_.field_difference_cost) return sm_.length(a, b);
     const Field& f = mesh_.vertex_fields[0];
     return std::fabs(f.values[size_t(a) * size_t(f.components)] - f.values[size_t(b) * size_t(f.components)]);
   }
+
+  // Minus the drop of the harmonic sum (+infinity outside the mask, where Q refuses, or where
+  // it does not drop), with the survivor where the rules or the line search put it.
+  double harmonic_cost(int32_t a, int32_t b);
+  // The line search: the place on the edge (a, b) with the smallest harmonic sum after the
+  // collapse, and that sum.
+  double harmonic_place(int32_t a, int32_t b, geo::tc_d3* place);
 
   struct QueueEntry {
     double cost;

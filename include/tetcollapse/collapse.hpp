@@ -255,6 +255,12 @@ struct CollapseOptions {
   // required) are marked. Unlike the same cost as a cost_cl_source, the host tail and the
   // sequential method evaluate it too. Not with cost_cl_source.
   bool field_difference_cost = false;
+  // The paper's collapse for mesh improvement (Section 4.6), sequential method only: the cost of
+  // an edge is minus the drop of the sum of the harmonic indices eta = (sum of the squared face
+  // areas) / volume (Alexa 2019) over the tets the collapse reshapes, an edge whose collapse
+  // leaves that sum no lower is not marked (target_length is not used), and a survivor that
+  // may go anywhere on the edge goes where a line search along it puts the smallest sum.
+  bool harmonic_cost = false;
 
   // Optional user cost, OpenCL C source defining
   //     double tc_user_cost(double3 p0, double3 p1, double f0, double f1);

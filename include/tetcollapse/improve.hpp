@@ -26,8 +26,11 @@
 //         do not move)
 //       stop when nothing changed, or when a pass left the smallest dihedral angle and the
 //       counts of tets below 10 and 13 degrees as they were
-//     collapse short edges between vertices of the tets still below 13 degrees, each only when
-//     it does not lower the worst quality of what it reshapes; then the passes above again
+//     collapse edges between vertices of the tets still below 13 degrees: first the paper's
+//     (those whose collapse lowers the sum of the harmonic indices of what it reshapes, the
+//     largest drop first, the survivor where a line search along the edge puts the smallest
+//     sum), then the shortest; each only when it does not lower the worst quality of what it
+//     reshapes; then the passes above again
 //
 // The worst quality of the mesh never falls: each operation is accepted only when the worst
 // quality of what it changes rises. Flips change interior faces of one label only, so the
@@ -109,6 +112,11 @@ struct ImproveOptions {
   // 1.5 x the mesh's median edge length. After it, flips and relocation run again.
   bool collapse = true;
   double collapse_length = 0;
+  // The collapse step begins as the paper's: edges of the bad tets whose collapse lowers the sum
+  // of the harmonic indices of what it reshapes, the largest drop first, the survivor placed by
+  // a line search along the edge, and no tet of the region made worse by its smallest dihedral
+  // angle (CollapseOptions::harmonic_cost); then the shortest edges as above on what is left.
+  bool harmonic_collapse = true;
   // With a non-empty mask (one byte per vertex, non-zero = selected), only selected vertices
   // move, and only tets whose vertices are all selected are flipped; the collapse step does not
   // run (it renumbers the vertices).
