@@ -99,23 +99,23 @@ int run(Options& o, MPI_Comm comm) {
   s.collapse.eps_v_relative = false;
   stats.target_length = s.collapse.target_length;
 
-  // Every rank its own device context.
-  std::unique_ptr<Context> ctx;
-  code = guarded(rank, [&] { ctx = cli::open_device(o.device, !talk); });
+  // Every rank its own device context: the device chosen now (a --device naming none fails
+  // before any work), the context opened when the rank first coarsens.
+  code = guarded(rank, [&] { stats.device = select_device(o.device).name; });
   if ((code = agree(code, comm))) return code;
-  stats.device = ctx->info().name;
+  LazyDevice device(o.device, talk);
   if (talk)
     std::fprintf(stderr, "%d ranks, target length %.6g (median edge length %.6g)\n", nranks, s.collapse.target_length,
                  stats.median_edge_length);
 
   // The collapse phase, then the improvement phase, each in rounds until nothing is left to do.
   Round state{whole, {}, 0};
-  code = run_phase(Phase::Collapse, state, s, o, *ctx, stats, comm);
+  code = run_phase(Phase::Collapse, state, s, o, device, stats, comm);
   if (code == cli::kOk && !o.no_improve) {
     // the improvement's collapse step reaches as far as tc::improve's default on the whole mesh
     if (rank == 0) s.collapse_length = 1.5 * median_edge_length(whole);
     bcast(&s.collapse_length, 1, comm);
-    code = run_phase(Phase::Improve, state, s, o, *ctx, stats, comm);
+    code = run_phase(Phase::Improve, state, s, o, device, stats, comm);
   }
   if (code) return code;
 

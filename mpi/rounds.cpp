@@ -11,11 +11,16 @@
 
 namespace tc::mpi {
 
+Context& LazyDevice::get() {
+  if (!ctx_) ctx_ = cli::open_device(spec_, !talk_);
+  return *ctx_;
+}
+
 namespace {
 
 // One round: partition (the cut avoiding the band), scatter, coarsen or improve, gather. Returns
 // the agreed exit code; on rank 0 fills `rs` and the next round's band.
-int run_round(Phase phase, Round& st, const Settings& s, const Options& o, Context& ctx, RoundStats& rs,
+int run_round(Phase phase, Round& st, const Settings& s, const Options& o, LazyDevice& device, RoundStats& rs,
               MPI_Comm comm) {
   int rank = 0, nranks = 1;
   MPI_Comm_rank(comm, &rank);
@@ -59,7 +64,7 @@ int run_round(Phase phase, Round& st, const Settings& s, const Options& o, Conte
   // Every rank works on its part.
   RankReport rr;
   Stopwatch own;
-  code = guarded(rank, [&] { rr = coarsen_part(mine, phase, s, ctx); });
+  code = guarded(rank, [&] { rr = coarsen_part(mine, phase, s, device.get()); });
   const RankStats mine_stats{double(rr.tets_in), double(rr.tets_out), double(rr.frozen), own.lap(),
                              rr.seconds_collapse, rr.seconds_improve, double(peak_rss_kb())};
   if ((code = agree(code, comm))) return code;
@@ -94,7 +99,7 @@ int run_round(Phase phase, Round& st, const Settings& s, const Options& o, Conte
 // band around what the one before left frozen, until a round has nothing of its band frozen (or,
 // collapsing, removed fewer than o.round_threshold of its tets), or after o.max_rounds (two
 // when improving).
-int run_phase(Phase phase, Round& st, const Settings& s, const Options& o, Context& ctx, RunStats& stats,
+int run_phase(Phase phase, Round& st, const Settings& s, const Options& o, LazyDevice& device, RunStats& stats,
               MPI_Comm comm) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
@@ -103,7 +108,7 @@ int run_phase(Phase phase, Round& st, const Settings& s, const Options& o, Conte
     RoundStats rs;
     rs.round = ++st.number;
     rs.phase = phase == Phase::Collapse ? "collapse" : "improve";
-    if (int code = run_round(phase, st, s, o, ctx, rs, comm)) return code;
+    if (int code = run_round(phase, st, s, o, device, rs, comm)) return code;
     double go = 0;
     if (rank == 0) {
       const double removed = rs.tets_before ? double(rs.tets_before - rs.tets_after) / double(rs.tets_before) : 0;

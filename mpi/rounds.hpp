@@ -5,6 +5,8 @@
 #include <mpi.h>
 
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <vector>
 
 #include "coarsen.hpp"
@@ -23,8 +25,22 @@ struct Round {
   int number;  // rounds so far, over both phases
 };
 
+// The rank's device context, opened when first needed: on rank 0 after the first cut, whose
+// METIS work then does not add to the OpenCL runtime's memory in rank 0's peak (the other ranks
+// open theirs while rank 0 cuts).
+class LazyDevice {
+ public:
+  LazyDevice(std::string spec, bool talk) : spec_(std::move(spec)), talk_(talk) {}
+  Context& get();
+
+ private:
+  std::string spec_;
+  bool talk_;
+  std::unique_ptr<Context> ctx_;
+};
+
 // Runs on every rank; returns the agreed exit code. Rank 0 appends each round to stats.rounds.
-int run_phase(Phase phase, Round& state, const Settings& settings, const Options& options, Context& ctx,
+int run_phase(Phase phase, Round& state, const Settings& settings, const Options& options, LazyDevice& device,
               RunStats& stats, MPI_Comm comm);
 
 }  // namespace tc::mpi
