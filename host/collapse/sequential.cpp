@@ -137,6 +137,10 @@ SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const T
 }
 
 double SequentialRun::harmonic_place(int32_t a, int32_t b, geo::tc_d3* place) {
+  if (last_place_.a == a && last_place_.b == b && last_place_.collapses == collapses_) {
+    *place = last_place_.place;
+    return last_place_.sum;
+  }
   const geo::tc_d3 pa = geo::tc_point(mesh_.points.data(), a), pb = geo::tc_point(mesh_.points.data(), b);
   auto at = [&](double t) { return pa + (pb - pa) * t; };
   auto sum = [&](double t) {
@@ -165,6 +169,7 @@ double SequentialRun::harmonic_place(int32_t a, int32_t b, geo::tc_d3* place) {
   double t = double(best) / kSamples;
   if (std::min(f1, f2) < best_sum) best_sum = std::min(f1, f2), t = f1 < f2 ? x1 : x2;
   *place = at(t);
+  last_place_ = {a, b, collapses_, *place, best_sum};
   return best_sum;
 }
 
@@ -328,6 +333,7 @@ bool SequentialRun::step() {
       continue;  // (as the boundary bound: the verdict changes only with the star)
     }
     const int32_t survivor = sm_.collapse(e.a, e.b, dir);
+    ++collapses_;
     if (field_) field_->apply(mesh_, survivor);
     if (eps_after > 0) eps_[size_t(survivor)] = std::max(eps_[size_t(survivor)], eps_after);
     ++s.collapsed;
@@ -372,6 +378,7 @@ bool SequentialRun::step() {
         if (sm_.tet_alive(t)) tmap_[size_t(t)] = m++;
     }
     sm_.compact(vmap_, kept_);
+    last_place_ = {};  // (renumbered)
     if (field_) field_->compact(tmap_);
     // per-vertex data of the survivors; origin composed with the vertex map
     for (size_t i = 0; i < kept_.size(); ++i) touched_[i] = touched_[kept_[i]];

@@ -114,6 +114,16 @@ class SequentialRun {
   // The line search: the place on the edge (a, b) with the smallest harmonic sum after the
   // collapse, and that sum.
   double harmonic_place(int32_t a, int32_t b, geo::tc_d3* place);
+  // The last line search's edge, result and the collapse count it saw: the cost, the checks and
+  // the collapse ask for the same edge's place several times between two collapses.
+  struct HarmonicPlace {
+    int32_t a = -1, b = -1;
+    int64_t collapses = -1;
+    geo::tc_d3 place{0, 0, 0};
+    double sum = 0;
+  };
+  HarmonicPlace last_place_;
+  int64_t collapses_ = 0;  // collapses so far (the line search's cache key)
 
   struct QueueEntry {
     double cost;
