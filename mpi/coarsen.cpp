@@ -82,9 +82,17 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context& ctx
     if (d > 0) io.max_boundary_move *= s.whole_diagonal / d;
     improve(m, io, ctx);
     // Under a mask the library leaves out its collapse step: run it here, then the passes again.
-    if (masked && io.collapse && collapse_bad_tets(m, selected_by_field(m), io, s.collapse_length) > 0) {
-      io.vertex_mask = selected_by_field(m);
-      improve(m, io, ctx);
+    // The improvement keeps the numbering under a mask but gives a moved vertex the fields
+    // interpolated at its new place (-1 from -1s need not come out exact): mark the vertices
+    // again by the mask before the collapse.
+    if (masked && io.collapse) {
+      std::vector<double>& marks = m.vertex_fields.back().values;
+      for (size_t v = 0; v < nv; ++v)
+        if (!part.frozen[v]) marks[v] = mask[v] ? kSelected : kLeft;
+      if (collapse_bad_tets(m, selected_by_field(m), io, s.collapse_length) > 0) {
+        io.vertex_mask = selected_by_field(m);
+        improve(m, io, ctx);
+      }
     }
     r.seconds_improve = clock.lap();
   }
