@@ -185,6 +185,41 @@ TEST_P(MpiTool, SameOutputTwice) {
   EXPECT_TRUE(a == b) << "two runs with " << GetParam() << " ranks differ";
 }
 
+// --stats: every round with its phase, every rank's tets, seconds and peak memory; the rounds
+// chain (each starts from the tets the one before left) and end at the output's count.
+TEST_P(MpiTool, StatsNameEveryRoundAndRank) {
+  TempDir dir;
+  const std::string in = tc::test::project_mesh("bracket.msh");
+  std::string log;
+  ASSERT_EQ(run_mpi(GetParam(), in + " " + dir.file("o.msh") + " --target-factor 2 -q --stats " + dir.file("s.json"), &log),
+            0)
+      << log;
+  const std::string json = tc::test::read_text(dir.file("s.json"));
+  auto count = [&](const std::string& what) {
+    int n = 0;
+    for (size_t at = json.find(what); at != std::string::npos; at = json.find(what, at + 1)) ++n;
+    return n;
+  };
+  auto numbers = [&](const std::string& key) {
+    std::vector<long long> v;
+    for (size_t at = json.find("\"" + key + "\":"); at != std::string::npos; at = json.find("\"" + key + "\":", at + 1))
+      v.push_back(std::stoll(json.substr(json.find_first_of("0123456789-", at + key.size() + 3))));
+    return v;
+  };
+  const int rounds = count("\"phase\":");
+  EXPECT_GE(rounds, 2) << "a collapse and an improvement round at least";
+  EXPECT_GE(count("\"phase\":\"collapse\""), 1);
+  EXPECT_GE(count("\"phase\":\"improve\""), 1);
+  EXPECT_EQ(count("\"rank\":"), rounds * GetParam());
+  const auto before = numbers("tets_before"), after = numbers("tets_after");
+  ASSERT_EQ(int(before.size()), rounds);
+  for (int r = 1; r < rounds; ++r) EXPECT_EQ(before[size_t(r)], after[size_t(r - 1)]) << "round " << r + 1;
+  EXPECT_EQ(after.back(), tc::read_mesh(dir.file("o.msh")).num_tets());
+  const auto peaks = numbers("peak_rss_kb");  // per rank per round, then per rank over the run
+  ASSERT_FALSE(peaks.empty());
+  for (long long kb : peaks) EXPECT_GT(kb, 1000);
+}
+
 INSTANTIATE_TEST_SUITE_P(Ranks, MpiTool, ::testing::Values(2, 3), [](const auto& info) {
   return std::to_string(info.param) + "ranks";
 });
