@@ -1,0 +1,97 @@
+// tc::coarsen: the command line's sequence as one call (tetcollapse/coarsen.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "test_support.hpp"
+#include "tetcollapse/coarsen.hpp"
+#include "tetcollapse/device.hpp"
+#include "tetcollapse/fields.hpp"
+
+namespace tc {
+namespace {
+
+Mesh bumpy_cube(unsigned seed) {
+  Mesh m = test::cube_tets(7);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.25 / 7, 0.25 / 7);  // (more inverts Kuhn tets)
+  for (double& x : m.points)
+    if (x > 0 && x < 1) x += u(rng);
+  m.vertex_fields.push_back({"rho", 1, {}});
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    const double* p = &m.points[3 * size_t(v)];
+    m.vertex_fields[0].values.push_back(std::exp(-8 * (std::pow(p[0] - 0.5, 2) + std::pow(p[1] - 0.4, 2))) + p[2]);
+  }
+  return m;
+}
+
+// The same mesh as the collapse, the improvement and the resampling called one after the other.
+TEST(Coarsen, IsTheCollapseThenTheImprovementThenTheFields) {
+  Context ctx;
+  const Mesh in = bumpy_cube(1);
+  CoarsenOptions co;
+  co.collapse.target_factor = 2;
+  Mesh a = in;
+  const CoarsenReport r = coarsen(a, co, &ctx);
+  EXPECT_TRUE(r.improved);
+  Mesh b = in;
+  collapse(b, co.collapse, ctx);
+  ImproveOptions io;
+  improve(b, io, ctx);
+  resample_vertex_fields(in, b);
+  EXPECT_EQ(a.tets, b.tets);
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_EQ(a.vertex_fields[0].values, b.vertex_fields[0].values);
+  EXPECT_EQ(r.collapse.tets_out, a.num_tets());
+}
+
+// A boundary error bound: the collapse uses its share, the improvement the rest, and the result
+// stays within the whole.
+TEST(Coarsen, SharesABoundaryErrorBoundWithTheImprovement) {
+  Context ctx;
+  Mesh m = bumpy_cube(2);
+  CoarsenOptions co;
+  co.collapse.target_factor = 2;
+  co.collapse.max_boundary_error = 0.002;
+  const double bound = boundary_error_bound(m, co.collapse);
+  const CoarsenReport r = coarsen(m, co, &ctx);
+  EXPECT_TRUE(r.improved);
+  EXPECT_EQ(r.collapse.boundary_error_bound, bound);
+  EXPECT_LE(r.collapse.boundary_error, kCollapseShareOfBound * bound * (1 + 1e-12));
+}
+
+// No improvement phase under the field error bound (its moves are not checked against it) or a
+// user predicate (rules it cannot know); the field options are checked.
+TEST(Coarsen, SkipsTheImprovementWhereItWouldBreakARule) {
+  Context ctx;
+  {
+    Mesh m = bumpy_cube(3);
+    CoarsenOptions co;
+    co.preserve_field = "rho";
+    co.collapse.max_field_error = 0.02;
+    const CoarsenReport r = coarsen(m, co, &ctx);
+    EXPECT_FALSE(r.improved);
+    EXPECT_LE(r.collapse.field_error, 0.02);
+    EXPECT_LT(m.num_vertices(), bumpy_cube(3).num_vertices());
+  }
+  {
+    Mesh m = bumpy_cube(4);
+    CoarsenOptions co;
+    co.collapse.target_factor = 2;
+    co.collapse.predicate_cl_source = "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) { return 1; }";
+    EXPECT_FALSE(coarsen(m, co, &ctx).improved);
+  }
+  Mesh m = bumpy_cube(5);
+  CoarsenOptions co;
+  co.preserve_field = "nope";
+  EXPECT_THROW(coarsen(m, co, &ctx), std::invalid_argument);
+  co.preserve_field.clear();
+  co.collapse.max_field_error = 0.01;
+  EXPECT_THROW(coarsen(m, co, &ctx), std::invalid_argument) << "which field?";
+  CoarsenOptions parallel;
+  EXPECT_THROW(coarsen(m, parallel, nullptr), std::invalid_argument) << "the parallel method needs a device";
+}
+
+}  // namespace
+}  // namespace tc
