@@ -143,10 +143,8 @@ double SequentialRun::harmonic_place(int32_t a, int32_t b, geo::tc_d3* place) {
   }
   const geo::tc_d3 pa = geo::tc_point(mesh_.points.data(), a), pb = geo::tc_point(mesh_.points.data(), b);
   auto at = [&](double t) { return pa + (pb - pa) * t; };
-  auto sum = [&](double t) {
-    const geo::tc_d3 p = at(t);
-    return sm_.harmonic_sum(a, b, &p);
-  };
+  sm_.harmonic_terms(a, b, terms_);
+  auto sum = [&](double t) { return SeqMesh::harmonic_at(terms_, t); };
   // samples, then a golden-section search in the best one's bracket (the sum need not be
   // convex along the edge; deterministic, so the checks and the collapse see the same place)
   constexpr int kSamples = 8;
@@ -179,15 +177,21 @@ double SequentialRun::harmonic_cost(int32_t a, int32_t b) {
   const int dir = sm_.predicate(a, b, fe);
   if (dir < 0) return INFINITY;
   geo::tc_d3 p;
-  if (dir & TCC_DIR_MIDPOINT) harmonic_place(a, b, &p);
-  else p = geo::tc_point(mesh_.points.data(), (dir & TCC_DIR_REMOVE_V1) ? a : b);
+  double after;
+  if (dir & TCC_DIR_MIDPOINT) {
+    after = harmonic_place(a, b, &p);
+  } else {
+    p = geo::tc_point(mesh_.points.data(), (dir & TCC_DIR_REMOVE_V1) ? a : b);
+    after = sm_.harmonic_sum(a, b, &p);
+  }
+  const double gain = sm_.harmonic_sum(a, b, nullptr) - after;
+  if (!(gain > 0)) return INFINITY;
   // and, as every operation of the improvement, only if the worst tet of the region (by its
-  // smallest dihedral angle's sine) is no worse after
+  // smallest dihedral angle's sine) is no worse after (asked last: the sines cost more)
   double worst_before, worst_after;
-  const double before = sm_.harmonic_sum(a, b, nullptr, &worst_before);
-  const double after = sm_.harmonic_sum(a, b, &p, &worst_after);
-  const double gain = before - after;
-  return gain > 0 && worst_after >= worst_before ? -gain : INFINITY;
+  sm_.harmonic_sum(a, b, nullptr, &worst_before);
+  sm_.harmonic_sum(a, b, &p, &worst_after);
+  return worst_after >= worst_before ? -gain : INFINITY;
 }
 
 bool SequentialRun::step() {
@@ -228,9 +232,14 @@ bool SequentialRun::step() {
     seed_edges_ = {};
   } else {
     const int32_t nv = sm_.num_vertices();
+    // with a mask that needs both ends, only the edges between selected vertices can be marked:
+    // only those are listed
+    const bool both_selected = !mask_.empty() && !o_.mask_either;
     for (int32_t v = 0; v < nv; ++v) {
+      if (both_selected && !mask_[v]) continue;
       sm_.neighbours(v, nb_, true);
-      for (int32_t u : nb_) edges_.push_back({cost(v, u), v, u, 0});
+      for (int32_t u : nb_)
+        if (!both_selected || mask_[u]) edges_.push_back({cost(v, u), v, u, 0});
     }
   }
   s.edges = int64_t(edges_.size());

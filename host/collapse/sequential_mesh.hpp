@@ -141,6 +141,14 @@ class SeqMesh {
   // the collapse of (a, b) leaves with the survivor at *place (infinity if one is flat or
   // inverted); *worst_sine (when given): the smallest tc_tet_min_sine of those tets.
   double harmonic_sum(int32_t a, int32_t b, const geo::tc_d3* place, double* worst_sine = nullptr);
+  // The same sum for the survivor at a + t (b - a), as a function of t: per tet the collapse
+  // leaves, eta(t) = (q0 + q1 t + q2 t^2) / (v0 + v1 t) (squared areas are quadratic in t, the
+  // volume is linear), so that a line search evaluates each tet in a few operations.
+  struct HarmonicTerm {
+    double q0, q1, q2, v0, v1;
+  };
+  void harmonic_terms(int32_t a, int32_t b, std::vector<HarmonicTerm>& terms);
+  static double harmonic_at(const std::vector<HarmonicTerm>& terms, double t);
   // Where the survivor goes when both ends may move (TCC_DIR_MIDPOINT): fn(a, b, &p) sets p,
   // or returns false for the midpoint. The checks and the collapse all see it.
   void set_free_placement(std::function<bool(int32_t, int32_t, geo::tc_d3*)> fn) { free_placement_ = std::move(fn); }

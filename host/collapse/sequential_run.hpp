@@ -26,8 +26,9 @@
 // The options of the parallel method's conflict detection (conflicts, selection_rounds) do not
 // apply; a user cost (cost_cl_source) is refused.
 //
-// IterationStats of an iteration: marked (all marked edges; in a greedy iteration after the
-// first, of the listed edges only, as edges), candidates (of those, passing Q at the start),
+// IterationStats of an iteration: edges (all edges of the mesh; with a vertex mask that needs
+// both end points, the edges between selected vertices, the only ones listed), marked (all
+// marked edges; in a greedy iteration after the first, of the listed edges only, as edges), candidates (of those, passing Q at the start),
 // tested (link and volume tests at the start), selected (pushed into the queue),
 // refused_by_guard (popped edges the surface guard refused); seconds_connectivity: the edge
 // list, seconds_select: marking, checks and queue, seconds_collapse: popping, checking
@@ -123,6 +124,7 @@ class SequentialRun {
     double sum = 0;
   };
   HarmonicPlace last_place_;
+  std::vector<SeqMesh::HarmonicTerm> terms_;
   int64_t collapses_ = 0;  // collapses so far (the line search's cache key)
 
   struct QueueEntry {
