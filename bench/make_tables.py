@@ -25,6 +25,7 @@ results files:
     boundary_error  bench/results/boundary_error.json                   (bench/quality_peers.py; its table)
     volume_rendering bench/results/volume_rendering.json               (bench/volume_rendering.py; its table)
     cold_start      bench/results/cold_start.json                       (bench/cold_start.py; its table)
+    mpi_scale       bench/results/mpi_scale.json                        (bench/mpi_scale.py; its table)
     robustness      bench/robustness/results.json                       (scripts/robustness.py)
     io, primitives, bench/results/io.json, primitives.json, connectivity.json, checker.json,
     connectivity,   boundary_rule.json
@@ -209,6 +210,20 @@ def recorded_block(name, module):
     return head + "\n\n" + mod.table(doc), path
 
 
+def printed_block(name, module):
+    """A results file whose script prints its own table, head line included, from the path."""
+    import contextlib
+    import io
+    mod = __import__(module)
+    path = os.path.join(RESULTS, f"{name}.json")
+    if not os.path.exists(path):
+        return None, f"no {rel(path)}"
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        mod.table(path)
+    return f"Recorded: `{rel(path)}`; " + out.getvalue().rstrip("\n"), path
+
+
 def robustness_block():
     path = os.path.join(HERE, "robustness", "results.json")
     if not os.path.exists(path):
@@ -348,6 +363,7 @@ BLOCKS = {
     "boundary_error": lambda: recorded_block("boundary_error", "quality_peers"),
     "volume_rendering": lambda: recorded_block("volume_rendering", "volume_rendering"),
     "cold_start": lambda: recorded_block("cold_start", "cold_start"),
+    "mpi_scale": lambda: printed_block("mpi_scale", "mpi_scale"),
     "robustness": robustness_block,
     "io": io_block,
     "primitives": primitives_block,
