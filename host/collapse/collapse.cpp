@@ -39,16 +39,40 @@ namespace {
 // coarsens S and what its changes free. Why two phases: the bound's fan test and the per-vertex
 // bound are host code so far; the interior, most of the work, still runs on the device.
 CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
-  if (!options.vertex_mask.empty() || options.has_user_functions())
+  if (options.has_user_functions())
     throw std::invalid_argument(
-        "the boundary error bound on the parallel method takes no vertex mask (--region, --labels) and no user "
-        "cost, placement or predicate yet: use the sequential method");
+        "the boundary error bound on the parallel method takes no user cost, placement or predicate yet: use the "
+        "sequential method");
   const double bound = boundary_error_bound(mesh, options);
   CollapseOptions inner = options;
   inner.boundary = CollapseOptions::Strict;
   inner.max_boundary_error = inner.max_boundary_error_abs = 0;
-  CollapseReport report = collapse(mesh, inner, ctx);
+  // A vertex mask reaches the second phase through a vertex field, which the device's
+  // compaction and renumbering carry to the survivors (a collapse averages it at a midpoint:
+  // 1 stays 1 where both ends must be selected; with either end, a survivor of a selected end
+  // stays selected).
+  const bool masked = !options.vertex_mask.empty();
+  if (masked) {
+    Field f{"tetcollapse:vertex_mask", 1, {}};
+    f.values.assign(options.vertex_mask.begin(), options.vertex_mask.end());
+    for (double& x : f.values) x = x != 0 ? 1.0 : 0.0;
+    mesh.vertex_fields.push_back(std::move(f));
+  }
+  CollapseReport report;
+  try {
+    report = collapse(mesh, inner, ctx);
+  } catch (...) {
+    if (masked) mesh.vertex_fields.pop_back();
+    throw;
+  }
   CollapseOptions outer = options;
+  if (masked) {
+    const std::vector<double>& v = mesh.vertex_fields.back().values;
+    outer.vertex_mask.resize(v.size());
+    for (size_t i = 0; i < v.size(); ++i)
+      outer.vertex_mask[i] = options.mask_either ? v[i] > 0 : v[i] > 1 - 1e-9;
+    mesh.vertex_fields.pop_back();
+  }
   outer.method = CollapseOptions::Sequential;
   outer.target_length = report.target_length;  // the input's, not the coarse mesh's median
   outer.max_boundary_error = 0;

@@ -209,8 +209,8 @@ struct CollapseOptions {
   // (cl/collapse_surface_error.h); it is conservative, so the measured distance is smaller. With
   // a bound, eps_f is not used: a vertex of a smoothly curved face is a face vertex (ridges and
   // corners as eps_r says), so curved faces coarsen within the bound. The parallel method
-  // coarsens with S frozen on the device, then S with the sequential method's checks; not with a
-  // vertex mask or user functions (std::invalid_argument). 0 (both): no bound.
+  // coarsens with S frozen on the device, then S with the sequential method's checks (a vertex
+  // mask applies to both); not with user functions (std::invalid_argument). 0 (both): no bound.
   double max_boundary_error = 0;
   double max_boundary_error_abs = 0;
   bool bounds_boundary_error() const { return max_boundary_error > 0 || max_boundary_error_abs > 0; }
