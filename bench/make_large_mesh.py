@@ -12,7 +12,7 @@ With the defaults (a0.001) the result is /work/large/robot_q1.33a0.001.msh: 10,7
 TetGen about 9 minutes (under the load of other builds) with a peak of 1.9 GB resident, the
 conversion about 10 s; the intermediate .node/.ele (560 MB) are deleted unless --keep-tetgen.
 TetGen is deterministic here: the same counts on every run. Other sizes: a0.03 gives 0.86M
-tets, a0.0015 7.5M.
+tets, a0.0015 7.5M; W1's a0.6 gives 511,949 (W1 has 514,161: its OFF came from another tool).
 
     /usr/bin/python3 bench/make_large_mesh.py [--out-dir /work/large] [--volume 0.001]
 """
@@ -75,8 +75,9 @@ def main():
     args = ap.parse_args()
 
     os.makedirs(args.out_dir, exist_ok=True)
-    base = os.path.join(args.out_dir, "robot_q%sa%s" % (args.quality, args.volume))
-    out = os.path.join(args.out_dir, args.name or os.path.basename(base) + ".msh")
+    # TetGen reads a trailing ".<digits>" of the input's name as an iteration number: no dots
+    base = os.path.join(args.out_dir, "robot")
+    out = os.path.join(args.out_dir, args.name or "robot_q%sa%s.msh" % (args.quality, args.volume))
     nv, nf = stl_to_off(args.surface, base + ".off")
     print("surface: %d vertices, %d triangles -> %s.off" % (nv, nf, base), flush=True)
     t0 = time.time()
@@ -91,8 +92,9 @@ def main():
     subprocess.run(cmd, check=True)
     print("convert: %.0f s; %s: %.0f MB" % (time.time() - t1, out, os.path.getsize(out) / 1e6), flush=True)
     if not args.keep_tetgen:
-        for ext in (".1.node", ".1.ele"):
-            os.remove(base + ext)
+        for ext in (".1.node", ".1.ele", ".1.smesh"):
+            if os.path.exists(base + ext):
+                os.remove(base + ext)
     return 0
 
 
