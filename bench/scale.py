@@ -110,6 +110,30 @@ def one_mesh(args, name, path, mode, runs):
     return rec
 
 
+def table(path):
+    """Prints the markdown table of a results file (bench/make_tables.py calls it)."""
+    with open(path) as f:
+        d = json.load(f)
+    m = d["meta"]
+    print(f"commit {m['commit']}, {m['machine']}, device {m['device']}, load average "
+          f"{m['load_before']}-{m['load_after']}; W1 median of {m['runs_w1']} runs, the large mesh "
+          f"{m['runs_large']}.\n")
+    print("| mesh | mode | tets in | tets out | s | s per M tets | peak MB | bytes per input tet | check |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---|")
+    for r in d["runs"]:
+        name = "W1" if "514k" in r["mesh"] else f"{r['tets_in'] / 1e6:.1f}M robot"
+        mode = "default" if r["mode"] == "default" else "`--no-improve`"
+        print(f"| {name} | {mode} | {r['tets_in']:,} | {r['tets_out']:,} | {r['seconds']:.2f} | "
+              f"{r['seconds_per_million_tets']:.2f} | {r['peak_rss_bytes'] / 1e6:,.0f} | "
+              f"{r['bytes_per_input_tet']:.0f} | {'valid' if r['valid'] else 'INVALID'} |")
+    print()
+    for mode, q in d["ratios"].items():
+        label = "default" if mode == "default" else "--no-improve"
+        print(f"- {label}: time per input tet, large over W1, {q['time_per_tet_large_over_w1']:.2f} (goal at most "
+              f"{q['goal_time_ratio_at_most']}); {q['large_bytes_per_input_tet']:.0f} bytes per input tet (goal at "
+              f"most {q['goal_bytes_per_tet_at_most']}).")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--tetcollapse", default=os.path.join(ROOT, "build", "tetcollapse"))
