@@ -16,6 +16,10 @@ namespace {
 constexpr double kDeg = 180.0 / 3.14159265358979323846;
 constexpr double kMinAngleGain = 0.05;  // degrees
 constexpr double kMinCountGain = 0.05;  // share of the tets below 10 or 13 degrees
+// The collapse step's rounds: at most this many, each only after one that raised the smallest
+// angle by kMinAngleGain or removed this share of the tets below 10 or 13 degrees.
+constexpr int kMaxCollapseRounds = 4;
+constexpr double kMinRoundGain = 0.1;
 // A tet is below 10 (13) degrees when the cosine of its smallest angle is above these.
 const double kCos10 = std::cos(10 / kDeg), kCos13 = std::cos(13 / kDeg);
 
@@ -170,8 +174,14 @@ ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) 
   ImproveOptions options = given;
   if (given.max_boundary_error_abs > 0) options.max_boundary_error_abs = given.max_boundary_error_abs / 3;
   passes(mesh, options, ctx, options.max_iterations, report, true);
-  // (With a vertex mask the step does not run: the collapse renumbers the vertices.)
-  if (options.collapse && options.vertex_mask.empty() && int(report.passes.size()) < options.max_iterations) {
+  // Rounds of the collapse step and the passes after it, while a round raises the smallest angle
+  // or removes a tenth of the tets below 10 or 13 degrees left (a collapse frees its neighbours for the next passes, which free
+  // edges for the next step). Under a boundary error bound one round: the bound is shared by the
+  // three stages. (With a vertex mask the step does not run: the collapse renumbers the vertices.)
+  const int rounds = given.max_boundary_error_abs > 0 ? 1 : kMaxCollapseRounds;
+  for (int round = 0; round < rounds; ++round) {
+    if (!options.collapse || !options.vertex_mask.empty() || int(report.passes.size()) >= options.max_iterations) break;
+    const ImprovePassStats before = report.passes.back();
     const Stopwatch step;
     ImprovePassStats stats;
     stats.iteration = int(report.passes.size());
@@ -208,6 +218,11 @@ ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) 
       if (options.progress) options.progress(stats);
       passes(mesh, options, ctx, options.max_iterations - int(report.passes.size()), report, false);
     }
+    const ImprovePassStats& after = report.passes.back();
+    if (!(after.min_dihedral_deg >= before.min_dihedral_deg + kMinAngleGain ||
+          double(after.below_10_deg) < double(before.below_10_deg) * (1 - kMinRoundGain) ||
+          double(after.below_13_deg) < double(before.below_13_deg) * (1 - kMinRoundGain)))
+      break;
   }
   report.after = quality_summary(mesh);
   report.seconds_total = clock.peek();
