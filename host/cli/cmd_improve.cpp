@@ -33,6 +33,12 @@ void add_improve_options(CLI::App& cmd, ImproveCli& c) {
   cmd.add_flag("--no-harmonic-collapse", c.no_harmonic,
                "Improvement: the collapse step without the paper's part (edges of the bad tets by the drop\n"
                "of the harmonic index, the survivor placed by a line search): the shortest edges only");
+  cmd.add_option("--improve-collapse-rounds", c.opt.collapse_rounds,
+                 "Improvement: at most N rounds of the collapse step and the passes after it, each only\n"
+                 "after one that raised the smallest angle or removed a tenth of the tets below 10 or 13\n"
+                 "degrees (fewer: faster, more slivers left)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--no-improve-collapse", c.no_collapse,
                "Improvement: no collapse of the short edges of the tets still below 13 degrees after\n"
                "the flips and relocation (that step removes a few vertices)");

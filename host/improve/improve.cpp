@@ -16,9 +16,8 @@ namespace {
 constexpr double kDeg = 180.0 / 3.14159265358979323846;
 constexpr double kMinAngleGain = 0.05;  // degrees
 constexpr double kMinCountGain = 0.05;  // share of the tets below 10 or 13 degrees
-// The collapse step's rounds: at most this many, each only after one that raised the smallest
-// angle by kMinAngleGain or removed this share of the tets below 10 or 13 degrees.
-constexpr int kMaxCollapseRounds = 4;
+// The collapse step's rounds (ImproveOptions::collapse_rounds): each only after one that raised
+// the smallest angle by kMinAngleGain or removed this share of the tets below 10 or 13 degrees.
 constexpr double kMinRoundGain = 0.1;
 // A tet is below 10 (13) degrees when the cosine of its smallest angle is above these.
 const double kCos10 = std::cos(10 / kDeg), kCos13 = std::cos(13 / kDeg);
@@ -178,7 +177,7 @@ ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) 
   // or removes a tenth of the tets below 10 or 13 degrees left (a collapse frees its neighbours for the next passes, which free
   // edges for the next step). Under a boundary error bound one round: the bound is shared by the
   // three stages. (With a vertex mask the step does not run: the collapse renumbers the vertices.)
-  const int rounds = given.max_boundary_error_abs > 0 ? 1 : kMaxCollapseRounds;
+  const int rounds = given.max_boundary_error_abs > 0 ? std::min(1, options.collapse_rounds) : options.collapse_rounds;
   for (int round = 0; round < rounds; ++round) {
     if (!options.collapse || !options.vertex_mask.empty() || int(report.passes.size()) >= options.max_iterations) break;
     const ImprovePassStats before = report.passes.back();

@@ -119,6 +119,10 @@ struct ImproveOptions {
   // a line search along the edge, and no tet of the region made worse by its smallest dihedral
   // angle (CollapseOptions::harmonic_cost); then the shortest edges as above on what is left.
   bool harmonic_collapse = true;
+  // At most this many rounds of the collapse step and the passes after it, each only after one
+  // that raised the smallest angle or removed a tenth of the tets below 10 or 13 degrees (one
+  // under a boundary error bound, which the stages share).
+  int collapse_rounds = 4;
   // With a non-empty mask (one byte per vertex, non-zero = selected), only selected vertices
   // move, and only tets whose vertices are all selected are flipped; the collapse step does not
   // run (it renumbers the vertices).

@@ -204,6 +204,12 @@ TEST(ImproveOps, ASliverOnlyACollapseRemoves) {
   EXPECT_GT(r.after.min_dihedral_deg, 25) << "the collapse took the short edge and its slivers";
   EXPECT_EQ(r.after.below_13_deg, 0);
   EXPECT_TRUE(check_mesh(m, {}, nullptr).valid);
+  // no rounds: no collapse step
+  Mesh no_rounds = without;
+  o.collapse_rounds = 0;
+  int64_t none = 0;
+  for (const auto& p : improve(no_rounds, o).passes) none += p.collapsed;
+  EXPECT_EQ(none, 0);
 }
 
 // A thin tet (a, b, x1, x2) on top of two others (c below), which four more tets (e1..e4)
