@@ -2,6 +2,7 @@
 
 #include <gmpxx.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "geometry.h"
@@ -182,6 +183,19 @@ void validate_arrays(const Mesh& mesh, const std::string& source) {
                                    std::to_string(nt) + " tets");
   if (mesh.tri_tags.size() != mesh.tris.size() / 3) throw InputError(source, "internal: triangle tags size mismatch");
   if (mesh.edge_tags.size() != mesh.edges.size() / 2) throw InputError(source, "internal: edge tags size mismatch");
+}
+
+double bbox_diagonal(const Mesh& mesh) {
+  const int64_t nv = mesh.num_vertices();
+  if (nv == 0) return 0;
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = mesh.points[size_t(k)];
+  for (int64_t v = 0; v < nv; ++v)
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], mesh.points[size_t(3 * v + k)]);
+      hi[k] = std::max(hi[k], mesh.points[size_t(3 * v + k)]);
+    }
+  return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
 }
 
 }  // namespace tc

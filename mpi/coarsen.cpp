@@ -28,18 +28,6 @@ std::vector<uint8_t> selected_by_field(const Mesh& m) {
   return sel;
 }
 
-double diagonal(const Mesh& m) {
-  if (m.num_vertices() == 0) return 0;
-  double lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = m.points[size_t(k)];
-  for (int64_t v = 0; v < m.num_vertices(); ++v)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], m.points[size_t(3 * v + k)]);
-      hi[k] = std::max(hi[k], m.points[size_t(3 * v + k)]);
-    }
-  return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-}
-
 }  // namespace
 
 RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context& ctx) {
@@ -78,7 +66,7 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context& ctx
     if (masked) io.vertex_mask = mask;
     // ImproveOptions::max_boundary_move is relative to the diagonal of the mesh it is given:
     // scale it so that the bound is the whole mesh's.
-    const double d = diagonal(m);
+    const double d = bbox_diagonal(m);
     if (d > 0) io.max_boundary_move *= s.whole_diagonal / d;
     improve(m, io, ctx);
     // Under a mask the library leaves out its collapse step: run it here, then the passes again.

@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "agree.hpp"
-#include "io/io_util.hpp"
+#include "cli/common.hpp"
 #include "report.hpp"
 #include "rounds.hpp"
 #include "stopwatch.hpp"
@@ -38,28 +38,6 @@ Settings make_settings(const Options& o) {
   i.use_labels = c.use_labels;
   i.max_boundary_move = o.max_boundary_move;
   return s;
-}
-
-double bbox_diagonal(const Mesh& m) {
-  if (m.num_vertices() == 0) return 0;
-  double lo[3], hi[3];
-  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = m.points[size_t(k)];
-  for (int64_t v = 0; v < m.num_vertices(); ++v)
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::min(lo[k], m.points[size_t(3 * v + k)]);
-      hi[k] = std::max(hi[k], m.points[size_t(3 * v + k)]);
-    }
-  return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
-}
-
-void write_text(const std::string& path, const std::string& text) {
-  if (path == "-") {
-    std::cout << text << "\n";
-    return;
-  }
-  io::AtomicFile f(path, false);
-  f.stream() << text << "\n";
-  f.commit();
 }
 
 }  // namespace
@@ -144,7 +122,7 @@ int run(Options& o, MPI_Comm comm) {
                    o.out.c_str(), (long long)stats.tets_in, (long long)stats.tets_out,
                    stats.tets_in ? 100.0 * (1.0 - double(stats.tets_out) / double(stats.tets_in)) : 0.0,
                    stats.rounds.size(), stats.seconds_total);
-    if (!o.stats.empty()) write_text(o.stats, stats_json(stats));
+    if (!o.stats.empty()) cli::write_report(o.stats, stats_json(stats));
   });
   if (code == cli::kOk) code = exit_code;
   return agree(code, comm);

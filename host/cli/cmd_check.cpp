@@ -6,17 +6,6 @@
 
 namespace tc::cli {
 
-// Writes `text` to `path` atomically, or to stdout when path is "-".
-void write_report(const std::string& path, const std::string& text) {
-  if (path == "-") {
-    std::cout << text << "\n";
-    return;
-  }
-  io::AtomicFile f(path, false);
-  f.stream() << text << "\n";
-  f.commit();
-}
-
 void register_check(CLI::App& app, int& exit_code) {
   struct Opts {
     std::string path, reference, json;

@@ -22,7 +22,6 @@ namespace {
 // Moves the vertex field `name` to the front (the user cost sees the first); returns where it was.
 }  // namespace
 
-void write_report(const std::string& path, const std::string& text);  // cmd_check.cpp
 
 namespace {
 

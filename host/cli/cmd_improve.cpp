@@ -10,7 +10,6 @@
 
 namespace tc::cli {
 
-void write_report(const std::string& path, const std::string& text);  // cmd_check.cpp
 
 void add_improve_options(CLI::App& cmd, ImproveCli& c) {
   cmd.add_option("--improve-iterations", c.opt.max_iterations,

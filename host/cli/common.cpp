@@ -95,4 +95,15 @@ std::string check_result(const Mesh& result, const Mesh& input, bool hausdorff, 
 #endif
 }
 
+// Writes `text` to `path` atomically, or to stdout when path is "-".
+void write_report(const std::string& path, const std::string& text) {
+  if (path == "-") {
+    std::cout << text << "\n";
+    return;
+  }
+  io::AtomicFile f(path, false);
+  f.stream() << text << "\n";
+  f.commit();
+}
+
 }  // namespace tc::cli

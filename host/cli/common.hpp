@@ -45,6 +45,8 @@ WriteOptions write_options(const OutputOptions& o);
 // format or extension, a folder that does not exist), so that a long run does not end in
 // them. `o` null: a report file (JSON), whose format is not a mesh format, and "-" is stdout.
 void check_output_path(const std::string& path, const OutputOptions* o);
+// Writes `text` to `path` atomically, or to stdout when path is "-" (--stats, --json).
+void write_report(const std::string& path, const std::string& text);
 
 // --boundary strict|features|free (the option checks the name) as the options' enum.
 CollapseOptions::Boundary boundary_mode(const std::string& name);

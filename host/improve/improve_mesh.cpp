@@ -83,14 +83,7 @@ ImpMesh::ImpMesh(Mesh& mesh, const ImproveOptions& options) : mesh_(mesh), point
     bounded_ = true;
     max_boundary_move_ = options.max_boundary_error_abs;
   } else if (options.boundary != CollapseOptions::Strict && options.max_boundary_move > 0 && nv > 0) {
-    double lo[3], hi[3];
-    for (int k = 0; k < 3; ++k) lo[k] = hi[k] = points_[size_t(k)];
-    for (int64_t v = 0; v < nv; ++v)
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], points_[size_t(3 * v + k)]);
-        hi[k] = std::max(hi[k], points_[size_t(3 * v + k)]);
-      }
-    max_boundary_move_ = options.max_boundary_move * std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+    max_boundary_move_ = options.max_boundary_move * bbox_diagonal(mesh);
   }
   mark_motion(options);
   if (max_boundary_move_ > 0) build_surface_grid();

@@ -77,6 +77,10 @@ enum class OrientationPolicy {
   Keep,    // leave a mixed orientation as it is (reported; the checker's reading)
 };
 
+// The length of the diagonal of the mesh's bounding box (0 without vertices): what relative
+// distances (ImproveOptions::max_boundary_move, ...) are shares of.
+double bbox_diagonal(const Mesh& mesh);
+
 // Bring the mesh to positive orientation. A consistently negative mesh is flipped
 // (swap of the last two vertices of each tet). Mixed orientation: with Refuse, throws
 // tc::InputError naming the counts; with Fix, flips the negative tets.
