@@ -23,18 +23,10 @@ void SeqMesh::collapse_region(int32_t a, int32_t b, uint8_t dir, std::vector<int
   *place = placement(a, b, dir);
   tets.clear();
   after.clear();
-  for (int side = 0; side < 2; ++side) {
-    const int32_t z = side == 0 ? x : y;
-    const int32_t* rz = ring(z);
-    for (uint32_t i = 0; i < rlen_[z]; ++i) {
-      const int32_t t = rz[i];
-      const int32_t* q = tet(t);
-      const bool removed = has(q, x) && has(q, y);
-      if (side == 1 && (removed || has(q, x))) continue;  // seen from ring(x)
-      tets.push_back(t);
-      for (int k = 0; k < 4; ++k) after.push_back(removed ? -1 : q[k] == x ? y : q[k]);
-    }
-  }
+  each_edge_star_tet(x, y, [&](int32_t t, const int32_t* q, bool removed) {
+    tets.push_back(t);
+    for (int k = 0; k < 4; ++k) after.push_back(removed ? -1 : q[k] == x ? y : q[k]);
+  });
 }
 
 namespace {
@@ -96,6 +88,14 @@ FieldBound::FieldBound(const Mesh& mesh, const CollapseOptions& o, const SeqMesh
   }
 }
 
+double FieldBound::at_survivor(const Field& f, size_t c) const {
+  const size_t nc = size_t(f.components);
+  double x = 0;
+  for (int k = 0; k < 4; ++k)
+    x += survivor_bary_[k] * f.values[size_t(input_.tets[4 * size_t(survivor_tet_) + size_t(k)]) * nc + c];
+  return x;
+}
+
 double FieldBound::value_error(double value, int32_t v, int c) const {
   return std::abs(value - input_.vertex_fields[in_field_].values[size_t(v) * size_t(nc_) + size_t(c)]);
 }
@@ -106,11 +106,8 @@ bool FieldBound::admits(SeqMesh& sm, const Mesh& mesh, int32_t a, int32_t b, uin
   const double pp[3] = {p.x, p.y, p.z};
   survivor_tet_ = locator_.locate(pp, survivor_bary_);
   const Field& in = input_.vertex_fields[in_field_];
-  survivor_values_.assign(size_t(nc_), 0.0);
-  for (int c = 0; c < nc_; ++c)
-    for (int k = 0; k < 4; ++k)
-      survivor_values_[size_t(c)] +=
-          survivor_bary_[k] * in.values[size_t(input_.tets[4 * size_t(survivor_tet_) + size_t(k)]) * size_t(nc_) + size_t(c)];
+  survivor_values_.resize(size_t(nc_));
+  for (int c = 0; c < nc_; ++c) survivor_values_[size_t(c)] = at_survivor(in, size_t(c));
   points_.clear();
   for (int32_t t : region_)
     for (int32_t v = head_[size_t(t)]; v >= 0; v = next_[size_t(v)]) points_.push_back(v);
@@ -163,12 +160,7 @@ void FieldBound::apply(Mesh& mesh, int32_t survivor) {
     const Field* g = input_.find_vertex_field(f.name);
     if (!g || g->components != f.components) continue;
     const size_t nc = size_t(f.components);
-    for (size_t c = 0; c < nc; ++c) {
-      double x = 0;
-      for (int k = 0; k < 4; ++k)
-        x += survivor_bary_[k] * g->values[size_t(input_.tets[4 * size_t(survivor_tet_) + size_t(k)]) * nc + c];
-      f.values[size_t(survivor) * nc + c] = x;
-    }
+    for (size_t c = 0; c < nc; ++c) f.values[size_t(survivor) * nc + c] = at_survivor(*g, c);
   }
   for (int32_t t : region_) head_[size_t(t)] = -1;
   for (size_t j = 0; j < points_.size(); ++j) {

@@ -38,6 +38,8 @@ class FieldBound {
 
  private:
   double value_error(double value, int32_t input_vertex, int c) const;
+  // Component c of the input's field f at the survivor's place (admits() located it).
+  double at_survivor(const Field& f, size_t c) const;
 
   Mesh input_;  // points, tets and vertex fields of the input
   TetLocator locator_;

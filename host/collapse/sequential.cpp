@@ -172,7 +172,7 @@ double SequentialRun::harmonic_place(int32_t a, int32_t b, geo::tc_d3* place) {
 }
 
 double SequentialRun::harmonic_cost(int32_t a, int32_t b) {
-  if (!mask_.empty() && !(o_.mask_either ? (mask_[a] || mask_[b]) : (mask_[a] && mask_[b]))) return INFINITY;
+  if (!selected(a, b)) return INFINITY;
   uint8_t fe = 0;
   const int dir = sm_.predicate(a, b, fe);
   if (dir < 0) return INFINITY;
@@ -188,10 +188,7 @@ double SequentialRun::harmonic_cost(int32_t a, int32_t b) {
   if (!(gain > 0)) return INFINITY;
   // and, as every operation of the improvement, only if the worst tet of the region (by its
   // smallest dihedral angle's sine) is no worse after (asked last: the sines cost more)
-  double worst_before, worst_after;
-  sm_.harmonic_sum(a, b, nullptr, &worst_before);
-  sm_.harmonic_sum(a, b, &p, &worst_after);
-  return worst_after >= worst_before ? -gain : INFINITY;
+  return sm_.worst_sine(a, b, &p) >= sm_.worst_sine(a, b, nullptr) ? -gain : INFINITY;
 }
 
 bool SequentialRun::step() {
@@ -264,11 +261,7 @@ bool SequentialRun::step() {
   // marking, Q, link and volume; the admissible edges into the queue
   const bool reuse = o_.tuning.reuse_across_iterations;
   const uint32_t prev = uint32_t(it_);  // touched_ value of the previous iteration (0: the input)
-  const int mask_mode = mask_.empty() ? 0 : o_.mask_either ? 2 : 1;
-  auto marked = [&](int32_t a, int32_t b, double c) {
-    const bool allowed = mask_mode == 0 ? true : mask_mode == 1 ? (mask_[a] && mask_[b]) : (mask_[a] || mask_[b]);
-    return allowed && c < target_;
-  };
+  auto marked = [&](int32_t a, int32_t b, double c) { return selected(a, b) && c < target_; };
   heap_.clear();
   for (const QueueEntry& e : edges_) {
     if (!marked(e.a, e.b, e.cost)) continue;

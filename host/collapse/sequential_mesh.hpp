@@ -139,8 +139,9 @@ class SeqMesh {
   bool tet_alive(int32_t t) const { return talive_[t] != 0; }
   // The sum of the harmonic indices of the tets of ring(a) U ring(b) (place null), or of those
   // the collapse of (a, b) leaves with the survivor at *place (infinity if one is flat or
-  // inverted); *worst_sine (when given): the smallest tc_tet_min_sine of those tets.
-  double harmonic_sum(int32_t a, int32_t b, const geo::tc_d3* place, double* worst_sine = nullptr);
+  // inverted); worst_sine: the smallest tc_tet_min_sine of the same tets.
+  double harmonic_sum(int32_t a, int32_t b, const geo::tc_d3* place);
+  double worst_sine(int32_t a, int32_t b, const geo::tc_d3* place);
   // The same sum for the survivor at a + t (b - a), as a function of t: per tet the collapse
   // leaves, eta(t) = (q0 + q1 t + q2 t^2) / (v0 + v1 t) (squared areas are quadratic in t, the
   // volume is linear), so that a line search evaluates each tet in a few operations.
@@ -229,6 +230,32 @@ class SeqMesh {
   }
 
   const int32_t* ring(int32_t v) const { return pool_.data() + roff_[v]; }
+  // fn(t, q, removed) for every tet t = q of ring(first) U ring(second), each once, those of
+  // ring(first) first; removed: it holds both (the collapse of the edge removes it).
+  template <class Fn>
+  void each_edge_star_tet(int32_t first, int32_t second, Fn&& fn) const {
+    for (int side = 0; side < 2; ++side) {
+      const int32_t z = side == 0 ? first : second, w = side == 0 ? second : first;
+      const int32_t* rz = ring(z);
+      for (uint32_t i = 0; i < rlen_[z]; ++i) {
+        const int32_t* q = tet(rz[i]);
+        const bool both = has(q, w);
+        if (side == 1 && both) continue;  // seen from ring(first)
+        fn(rz[i], q, both);
+      }
+    }
+  }
+  // fn(c) for the corners c of each tet of ring(a) U ring(b) (place null), or of each one the
+  // collapse of (a, b) leaves, with the survivor at *place
+  template <class Fn>
+  void each_edge_star_shape(int32_t a, int32_t b, const geo::tc_d3* place, Fn&& fn) const {
+    each_edge_star_tet(a, b, [&](int32_t, const int32_t* q, bool removed) {
+      if (removed && place) return;
+      geo::tc_d3 c[4];
+      for (int k = 0; k < 4; ++k) c[k] = place && (q[k] == a || q[k] == b) ? *place : point(q[k]);
+      fn(c);
+    });
+  }
   uint32_t ring_size(int32_t v) const { return rlen_[v]; }
   void ring_append(int32_t v, int32_t t);
   void ring_remove(int32_t v, int32_t t);

@@ -109,6 +109,12 @@ class SequentialRun {
     return std::fabs(f.values[size_t(a) * size_t(f.components)] - f.values[size_t(b) * size_t(f.components)]);
   }
 
+  // The vertex mask's verdict on the edge (a, b): both end points selected, or either with
+  // mask_either; every edge without a mask.
+  bool selected(int32_t a, int32_t b) const {
+    if (mask_.empty()) return true;
+    return o_.mask_either ? (mask_[a] || mask_[b]) : (mask_[a] && mask_[b]);
+  }
   // Minus the drop of the harmonic sum (+infinity outside the mask, where Q refuses, or where
   // it does not drop), with the survivor where the rules or the line search put it.
   double harmonic_cost(int32_t a, int32_t b);
