@@ -259,6 +259,26 @@ inline uchar tcc_lazy_verdict(int e, int a, int b, int dir, TCC_TEST_PARAMS) {
   return edges2verdict[e];
 }
 
+/* The turn of edge e in the lazy filter: its link and volume tests (or the verdict kept),
+ * then IN (verts2collapse of both end points; returns 1) or OUT (0). */
+inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* edges2state, __global int* verts2collapse,
+                           TCC_TEST_PARAMS) {
+  int a = edges[2 * e], b = edges[2 * e + 1];
+  int dir = tcc_lazy_dir(e, a, b, TCC_TEST_ARGS);
+  uchar r = tcc_lazy_verdict(e, a, b, dir, TCC_TEST_ARGS);
+  edges2reason[e] = r;
+  if (r == TCC_OK) {
+    edges2dir[e] = (uchar)dir;
+    atomic_inc(&counters[1]);
+    edges2state[e] = TCC_IN;
+    verts2collapse[a] = e;
+    verts2collapse[b] = e;
+    return 1;
+  }
+  edges2state[e] = TCC_OUT;
+  return 0;
+}
+
 /* verts2slot[v] anew; with verts2slot_priority (the matching selection), verts2slot_priority[v] =
  * the slot's priority (INFINITY for none), which its scans compare without loading the edge's. */
 inline void tcc_p1_recompute(int v, __global const uint* nb_off, __global const int* nb_edge,

@@ -11,14 +11,14 @@ namespace tc::collapse_detail {
 
 uint32_t greedy_selection(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                           uint32_t& passed_q, uint32_t& tested) {
-  const std::string A = "collapse_admissible.cl";
-  Kernel decide = stage_kernel(ctx, p, A, "greedy_decide"), loop = stage_kernel(ctx, p, A, "greedy_loop");
+  const std::string A = "collapse_admissible.cl", G = "collapse_select_greedy.cl";
+  Kernel decide = stage_kernel(ctx, p, G, "greedy_decide"), loop = stage_kernel(ctx, p, G, "greedy_loop");
   // the priority first: lazy_init claims the first slots in its order
   const DeviceBuffer<double>& prio = selection_priority(ctx, c, s, p);
   lazy_start(ctx, dm, c, s, p, prio, {&decide, &loop});
   selection_buffers(ctx, dm, c, s);
   const cl_int W = p.waiting_lists ? 1 : 0;
-  Kernel block = kernel(ctx, A, "greedy_block"), recompute = kernel(ctx, A, "lazy_p1_recompute"),
+  Kernel block = kernel(ctx, G, "greedy_block"), recompute = kernel(ctx, A, "lazy_p1_recompute"),
              turns = kernel(ctx, A, "lazy_p1_turns");
   auto one_round = [&](uint32_t nt, int cur, cl_uint round) {
     decide.set(arg("n", nt), arg("cur", cl_uint(cur)), arg("tlist", s.lazy.turn_lists[cur]), arg("tnext", s.lazy.turn_lists[1 - cur]), arg("cnt", s.lazy.list_counts), arg("edges", c.edges), arg("edges2priority", prio), arg("verts2slot", s.lazy.verts2slot[0]), arg("edges2blocker", s.lazy.edges2blocker), arg("edges2queued", s.lazy.edges2queued), arg("round", round), arg("inlist", s.lazy.round_taken), arg("verts2listed", s.lazy.verts2listed), arg("dlist", s.lazy.vertex_list), arg("edges2state", s.result.edges2state), arg("verts2collapse", s.result.verts2collapse), arg("waiting", W), arg("verts2waiting", s.lazy.verts2waiting), arg("edges2next_waiting", s.lazy.edges2next_waiting));

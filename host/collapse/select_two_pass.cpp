@@ -151,9 +151,9 @@ uint32_t conflict_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState
 
 uint32_t lazy_admissible_pass1(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p,
                                uint32_t& passed_q, uint32_t& tested, bool restrict_clean) {
-  const std::string A = "collapse_admissible.cl";
+  const std::string T = "collapse_select_two_pass.cl";
   // the test's arguments, the same for the per-round kernel and the one-work-group loop
-  Kernel decide = stage_kernel(ctx, p, A, "lazy_p1_decide"), loop = stage_kernel(ctx, p, A, "lazy_p1_loop");
+  Kernel decide = stage_kernel(ctx, p, T, "lazy_p1_decide"), loop = stage_kernel(ctx, p, T, "lazy_p1_loop");
   lazy_start(ctx, dm, c, s, p, s.cost.edges2cost, {&decide, &loop}, false, restrict_clean);
   lazy_p1_rounds(ctx, s, c, decide, loop, p);
   run(ctx, "collapse_conflict.cl", "conflict_pass1_finish", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("edges2state", s.result.edges2state), arg("edges_pass1", s.result.edges_pass1), arg("verts2collapse", s.result.verts2collapse), arg("counters", s.cost.counters));
