@@ -20,6 +20,9 @@ inline uint tc_load(__global const uint* in, uint i, uint n, uint as_flags) {
   return as_flags ? (v != 0u ? 1u : 0u) : v;
 }
 
+/* The tile scan (GPU devices); without it where the host runs the chunked one (TC_SCAN_CHUNKED),
+ * which saves a CPU device compiling kernels it never launches. */
+#ifndef TC_SCAN_CHUNKED
 /* Exclusive scan of s[0..m) in local memory (m = local size); returns the total. */
 inline uint tc_local_exclusive_scan(__local uint* s, uint l, uint m) {
   for (uint off = 1; off < m; off <<= 1) {
@@ -79,6 +82,7 @@ __kernel void scan_downsweep(__global const uint* in, __global uint* out, uint n
   }
   if (g == get_num_groups(0) - 1 && l == 0) total[0] = offset + tile_total;
 }
+#endif
 
 /* Compaction: positions = exclusive scan of (flags != 0). */
 __kernel void compact_indices(__global const uint* flags, __global const uint* positions, uint n,

@@ -223,6 +223,10 @@ PYBIND11_MODULE(_core, mod) {
   mod.def("improve", &improve_py, py::arg("points"), py::arg("tets"), py::kw_only(), py::arg("boundary") = "features",
           py::arg("labels") = py::none(), py::arg("vertex_fields") = py::none(), py::arg("device") = py::none(),
           py::arg("method") = "parallel", "Raises the worst element quality; returns a dict as collapse does.");
+  // a first run's kernels compile in helper processes: this module, in another interpreter
+  // (tetcollapse/__init__.py sets the command; tc::set_compile_helper)
+  mod.def("_set_compile_helper", &tc::set_compile_helper, py::arg("argv"));
+  mod.def("_compile_helper", &tc::run_compile_helper, py::arg("device_index"));
   mod.def("check", &check_py, py::arg("points"), py::arg("tets"),
           "Checks a mesh (tetcollapse check): the report as a dict (valid, findings, quality, ...).");
   mod.def(

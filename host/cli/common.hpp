@@ -20,6 +20,9 @@ enum ExitCode : int {
   kOutputError = 4,   // the result could not be written (nothing half-written is left)
 };
 
+// The first argument by which the tool starts itself as a kernel compile helper (main.cpp).
+inline constexpr const char* kCompileHelperArg = "__compile-helper";
+
 // Options every subcommand that reads a mesh shares.
 struct InputOptions {
   std::string format;            // "" = from the extension

@@ -1,11 +1,16 @@
 // tetcollapse: the command-line tool. Each subcommand lives in its own cmd_*.cpp file; this
 // file only wires them together and turns exceptions into the documented exit codes.
+#include <cstdlib>
 #include <iostream>
+#include <string>
 
 #include "cli/common.hpp"
 
 int main(int argc, char** argv) {
   using namespace tc::cli;
+  // a first run's kernels compile in helpers, this program started again (tc::set_compile_helper)
+  if (argc == 3 && std::string(argv[1]) == kCompileHelperArg) return tc::run_compile_helper(std::atoi(argv[2]));
+  tc::set_compile_helper({"/proc/self/exe", kCompileHelperArg});
   CLI::App app{
       "tetcollapse " TETCOLLAPSE_VERSION
       ": coarsen unstructured tetrahedral meshes by massively parallel edge collapse (OpenCL).\n"

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "collapse/programs.hpp"
 #include "tetcollapse/fields.hpp"
 
 namespace tc {
@@ -84,6 +85,9 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
     co.max_boundary_error = 0;
   }
 
+  if (ctx && co.method != CollapseOptions::Sequential && !(co.max_field_error > 0))
+    collapse_detail::prefetch_programs(*ctx, co);
+  if (ctx && improve_phase) improve_detail::prefetch_programs(*ctx);
   CoarsenReport r;
   {
     const bool cost_by_field = by_field && !(co.max_field_error > 0);

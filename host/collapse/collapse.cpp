@@ -9,10 +9,12 @@
 #include "collapse/cost.hpp"
 #include "collapse/edge_state.hpp"
 #include "collapse/host_tail.hpp"
+#include "collapse/programs.hpp"
 #include "collapse/selection.hpp"
 #include "collapse/target.hpp"
 #include "collapse/upload.hpp"
 #include "collapse/verdict_carry.hpp"
+#include "device/primitives.hpp"
 #include "stopwatch.hpp"
 #include "tetcollapse/collapse.hpp"
 
@@ -102,6 +104,25 @@ CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Cont
 
 }  // namespace
 
+namespace collapse_detail {
+void prefetch_programs(Context& ctx, const CollapseOptions& o) {
+  ctx.prefetch("collapse_connectivity.cl");
+  dev::prefetch_scan(ctx);
+  ctx.prefetch("collapse_cost.cl");
+  if (o.conflicts == CollapseOptions::Matching) ctx.prefetch("collapse_matching.cl");
+  if (o.conflicts == CollapseOptions::AtomicMin) ctx.prefetch("collapse_atomic_min.cl");
+  if (o.conflicts == CollapseOptions::TwoPass) ctx.prefetch("collapse_conflict.cl");
+  ctx.prefetch("collapse_admissible.cl");
+  if (o.boundary != CollapseOptions::Strict) {  // the surface guard
+    ctx.prefetch("collapse_guard_applied.cl");
+    ctx.prefetch("collapse_guard.cl");
+  }
+  ctx.prefetch("collapse_verdicts.cl");
+  ctx.prefetch("collapse_compact.cl");
+  ctx.prefetch("collapse_update.cl");
+}
+}  // namespace collapse_detail
+
 CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
   // The field error bound's check reads the input vertices of the region a collapse changes,
   // which live on the host (CollapseOptions::max_field_error).
@@ -110,6 +131,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   if (options.bounds_boundary_error()) return collapse_bounded(mesh, options, ctx);
   check_options(options, ctx);
   check_device_memory(ctx, mesh, options);
+  prefetch_programs(ctx, options);
   CollapseReport report = report_for(mesh, ctx);
   StageParams p = params_from(options);
   p.eps_v = report.eps_v = volume_threshold(mesh, options);

@@ -32,6 +32,12 @@ const std::string kScanOptions = "-DTC_ITEMS=" + std::to_string(kScanItems);
 
 std::optional<Tuning> g_override;
 
+// The scan program as the device runs it: without the tile scan's kernels where the host runs the
+// chunked scan (cl/scan.cl).
+std::string scan_options(const Context& ctx) {
+  return tuning_for(ctx).chunked_scan ? kScanOptions + " -DTC_SCAN_CHUNKED" : kScanOptions;
+}
+
 void check_n(size_t n, const char* what) {
   // Kernels index with 32-bit unsigned integers; tiles may run past n by one tile.
   if (n > (size_t{1} << 31)) throw std::invalid_argument(std::string(what) + ": more than 2^31 elements");
@@ -64,7 +70,7 @@ size_t scan_group_size(Context& ctx, const cl::Kernel& k) {
 
 uint32_t scan_chunked(Context& ctx, const cl::Buffer& in, cl::Buffer& out, size_t n, bool as_flags) {
   size_t items = (n + kScanChunk - 1) / kScanChunk;
-  cl::Kernel apply = ctx.kernel("scan.cl", "scan_chunk_apply", kScanOptions);
+  cl::Kernel apply = ctx.kernel("scan.cl", "scan_chunk_apply", scan_options(ctx));
   DeviceBuffer<uint32_t> total(ctx, 1);
   uint32_t result = 0;
   if (items == 1) {
@@ -74,7 +80,7 @@ uint32_t scan_chunked(Context& ctx, const cl::Buffer& in, cl::Buffer& out, size_
     total.download(&result, 1);
     return result;
   }
-  cl::Kernel sums_k = ctx.kernel("scan.cl", "scan_chunk_sums", kScanOptions);
+  cl::Kernel sums_k = ctx.kernel("scan.cl", "scan_chunk_sums", scan_options(ctx));
   DeviceBuffer<uint32_t> sums(ctx, items);
   set_args(sums_k, "scan_chunk_sums", in, u32(n), u32(as_flags), u32(kScanChunk), u32(items), sums.buffer());
   ctx.launch(sums_k, items, "clEnqueueNDRangeKernel(scan_chunk_sums)");
@@ -88,8 +94,8 @@ uint32_t scan_chunked(Context& ctx, const cl::Buffer& in, cl::Buffer& out, size_
 uint32_t scan_impl(Context& ctx, const cl::Buffer& in, cl::Buffer& out, size_t n, bool as_flags) {
   if (n == 0) return 0;
   if (tuning_for(ctx).chunked_scan) return scan_chunked(ctx, in, out, n, as_flags);
-  cl::Kernel reduce = ctx.kernel("scan.cl", "scan_reduce", kScanOptions);
-  cl::Kernel down = ctx.kernel("scan.cl", "scan_downsweep", kScanOptions);
+  cl::Kernel reduce = ctx.kernel("scan.cl", "scan_reduce", scan_options(ctx));
+  cl::Kernel down = ctx.kernel("scan.cl", "scan_downsweep", scan_options(ctx));
   size_t wg = std::min(scan_group_size(ctx, reduce), scan_group_size(ctx, down));
   size_t tile = wg * kScanItems;
   size_t groups = (n + tile - 1) / tile;
@@ -125,7 +131,7 @@ uint32_t compact_values(Context& ctx, const DeviceBuffer<T>& values, const Devic
   DeviceBuffer<uint32_t> pos(ctx, n);
   uint32_t count = scan_impl(ctx, flags.buffer(), pos.buffer(), n, true);
   out.resize(count);
-  cl::Kernel k = ctx.kernel("scan.cl", kernel_name, kScanOptions);
+  cl::Kernel k = ctx.kernel("scan.cl", kernel_name, scan_options(ctx));
   set_args(k, kernel_name, values.buffer(), flags.buffer(), pos.buffer(), u32(n), out.buffer());
   ctx.launch(k, n, kernel_name);
   return count;
@@ -178,6 +184,8 @@ void radix_sort_impl(Context& ctx, DeviceBuffer<uint64_t>& keys, DeviceBuffer<ui
 
 }  // namespace
 
+void prefetch_scan(Context& ctx) { ctx.prefetch("scan.cl", scan_options(ctx)); }
+
 Tuning default_tuning(bool cpu) {
   Tuning t;
   if (cpu) {
@@ -219,7 +227,7 @@ uint32_t compact_indices(Context& ctx, const DeviceBuffer<uint32_t>& flags, Devi
   DeviceBuffer<uint32_t> pos(ctx, n);
   uint32_t count = scan_impl(ctx, flags.buffer(), pos.buffer(), n, true);
   out.resize(count);
-  cl::Kernel k = ctx.kernel("scan.cl", "compact_indices", kScanOptions);
+  cl::Kernel k = ctx.kernel("scan.cl", "compact_indices", scan_options(ctx));
   set_args(k, "compact_indices", flags.buffer(), pos.buffer(), u32(n), out.buffer());
   ctx.launch(k, n, "clEnqueueNDRangeKernel(compact_indices)");
   return count;

@@ -11,8 +11,10 @@
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <thread>
 #include <vector>
 
+#include "device/compile_pool.hpp"
 #include "device/program_cache.hpp"
 #include "tetcollapse/device.hpp"
 
@@ -330,6 +332,16 @@ Context::Context(const DeviceInfo& info) {
 
 Context::~Context() = default;
 
+int run_compile_helper(int device_index) {
+  try {
+    auto all = enumerate();
+    if (device_index < 0 || size_t(device_index) >= all.size()) return 2;
+    return device_detail::serve_compile_requests(all[size_t(device_index)].device);
+  } catch (const std::exception&) {
+    return 3;
+  }
+}
+
 void Context::init(const DeviceInfo&) {
   cpu_tuning_ = info_.type == "CPU";
   // TETCOLLAPSE_TUNING=gpu|cpu overrides the device type's choice (e.g. the whole test suite
@@ -457,7 +469,7 @@ cl::Program& Context::program(const std::string& file, const std::string& option
   return build(file, text, options);
 }
 
-cl::Program& Context::build(const std::string& file, const std::string& text, const std::string& options) {
+std::string Context::options_as_built(const std::string& options) const {
   std::string opts = "-cl-std=CL1.2";
   // CPU devices run a work-group's items one after another, so a kernel may prefetch for its
   // next items (the selections' decisions and match_apply: tcc_prefetch_test in
@@ -470,26 +482,55 @@ cl::Program& Context::build(const std::string& file, const std::string& text, co
   opts += " -cl-kernel-arg-info";
   if (!options.empty()) opts += " " + options;
   if (const char* extra = std::getenv("TETCOLLAPSE_CL_OPTIONS"); extra && *extra) opts += std::string(" ") + extra;
+  return opts;
+}
+
+Context::Unit Context::unit(const std::string& file, const std::string& text, const std::string& options) const {
+  Unit u;
+  u.opts = options_as_built(options);
+  std::set<std::string> seen{file};
+  expand_text(text, u.source, seen, 0);
+  u.cache_key = info_.name + '\n' + info_.vendor + '\n' + info_.driver_version + '\n' + info_.platform_version + '\n' +
+                u.opts + '\n' + u.source;
+  return u;
+}
+
+device_detail::CompilePool& Context::pool() {
+  if (!pool_) {
+    const unsigned cores = std::thread::hardware_concurrency();
+    pool_ = std::make_unique<device_detail::CompilePool>(device_, info_.index, std::clamp(cores, 1u, 4u));
+  }
+  return *pool_;
+}
+
+void Context::prefetch(const std::string& file, const std::string& options) {
+  if (programs_.count({file, options_as_built(options)})) return;
+  const char* text = kernels::find(file.c_str());
+  if (!text) throw DeviceError("embedded kernel file '" + file + "' not found (is it in cl/?)");
+  Unit u = unit(file, text, options);
+  device_detail::ProgramCache cache(cache_dir(), u.cache_key);
+  std::error_code ec;
+  if (!cache.path().empty() && std::filesystem::exists(cache.path(), ec)) return;
+  if (compile_notice_) compile_notice_(file);
+  pool().prefetch(u.opts + '\n' + file, {u.source, u.opts, cache_dir(), u.cache_key});
+}
+
+cl::Program& Context::build(const std::string& file, const std::string& text, const std::string& options) {
   // in memory under the options as built: a change of cpu_tuning or of the environment's
   // options between two calls builds again
+  const std::string opts = options_as_built(options);
   auto key = std::make_pair(file, opts);
   if (auto it = programs_.find(key); it != programs_.end()) {
     last_build_source_ = BuildSource::Memory;
     return it->second;
   }
-  std::string source;
-  std::set<std::string> seen{file};
-  expand_text(text, source, seen, 0);
+  const Unit u = unit(file, text, options);
+  device_detail::ProgramCache cache(cache_dir(), u.cache_key);
 
-  std::string cache_key = info_.name + '\n' + info_.vendor + '\n' + info_.driver_version + '\n' + info_.platform_version +
-                          '\n' + opts + '\n' + source;
-  device_detail::ProgramCache cache(cache_dir(), cache_key);
-
-  cl::Program prog;
-  bool built = false;
-  if (auto binary = cache.load()) {
+  // a program from a binary (the disk cache's or a compile worker's); false if it will not load
+  auto from_binary = [&](const std::vector<unsigned char>& binary, cl::Program& prog) {
     try {
-      cl::Program::Binaries bins{*binary};
+      cl::Program::Binaries bins{binary};
       std::vector<cl_int> status;
       prog = cl::Program(context_, {device_}, bins, &status);
       prog.build({device_}, opts.c_str());
@@ -498,34 +539,38 @@ cl::Program& Context::build(const std::string& file, const std::string& text, co
       prog.createKernels(&kernels);
       if (!kernels.empty() && kernels[0].getInfo<CL_KERNEL_NUM_ARGS>() > 0)
         (void)kernels[0].getArgInfo<CL_KERNEL_ARG_NAME>(0);
-      built = true;
-      last_build_source_ = BuildSource::DiskCache;
+      return true;
     } catch (const cl::Error&) {
-      built = false;  // a stale or corrupt binary: rebuild from source below
+      return false;  // a stale or corrupt binary
     }
+  };
+
+  cl::Program prog;
+  const std::string pool_key = opts + '\n' + file;
+  const bool prefetched = pool_ && pool_->has(pool_key);  // then from the pool, which holds its binary
+  if (auto binary = prefetched ? std::nullopt : cache.load(); binary && from_binary(*binary, prog)) {
+    last_build_source_ = BuildSource::DiskCache;
+    return programs_.emplace(key, std::move(prog)).first->second;
   }
-  if (!built) {
-    detail::cl_call(("clCreateProgramWithSource(" + file + ")").c_str(), [&] { prog = cl::Program(context_, source); });
-    if (compile_notice_) compile_notice_(file);
+  if (compile_notice_) compile_notice_(file);
+  last_build_source_ = BuildSource::Source;
+  // on a worker (which also stores the binary on disk), while the others compile what was
+  // prefetched; from source here when that gives no binary, with the build log on failure
+  if (auto binary = pool().take(pool_key, {u.source, u.opts, cache_dir(), u.cache_key});
+      !binary.empty() && from_binary(binary, prog))
+    return programs_.emplace(key, std::move(prog)).first->second;
+  detail::cl_call(("clCreateProgramWithSource(" + file + ")").c_str(), [&] { prog = cl::Program(context_, u.source); });
+  try {
+    prog.build({device_}, opts.c_str());
+  } catch (const cl::Error& e) {
+    std::string log;
     try {
-      prog.build({device_}, opts.c_str());
-    } catch (const cl::Error& e) {
-      std::string log;
-      try {
-        log = prog.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
-      } catch (const cl::Error&) {
-        log = "(no build log)";
-      }
-      throw DeviceError("clBuildProgram(" + file + "): " + cl_error_name(e.err()) + " on '" + info_.name +
-                        "' with options '" + opts + "'; build log:\n" + log);
-    }
-    last_build_source_ = BuildSource::Source;
-    try {
-      auto bins = prog.getInfo<CL_PROGRAM_BINARIES>();
-      if (bins.size() == 1 && !bins[0].empty()) cache.store(bins[0]);
+      log = prog.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
     } catch (const cl::Error&) {
-      // Binaries are an optimisation; a device that cannot return them just recompiles.
+      log = "(no build log)";
     }
+    throw DeviceError("clBuildProgram(" + file + "): " + cl_error_name(e.err()) + " on '" + info_.name +
+                      "' with options '" + opts + "'; build log:\n" + log);
   }
   return programs_.emplace(key, std::move(prog)).first->second;
 }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "collapse/programs.hpp"
 #include "improve/improve_mesh.hpp"
 #include "stopwatch.hpp"
 
@@ -166,6 +167,7 @@ int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options, bool harmonic) {
 
 ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) {
   const Stopwatch clock;
+  if (ctx) prefetch_programs(*ctx);
   ImproveReport report;
   report.before = quality_summary(mesh);
   // A boundary error bound is shared by the three stages that may move S: the passes, the
@@ -229,6 +231,11 @@ ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) 
 }
 
 }  // namespace
+
+void improve_detail::prefetch_programs(Context& ctx) {
+  ctx.prefetch("improve_relocate.cl");                      // smooth_pass (relocate_device.cpp)
+  if (!ctx.cpu_tuning()) ctx.prefetch("improve_flip.cl");  // flip_pass (flips_device.cpp) off a CPU
+}
 
 ImproveReport improve(Mesh& mesh, const ImproveOptions& options) { return improve_on(mesh, options, nullptr); }
 ImproveReport improve(Mesh& mesh, const ImproveOptions& options, Context& ctx) {

@@ -31,6 +31,10 @@
 
 namespace tc {
 
+namespace device_detail {
+class CompilePool;
+}
+
 // One OpenCL device as listed by `tetcollapse devices`.
 struct DeviceInfo {
   int index = 0;                 // global index over all platforms, as used by --device INDEX
@@ -59,6 +63,16 @@ DeviceInfo select_device(const std::string& spec = "");
 // Translates an OpenCL error code into its name ("CL_OUT_OF_RESOURCES"); "CL_ERROR(<code>)"
 // for codes it does not know.
 const char* cl_error_name(int code);
+
+// A first run on a device compiles its programs in helper processes, one per core, when a
+// command for them is set: the argv of a program that, given these arguments followed by a device
+// index, returns run_compile_helper(index) (the command line tool sets itself). Why processes:
+// PoCL compiles one program at a time in a process. Without one (the default) the programs are
+// compiled in threads of this process. Process-wide.
+void set_compile_helper(std::vector<std::string> argv);
+// The helper's side: serves a parent's compile requests on its standard input (a socket) until
+// it closes; the exit code.
+int run_compile_helper(int device_index);
 
 // A context, a device and one in-order command queue. Programs are compiled once per context
 // (in memory) and once per machine (the on-disk binary cache).
@@ -107,6 +121,10 @@ class Context {
   cl::Program& build(const std::string& name, const std::string& source, const std::string& options = "");
   // A fresh kernel object of that program (kernels hold their arguments, so callers own them).
   cl::Kernel kernel(const std::string& file, const std::string& name, const std::string& options = "");
+  // Starts compiling program(file, options) on another thread when it is in neither the memory
+  // nor the disk cache, so that a first run compiles the programs it will use on every core
+  // while it waits for the first of them; program() then takes the result.
+  void prefetch(const std::string& file, const std::string& options = "");
 
   // Enqueues a 1-D launch of n work items: the global size is n rounded up to a multiple of the
   // work-group size, so kernels must check their global id against n. `what` names the kernel
@@ -133,6 +151,13 @@ class Context {
 
  private:
   void init(const DeviceInfo& info);
+  // What build() compiles: the options as built, the source with its includes, the disk cache key.
+  struct Unit {
+    std::string opts, source, cache_key;
+  };
+  Unit unit(const std::string& file, const std::string& text, const std::string& options) const;
+  std::string options_as_built(const std::string& options) const;
+  device_detail::CompilePool& pool();
   DeviceInfo info_;
   cl::Platform platform_;
   cl::Device device_;
@@ -143,6 +168,7 @@ class Context {
   std::map<std::pair<std::string, std::string>, cl::Program> programs_;
   BuildSource last_build_source_ = BuildSource::Memory;
   std::function<void(const std::string&)> compile_notice_;
+  std::unique_ptr<device_detail::CompilePool> pool_;  // made at the first compile from source
 };
 
 namespace detail {

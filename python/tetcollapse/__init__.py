@@ -15,6 +15,19 @@ with PyVista, from_pyvista / to_pyvista convert pyvista.UnstructuredGrid objects
 """
 from ._core import DeviceError, __version__, check, collapse, devices, improve, read, write  # noqa: F401
 
+# A first run on a device compiles the kernels in helper processes, one per core (PoCL compiles one
+# program at a time in a process): this interpreter again, running the module's helper loop, with
+# the device's index as its last argument.
+import os as _os
+import sys as _sys
+
+from . import _core
+
+_COMPILE_HELPER = [_sys.executable, "-c",
+                   "import sys; sys.path.insert(0, %r); from tetcollapse import _core; "
+                   "sys.exit(_core._compile_helper(int(sys.argv[1])))" % _os.path.dirname(_os.path.dirname(__file__))]
+_core._set_compile_helper(_COMPILE_HELPER)
+
 __all__ = ["collapse", "improve", "check", "read", "write", "devices", "from_meshio", "to_meshio", "from_pyvista",
            "to_pyvista", "DeviceError"]
 

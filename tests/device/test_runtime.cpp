@@ -336,6 +336,53 @@ TEST_F(RuntimeCtx, BinaryCacheIsUsedOnSecondStartAndSurvivesCorruption) {
   EXPECT_EQ(sixth->last_build_source(), tc::Context::BuildSource::Source);
 }
 
+// A first run compiles the programs it will use in helper processes (tc::set_compile_helper; the
+// command line tool names itself): they come back as binaries, land in the disk cache and run.
+// A helper that cannot start, or ends at once, leaves the build to this process.
+TEST_F(RuntimeCtx, PrefetchedProgramsCompileInHelperProcesses) {
+  const std::string opts = "-DTC_TEST_NONCE=" + std::to_string(std::random_device{}());
+  const std::string log = (dir_.path() / "helpers.log").string();
+  struct Restore {
+    ~Restore() { tc::set_compile_helper({}); }
+  } restore;
+  // the helper as a shell that notes its start, then the tool (the device index is its $0)
+  tc::set_compile_helper({"/bin/sh", "-c", "echo started >> '" + log + "'; exec '" TC_CLI "' __compile-helper \"$0\""});
+  ctx_->prefetch("segments.cl", opts);
+  ctx_->prefetch("scan.cl", opts);
+  cl::Kernel k = ctx_->kernel("scan.cl", "compact_indices", opts);
+  EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Source);
+  ctx_->kernel("segments.cl", "segment_heads", opts);
+  EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Source);
+  // the kernel runs: positions of the set flags
+  tc::DeviceBuffer<uint32_t> flags(*ctx_, std::vector<uint32_t>{1, 0, 1, 1}), pos(*ctx_, std::vector<uint32_t>{0, 1, 1, 2}),
+      out(*ctx_, 3);
+  k.setArg(0, flags.buffer());
+  k.setArg(1, pos.buffer());
+  k.setArg(2, cl_uint(4));
+  k.setArg(3, out.buffer());
+  ctx_->launch(k, 4, "compact_indices");
+  EXPECT_EQ(out.download(), (std::vector<uint32_t>{0, 2, 3}));
+  std::ifstream in(log);
+  const std::string started((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(started.find("started"), std::string::npos) << "no helper process ran";
+  // their binaries are in the disk cache
+  auto second = std::make_unique<tc::Context>();
+  second->program("scan.cl", opts);
+  EXPECT_EQ(second->last_build_source(), tc::Context::BuildSource::DiskCache);
+  second->program("segments.cl", opts);
+  EXPECT_EQ(second->last_build_source(), tc::Context::BuildSource::DiskCache);
+
+  for (const std::vector<std::string>& helper :
+       {std::vector<std::string>{"/no/such/helper"}, std::vector<std::string>{"/bin/sh", "-c", "exit 0"}}) {
+    tc::set_compile_helper(helper);
+    const std::string o = opts + "1" + std::to_string(helper.size());
+    auto third = std::make_unique<tc::Context>();
+    third->prefetch("scan.cl", o);
+    third->kernel("scan.cl", "compact_indices", o);
+    EXPECT_EQ(third->last_build_source(), tc::Context::BuildSource::Source) << helper[0];
+  }
+}
+
 TEST(Runtime, CacheDirFollowsTheEnvironment) {
   EnvVar a("TETCOLLAPSE_CACHE_DIR", "/tmp/tc-a");
   EXPECT_EQ(tc::Context::cache_dir(), "/tmp/tc-a");

@@ -33,6 +33,14 @@ def cube(n):
 
 
 class Module(unittest.TestCase):
+    def test_compile_helper_command_runs_the_helper_loop(self):
+        # the command a first run starts per core (tetcollapse/__init__.py): another interpreter
+        # that finds the module and serves compile requests until its input ends (here at once)
+        import subprocess
+        p = subprocess.run(tetcollapse._COMPILE_HELPER + ["0"], stdin=subprocess.DEVNULL, capture_output=True,
+                           text=True, cwd=tempfile.gettempdir(), env=dict(os.environ, PYTHONPATH=""))
+        self.assertEqual(p.returncode, 0, p.stderr)
+
     def test_collapse_numpy_in_and_out(self):
         points, tets = cube(6)
         field = points[:, 0] + 2 * points[:, 1]

@@ -1,0 +1,15 @@
+// The device programs a run uses, in the order it first needs them, for Context::prefetch: a
+// first run (nothing in the disk cache) compiles them on every core while it waits for the
+// first. A program left out is compiled when first used; one too many costs a compile.
+#pragma once
+
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/device.hpp"
+
+namespace tc::collapse_detail {
+void prefetch_programs(Context& ctx, const CollapseOptions& options);  // collapse.cpp
+}
+
+namespace tc::improve_detail {
+void prefetch_programs(Context& ctx);  // improve.cpp
+}
