@@ -59,6 +59,16 @@ TC_FN double tc_orient3d(tc_d3 a, tc_d3 b, tc_d3 c, tc_d3 d) {
 
 TC_FN double tc_tet_volume(tc_d3 a, tc_d3 b, tc_d3 c, tc_d3 d) { return tc_orient3d(a, b, c, d) / 6.0; }
 
+/* The barycentric coordinates of p in the tet (c0, c1, c2, c3): the point location of the
+ * fields, on the host (TetLocator) and on the device (bvh.cl), with the same operations. */
+TC_FN void tc_barycentric(tc_d3 c0, tc_d3 c1, tc_d3 c2, tc_d3 c3, tc_d3 p, double* b) {
+  const double v = tc_orient3d(c0, c1, c2, c3);
+  b[0] = tc_orient3d(p, c1, c2, c3) / v;
+  b[1] = tc_orient3d(c0, p, c2, c3) / v;
+  b[2] = tc_orient3d(c0, c1, p, c3) / v;
+  b[3] = 1.0 - b[0] - b[1] - b[2];
+}
+
 /* Error bound of the floating-point tc_orient3d relative to its "permanent"
  * (Shewchuk's o3derrboundA): when |det| > bound, the sign is exact. */
 TC_FN double tc_orient3d_errbound(tc_d3 a, tc_d3 b, tc_d3 c, tc_d3 d) {

@@ -37,13 +37,7 @@ double box_distance(const tc_d3 c[4], tc_d3 p) {
 
 namespace fields_detail {
 
-void barycentric(const tc_d3 c[4], tc_d3 p, double b[4]) {
-  const double v = geo::tc_orient3d(c[0], c[1], c[2], c[3]);
-  b[0] = geo::tc_orient3d(p, c[1], c[2], c[3]) / v;
-  b[1] = geo::tc_orient3d(c[0], p, c[2], c[3]) / v;
-  b[2] = geo::tc_orient3d(c[0], c[1], p, c[3]) / v;
-  b[3] = 1.0 - b[0] - b[1] - b[2];
-}
+void barycentric(const tc_d3 c[4], tc_d3 p, double b[4]) { geo::tc_barycentric(c[0], c[1], c[2], c[3], p, b); }
 
 namespace {
 
@@ -197,15 +191,29 @@ int64_t TetLocator::locate(const double p[3], double bary[4], bool* outside) con
   return best;
 }
 
-int64_t resample_vertex_fields(const Mesh& original, Mesh& mesh) {
-  struct Pair {
-    const Field* from;
-    Field* to;
-  };
-  std::vector<Pair> pairs;
+namespace fields_detail {
+
+std::vector<FieldPair> shared_fields(const Mesh& original, Mesh& mesh) {
+  std::vector<FieldPair> pairs;
   for (Field& f : mesh.vertex_fields)
     if (const Field* g = original.find_vertex_field(f.name); g && g->components == f.components)
       pairs.push_back({g, &f});
+  return pairs;
+}
+
+void interpolate_at(const Mesh& original, const FieldPair& p, int64_t t, const double b[4], int64_t v) {
+  const size_t nc = size_t(p.to->components);
+  for (size_t c = 0; c < nc; ++c) {
+    double x = 0;
+    for (int k = 0; k < 4; ++k) x += b[k] * p.from->values[size_t(original.tets[size_t(4 * t + k)]) * nc + c];
+    p.to->values[size_t(v) * nc + c] = x;
+  }
+}
+
+}  // namespace fields_detail
+
+int64_t resample_vertex_fields(const Mesh& original, Mesh& mesh) {
+  const std::vector<fields_detail::FieldPair> pairs = fields_detail::shared_fields(original, mesh);
   if (pairs.empty() || original.num_tets() == 0) return 0;
   const TetLocator locator(original);
   int64_t outside = 0;
@@ -214,14 +222,7 @@ int64_t resample_vertex_fields(const Mesh& original, Mesh& mesh) {
     bool out = false;
     const int64_t t = locator.locate(&mesh.points[3 * size_t(v)], bary, &out);
     outside += out;
-    for (const Pair& p : pairs) {
-      const size_t nc = size_t(p.to->components);
-      for (size_t c = 0; c < nc; ++c) {
-        double x = 0;
-        for (int k = 0; k < 4; ++k) x += bary[k] * p.from->values[size_t(original.tets[size_t(4 * t + k)]) * nc + c];
-        p.to->values[size_t(v) * nc + c] = x;
-      }
-    }
+    for (const auto& p : pairs) fields_detail::interpolate_at(original, p, t, bary, v);
   }
   return outside;
 }

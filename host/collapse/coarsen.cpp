@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "collapse/programs.hpp"
+#include "tetcollapse/device_fields.hpp"
 #include "tetcollapse/fields.hpp"
 
 namespace tc {
@@ -114,7 +115,7 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
     r.collapse.vertices_out = mesh.num_vertices();
     r.collapse.tets_out = mesh.num_tets();
   }
-  if (resample) r.outside = resample_vertex_fields(input, mesh);
+  if (resample) r.outside = ctx ? resample_vertex_fields(input, mesh, *ctx) : resample_vertex_fields(input, mesh);
   return r;
 }
 

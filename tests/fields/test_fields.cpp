@@ -11,6 +11,7 @@
 #include "test_support.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/device.hpp"
+#include "tetcollapse/device_fields.hpp"
 #include "tetcollapse/fields.hpp"
 #include "tetcollapse/io.hpp"
 
@@ -105,6 +106,72 @@ TEST(ResampleFields, AnyCoarseningKeepsALinearFieldExact) {
       EXPECT_EQ(e[0].name, "f");
       EXPECT_LT(e[0].max_rel, 1e-12);
     }
+  }
+}
+
+// The device's BVH (cl/bvh.cl) answers as a brute-force search over every tet does: the
+// lowest-numbered tet holding the point (coordinates >= -1e-12), -1 outside; the meshes from one
+// tet (the root a leaf) to a few thousand, points inside, on faces and vertices, and outside.
+TEST(DeviceTetLocator, FindsWhatABruteForceSearchFinds) {
+  Context ctx;
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-0.2, 1.2);
+  for (int n : {0, 1, 2, 7}) {
+    Mesh m = n == 0 ? cube_tets(1) : jiggled(n, unsigned(n));
+    if (n == 0) m.tets.resize(4);  // one tet
+    std::vector<double> q;
+    for (int i = 0; i < 3000; ++i) q.insert(q.end(), {u(rng), u(rng), u(rng)});
+    for (size_t i = 0; i < std::min<size_t>(m.points.size(), 600); ++i) q.push_back(m.points[i]);  // vertices
+    const DeviceTetLocator loc(m, ctx);
+    EXPECT_EQ(loc.nodes(), 2 * m.num_tets() - 1);
+    std::vector<int32_t> tets;
+    std::vector<double> bary;
+    loc.locate(q, tets, bary);
+    ASSERT_EQ(tets.size(), q.size() / 3);
+    int64_t inside = 0;
+    for (size_t i = 0; i < tets.size(); ++i) {
+      const tc_d3 p{q[3 * i], q[3 * i + 1], q[3 * i + 2]};
+      int64_t first = -1;
+      for (int64_t t = 0; t < m.num_tets() && first < 0; ++t)
+        if (min_bary(m, t, p) >= -1e-12) first = t;
+      ASSERT_EQ(tets[i], first) << "point " << i << " of the mesh of " << m.num_tets() << " tets";
+      inside += first >= 0;
+      if (first < 0) continue;
+      double b[4];
+      tc_d3 c[4];
+      for (int k = 0; k < 4; ++k) c[k] = geo::tc_point(m.points.data(), m.tets[size_t(4 * first + k)]);
+      geo::tc_barycentric(c[0], c[1], c[2], c[3], p, b);
+      for (int k = 0; k < 4; ++k) EXPECT_EQ(bary[4 * i + size_t(k)], b[k]);
+    }
+    EXPECT_GT(inside, n == 0 ? 100 : 1000) << "many points are inside";
+  }
+}
+
+// Resampling on the device gives the host's values bit for bit (the same operations, no
+// contraction), the points outside the original handed to the host's nearest-tet search.
+TEST(ResampleFields, TheDeviceGivesTheHostsValues) {
+  Context ctx;
+  Mesh in = jiggled(8, 7);
+  add_linear_field(in);
+  in.vertex_fields.push_back({"g", 2, {}});
+  for (int64_t v = 0; v < in.num_vertices(); ++v)
+    in.vertex_fields.back().values.insert(in.vertex_fields.back().values.end(),
+                                          {std::sin(9 * in.points[3 * size_t(v)]), double(v % 7)});
+  for (auto boundary : {CollapseOptions::Features, CollapseOptions::Free}) {
+    Mesh m = in;
+    CollapseOptions o;
+    o.method = CollapseOptions::Sequential;
+    o.target_factor = 2.5;
+    o.boundary = boundary;
+    collapse_sequential(m, o);
+    m.points[0] = 1.3;  // a vertex outside the original: the host's nearest-tet search
+    Mesh d = m;
+    const int64_t out_host = resample_vertex_fields(in, m), out_device = resample_vertex_fields(in, d, ctx);
+    EXPECT_EQ(out_device, out_host);
+    EXPECT_GE(out_host, 1);
+    for (size_t f = 0; f < m.vertex_fields.size(); ++f)
+      for (size_t i = 0; i < m.vertex_fields[f].values.size(); ++i)
+        ASSERT_EQ(d.vertex_fields[f].values[i], m.vertex_fields[f].values[i]) << "field " << f << " value " << i;
   }
 }
 
