@@ -336,6 +336,18 @@ def checker_block():
     return "\n".join(lines), path
 
 
+def locate_block():
+    path = os.path.join(RESULTS, "locate.json")
+    d = load(path)
+    lines = [f"Recorded: `{rel(path)}` by `{d['command']}` at commit {d['commit']} on {d['device']}.", "",
+             "| mesh | tets | points | host grid: build | locate | device BVH: build | locate | locate, device vs host |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|",
+             f"| {d['mesh']} | {d['tets']:,} | {d['queries']:,} | {d['host_build']:.3f} s | {d['host_locate']:.3f} s | "
+             f"{d['device_build']:.3f} s | {d['device_locate']:.3f} s | {d['device_locate'] / d['host_locate']:.2f}x |",
+             "", f"Medians of {d['runs']} runs; each located all {d['found_device']:,} points (the tests check that both give the same tet)."]
+    return "\n".join(lines), path
+
+
 def boundary_rule_block():
     path = os.path.join(RESULTS, "boundary_rule.json")
     d = load(path)
@@ -373,6 +385,7 @@ BLOCKS = {
     "primitives": primitives_block,
     "connectivity": connectivity_block,
     "checker": checker_block,
+    "locate": locate_block,
     "boundary_rule": boundary_rule_block,
 }
 
