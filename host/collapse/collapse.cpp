@@ -90,7 +90,7 @@ CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Cont
     };
   const CollapseReport tail = collapse_sequential(mesh, outer);
   for (IterationStats it : tail.iterations) {
-    it.iteration += int(report.iterations.size());
+    it.iteration += offset;
     it.on_host = true;
     report.iterations.push_back(it);
   }

@@ -177,6 +177,7 @@ TEST(BoundaryErrorRun, TheParallelMethodKeepsTheBoundToo) {
   bool host = false, device = false;
   for (const auto& it : r.iterations) (it.on_host ? host : device) = true;
   EXPECT_TRUE(host && device) << "both phases ran";
+  for (size_t i = 0; i < r.iterations.size(); ++i) EXPECT_EQ(r.iterations[i].iteration, int(i)) << "numbered on";
   EXPECT_LT(m.num_tets(), in.num_tets() / 3);
   // with a mask: only the selected half (x < 0.5) coarsens, in both phases, within the bound
   Mesh masked = in;
