@@ -59,7 +59,8 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context& ctx
   if (m.num_tets() > 0 && phase == Phase::Collapse) {
     CollapseOptions co = s.collapse;
     if (masked) co.vertex_mask = mask;
-    collapse(m, co, ctx);
+    if (s.boundary_bound > 0) co.max_boundary_error = 0, co.max_boundary_error_abs = s.boundary_bound;
+    r.boundary_error = collapse(m, co, ctx).boundary_error;
     r.seconds_collapse = clock.lap();
   } else if (m.num_tets() > 0) {
     ImproveOptions io = s.improve;
@@ -68,12 +69,19 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context& ctx
     // scale it so that the bound is the whole mesh's.
     const double d = bbox_diagonal(m);
     if (d > 0) io.max_boundary_move *= s.whole_diagonal / d;
+    // under a bound: a third each to the passes, the collapse step and the passes after it, as
+    // tc::improve shares its own
+    const bool step = masked && io.collapse;
+    if (s.boundary_bound > 0) {
+      io.max_boundary_error_abs = step ? s.boundary_bound / 3 : s.boundary_bound;
+      r.boundary_error = s.boundary_bound;  // not measured: all of it
+    }
     improve(m, io, ctx);
     // Under a mask the library leaves out its collapse step: run it here, then the passes again.
     // The improvement keeps the numbering under a mask but gives a moved vertex the fields
     // interpolated at its new place (-1 from -1s need not come out exact): mark the vertices
     // again by the mask before the collapse.
-    if (masked && io.collapse) {
+    if (step) {
       std::vector<double>& marks = m.vertex_fields.back().values;
       for (size_t v = 0; v < nv; ++v)
         if (!part.frozen[v]) marks[v] = mask[v] ? kSelected : kLeft;

@@ -16,11 +16,17 @@ struct Settings {
   ImproveOptions improve;     // max_boundary_move relative to the whole mesh's diagonal
   double whole_diagonal = 0;  // bounding-box diagonal of the whole input
   double collapse_length = 0;  // the improvement's collapse step: 1.5 x the coarse mesh's median
+  // This round's share of the boundary error bound, in mesh units (0: no bound). Each round
+  // measures from the mesh it is given, so the shares of all rounds add up to at most the bound
+  // (the Hausdorff distance obeys the triangle inequality; the parts' boundaries are disjoint
+  // but for the frozen interfaces, which do not change).
+  double boundary_bound = 0;
 };
 
 struct RankReport {
   int64_t tets_in = 0, tets_out = 0, vertices_in = 0, vertices_out = 0, frozen = 0;
   double seconds_collapse = 0, seconds_improve = 0;
+  double boundary_error = 0;  // of the bound, what the round may have used (an upper bound)
 };
 
 // What a round does to each part: the rounds of the collapse phase coarsen, then those of the

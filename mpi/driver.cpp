@@ -10,6 +10,7 @@
 #include "cli/common.hpp"
 #include "report.hpp"
 #include "rounds.hpp"
+#include "tetcollapse/coarsen.hpp"
 #include "stopwatch.hpp"
 #include "tetcollapse/fields.hpp"
 
@@ -87,13 +88,19 @@ int run(Options& o, MPI_Comm comm) {
                  stats.median_edge_length);
 
   // The collapse phase, then the improvement phase, each in rounds until nothing is left to do.
+  // A boundary error bound is shared as tc::coarsen shares it: kCollapseShareOfBound of it for
+  // the collapse, what the collapse left for the improvement.
+  const double bound = o.max_boundary_error_abs > 0 ? o.max_boundary_error_abs : o.max_boundary_error * s.whole_diagonal;
+  stats.boundary_error_bound = bound;
+  double bound_left = o.no_improve ? bound : kCollapseShareOfBound * bound;
   Round state{whole, {}, 0};
-  code = run_phase(Phase::Collapse, state, s, o, device, stats, comm);
+  code = run_phase(Phase::Collapse, state, s, o, device, stats, comm, bound_left);
   if (code == cli::kOk && !o.no_improve) {
     // the improvement's collapse step reaches as far as tc::improve's default on the whole mesh
     if (rank == 0) s.collapse_length = 1.5 * median_edge_length(whole);
     bcast(&s.collapse_length, 1, comm);
-    code = run_phase(Phase::Improve, state, s, o, device, stats, comm);
+    bound_left += (1 - kCollapseShareOfBound) * bound;
+    code = run_phase(Phase::Improve, state, s, o, device, stats, comm, bound_left);
   }
   if (code) return code;
 

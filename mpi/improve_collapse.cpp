@@ -30,6 +30,7 @@ int64_t collapse_bad_tets(Mesh& mesh, const std::vector<uint8_t>& selected, cons
   o.eps_f = options.eps_f;
   o.eps_r = options.eps_r;
   o.use_labels = options.use_labels;
+  if (options.boundary == CollapseOptions::Features) o.max_boundary_error_abs = options.max_boundary_error_abs;
   o.min_quality = 0.3;
   o.target_length = length;
   o.vertex_mask = std::move(mask);

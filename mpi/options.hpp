@@ -14,7 +14,7 @@ struct Options {
   std::string in, out, stats, device, boundary = "features";
   double target_length = 0, target_factor = 0;
   double eps_f = 0.01, eps_r = 0.1, eps_v = 2e-12, min_quality = 0.1;
-  double max_boundary_error = 0, max_boundary_error_abs = 0;  // refused: see validate()
+  double max_boundary_error = 0, max_boundary_error_abs = 0;  // features mode only: see validate()
   double max_boundary_move = 0.001;
   bool eps_v_relative = false, no_labels = false, no_improve = false, quiet = false, check = false,
        average_fields = false;

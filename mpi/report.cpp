@@ -16,14 +16,15 @@ int64_t peak_rss_kb() {
 }
 
 void RankStats::to(double* d) const {
-  const double v[kCount] = {tets_in, tets_out, frozen, seconds, seconds_collapse, seconds_improve, peak_rss_kb};
+  const double v[kCount] = {tets_in,         tets_out,    frozen,        seconds, seconds_collapse,
+                            seconds_improve, peak_rss_kb, boundary_error};
   for (int i = 0; i < kCount; ++i) d[i] = v[i];
 }
 
 RankStats RankStats::from(const double* d) {
   RankStats s;
   s.tets_in = d[0], s.tets_out = d[1], s.frozen = d[2], s.seconds = d[3], s.seconds_collapse = d[4],
-  s.seconds_improve = d[5], s.peak_rss_kb = d[6];
+  s.seconds_improve = d[5], s.peak_rss_kb = d[6], s.boundary_error = d[7];
   return s;
 }
 
@@ -80,7 +81,8 @@ std::string stats_json(const RunStats& s) {
         .field("seconds_partition", r.seconds_partition)
         .field("seconds_scatter", r.seconds_scatter)
         .field("seconds_coarsen", r.seconds_coarsen)
-        .field("seconds_gather", r.seconds_gather);
+        .field("seconds_gather", r.seconds_gather)
+        .field("boundary_bound", r.boundary_bound);
     w.key("ranks").begin_array();
     for (size_t i = 0; i < r.ranks.size(); ++i) {
       const RankStats& k = r.ranks[i];
@@ -93,6 +95,7 @@ std::string stats_json(const RunStats& s) {
           .field("seconds_collapse", k.seconds_collapse)
           .field("seconds_improve", k.seconds_improve)
           .field("peak_rss_kb", int64_t(k.peak_rss_kb))
+          .field("boundary_error", k.boundary_error)
           .end_object();
     }
     w.end_array().end_object();

@@ -16,7 +16,8 @@ struct RankStats {
   double tets_in = 0, tets_out = 0, frozen = 0;
   double seconds = 0, seconds_collapse = 0, seconds_improve = 0;
   double peak_rss_kb = 0;
-  static constexpr int kCount = 7;
+  double boundary_error = 0;  // what the rank's round may have used of the bound
+  static constexpr int kCount = 8;
   void to(double* d) const;
   static RankStats from(const double* d);
 };
@@ -28,6 +29,7 @@ struct RoundStats {
   int64_t interface_vertices = 0;  // frozen in this round
   int64_t refrozen_vertices = 0;   // of them, in the band the round was to coarsen
   double seconds_partition = 0, seconds_scatter = 0, seconds_coarsen = 0, seconds_gather = 0;
+  double boundary_bound = 0;  // the round's share of the boundary error bound (mesh units; 0: none)
   std::vector<RankStats> ranks;
 };
 
@@ -36,6 +38,7 @@ struct RunStats {
   int ranks = 1;
   int64_t vertices_in = 0, tets_in = 0, vertices_out = 0, tets_out = 0;
   double median_edge_length = 0, target_length = 0;
+  double boundary_error_bound = 0;  // mesh units; 0: none
   double seconds_total = 0, seconds_read = 0, seconds_write = 0;
   std::string check;  // "valid" / "invalid" with --check
   std::vector<RoundStats> rounds;

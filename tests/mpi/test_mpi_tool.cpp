@@ -94,6 +94,29 @@ TEST_P(MpiTool, ValidAndWithinFivePercentOfSingleDevice) {
   if (tested == 0) GTEST_SKIP() << "../shared/meshes (ipc_hammer.msh, gen_gmsh_wrenchnut_27k.msh) not present";
 }
 
+// A boundary error bound: the rounds share it, so the checker's two-sided distance between the
+// result's boundary and the input's stays within it, and the curved surfaces coarsen as much as
+// tetcollapse coarsens them under the same bound (within 5%).
+TEST_P(MpiTool, BoundaryErrorBoundHolds) {
+  const std::string in = shared_or_skip("gen_gmsh_wrenchnut_27k.msh");
+  if (in.empty()) GTEST_SKIP() << "../shared/meshes/gen_gmsh_wrenchnut_27k.msh not present";
+  TempDir dir;
+  std::string log;
+  const std::string opts = " --target-factor 2 --max-boundary-error 0.0005 -q";
+  ASSERT_EQ(run_single(in + " " + dir.file("single.msh") + opts, &log), 0) << log;
+  ASSERT_EQ(run_mpi(GetParam(), in + " " + dir.file("mpi.msh") + opts, &log), 0) << log;
+  const Mesh input = tc::read_mesh(in), single = tc::read_mesh(dir.file("single.msh")),
+             out = tc::read_mesh(dir.file("mpi.msh"));
+  tc::CheckOptions co;
+  co.hausdorff = true;
+  const tc::CheckReport r = tc::check_mesh(out, co, &input);
+  EXPECT_TRUE(r.valid) << tc::check_report_text(r);
+  EXPECT_LE(r.reference.hausdorff_rel, 0.0005);
+  EXPECT_GT(r.reference.hausdorff_rel, 0) << "the boundary did move";
+  EXPECT_NEAR(double(out.num_tets()) / double(single.num_tets()), 1.0, 0.05)
+      << out.num_tets() << " tets with " << GetParam() << " ranks, " << single.num_tets() << " with tetcollapse";
+}
+
 // Strict mode: no boundary vertex moves or goes, so the boundary faces are the input's, bit for
 // bit, across the partition interfaces too.
 TEST_P(MpiTool, StrictModeKeepsTheBoundaryBitForBit) {
@@ -239,8 +262,8 @@ TEST(MpiToolErrors, ExitCodesAndNothingWritten) {
   TempDir dir;
   const std::string in = tc::test::project_mesh("bracket.msh");
   std::string log;
-  EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --max-boundary-error 0.001", &log), 2);
-  EXPECT_NE(log.find("--max-boundary-error: not supported by tetcollapse-mpi"), std::string::npos) << log;
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --max-boundary-error 0.001 --boundary strict", &log), 2);
+  EXPECT_NE(log.find("--max-boundary-error: applies to --boundary features"), std::string::npos) << log;
   EXPECT_EQ(run_mpi(2, dir.file("missing.msh") + " " + dir.file("o.msh") + " -q", &log), 2);
   EXPECT_NE(log.find("missing.msh"), std::string::npos) << log;
   tc::test::write_text(dir.file("bad.msh"), "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n2\n1 0 0\n");
