@@ -6,10 +6,7 @@
                    [--work-dir DIR] [--timeout S] [--no-hausdorff]
 
 Runs, on mesh M with the uniform target edge length L, in this order:
-  tetcollapse           tetcollapse M OUT --target-length L            (default options, quality guard 0.1;
-                                                                        --method auto: the sequential method
-                                                                        below 40,000 tets on a CPU device)
-  tetcollapse_parallel  ... --method parallel                          (the OpenCL pipeline whatever the size)
+  tetcollapse           tetcollapse M OUT --target-length L            (default options, quality guard 0.1)
   tetcollapse_noimprove ... --no-improve                             (the collapse alone)
   tetcollapse_bounded   ... --max-boundary-error 0.001
                                                                        (the boundary error bound, as MMG's -hausd
@@ -60,7 +57,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-ALL_PEERS = ["tetcollapse", "tetcollapse_parallel", "tetcollapse_noimprove", "tetcollapse_bounded", "tetcollapse_q0", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "mmg3d_hmin", "mmg3d_hmin_nosurf", "mmg3d_hmin_hausd",
+ALL_PEERS = ["tetcollapse", "tetcollapse_noimprove", "tetcollapse_bounded", "tetcollapse_q0", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "mmg3d_hmin", "mmg3d_hmin_nosurf", "mmg3d_hmin_hausd",
              "cgal_remesh", "tetgen_rR", "tetgen_rR_keepbnd"]
 
 
@@ -266,8 +263,6 @@ def main():
                 cmd += ["--min-quality", "0", "--no-improve"]
             if peer == "tetcollapse_noimprove":
                 cmd += ["--no-improve"]
-            if peer == "tetcollapse_parallel":
-                cmd += ["--method", "parallel"]
             if peer == "tetcollapse_bounded":
                 cmd += ["--max-boundary-error", "0.001"]
 

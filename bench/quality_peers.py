@@ -6,10 +6,7 @@
 
 For each mesh of ../shared/meshes (top level), L = F x the input's median edge length (F = 2),
 bench/peers.py runs, in one process each and one after the other on the same machine:
-  tetcollapse            tetcollapse M OUT --target-length L         (defaults: collapse + improvement;
-                                                                      the sequential method below 40,000
-                                                                      tets on a CPU device)
-  tetcollapse_parallel   ... --method parallel                       (the OpenCL pipeline at every size)
+  tetcollapse            tetcollapse M OUT --target-length L         (defaults: collapse + improvement)
   tetcollapse_noimprove  ... --no-improve                            (the collapse alone)
   tetcollapse_bounded    ... --max-boundary-error 0.001               (the bound, as -hausd)
   mmg3d_hmin             mmg3d_O3 M.mesh -hmin L                     (MMG3D, coarsening only)
@@ -34,7 +31,7 @@ sys.path.insert(0, HERE)
 import peers  # noqa: E402
 
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "meshes")
-PEERS = ["tetcollapse", "tetcollapse_parallel", "tetcollapse_noimprove", "tetcollapse_bounded", "mmg3d_hmin", "mmg3d_hmin_hausd"]
+PEERS = ["tetcollapse", "tetcollapse_noimprove", "tetcollapse_bounded", "mmg3d_hmin", "mmg3d_hmin_hausd"]
 
 
 def fmt(x, spec):

@@ -119,16 +119,13 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
   co.preserve_field = preserve_field;
   co.field_tolerance = field_tolerance;
   co.sizing_field = sizing_field;
-  if (method != "auto" && method != "parallel" && method != "sequential")
-    throw InputError("<method>", "method must be 'auto', 'parallel' or 'sequential', not '" + method + "'");
+  if (method != "parallel" && method != "sequential")
+    throw InputError("<method>", "method must be 'parallel' or 'sequential', not '" + method + "'");
   std::unique_ptr<Context> ctx;
   CoarsenReport cr;
   {
     py::gil_scoped_release release;
-    // method="auto": as the command line's --method auto (a device given asks for the parallel method)
-    const bool sequential = method == "sequential" || (method == "auto" && device.is_none() &&
-                                                        auto_method(mesh, co, "") == CollapseOptions::Sequential);
-    if (sequential) {
+    if (method == "sequential") {
       o.method = CollapseOptions::Sequential;
     } else {
       ctx = std::make_unique<Context>(device.is_none() ? std::string() : device.cast<std::string>());
@@ -218,7 +215,7 @@ PYBIND11_MODULE(_core, mod) {
   });
   mod.def("collapse", &collapse_py, py::arg("points"), py::arg("tets"), py::kw_only(), py::arg("target_factor") = 1.0,
           py::arg("target_length") = py::none(), py::arg("boundary") = "features", py::arg("labels") = py::none(),
-          py::arg("vertex_fields") = py::none(), py::arg("device") = py::none(), py::arg("method") = "auto",
+          py::arg("vertex_fields") = py::none(), py::arg("device") = py::none(), py::arg("method") = "parallel",
           py::arg("improve") = true, py::arg("min_quality") = 0.1, py::arg("max_boundary_error") = 0.0,
           py::arg("average_fields") = false, py::arg("preserve_field") = "", py::arg("field_tolerance") = 0.02,
           py::arg("max_field_error") = 0.0, py::arg("sizing_field") = "",

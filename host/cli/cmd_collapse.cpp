@@ -32,7 +32,7 @@ struct CollapseCli {
   CollapseOptions opt;
   double target_length = 0, target_factor = 0;
   double priority_levels = -1;  // not given
-  std::string boundary = "features", method = "auto", conflicts = "matching";
+  std::string boundary = "features", method = "parallel", conflicts = "matching";
   std::string region, sizing_field, labels, cost_cl, placement_cl, predicate_cl, device, stats;
   bool check = false, quiet = false, no_labels = false, no_spatial_order = false, no_improve = false,
        average_fields = false;
@@ -269,14 +269,9 @@ void register_collapse(CLI::App& app, int& exit_code) {
                  "OpenCL C file defining int tc_user_predicate(double3 p0, double3 p1, double f0, double f1);\n"
                  "0 refuses the collapse of the edge (besides the built-in checks)");
   app.add_option("--method", c->method,
-                 "parallel: the OpenCL pipeline; sequential: the CPU priority-queue baseline with the same\n"
-                 "checks (no OpenCL device needed); auto (default): sequential for a mesh of fewer than\n"
-                 "40,000 tets when the device is a CPU (faster there, the same quality) or when there is no\n"
-                 "OpenCL device, else parallel; parallel whenever an option of the parallel method is given\n"
-                 "(--device, --conflicts, --priority-levels, --no-spatial-order, --host-tail, a user function\n"
-                 "or --sizing-field)")
-      ->capture_default_str()
-      ->check(CLI::IsMember({"auto", "parallel", "sequential"}));
+                 "parallel (default): the OpenCL pipeline; sequential: the CPU priority-queue baseline\n"
+                 "with the same checks (no OpenCL device needed)")
+      ->check(CLI::IsMember({"parallel", "sequential"}));
   app.add_flag("--sequential-skip-invalidated", c->opt.sequential_skip_invalidated,
                "Sequential method: skip (until the next iteration) an edge whose star an earlier\n"
                "collapse of the iteration changed, as the paper's baseline; default: re-check it");
@@ -338,19 +333,6 @@ void register_collapse(CLI::App& app, int& exit_code) {
     opt.boundary = boundary_mode(c->boundary);
     opt.use_labels = !c->no_labels;
     opt.tuning.spatial_order = !c->no_spatial_order;
-    // --method auto (tc::auto_method): the sequential method on a small mesh and a CPU device,
-    // unless an option of the parallel method asks for the device
-    const bool auto_method_chosen = c->method == "auto";
-    if (auto_method_chosen) {
-      const bool parallel_asked = !c->device.empty() || app.count("--conflicts") > 0 ||
-                                  app.count("--priority-levels") > 0 || c->no_spatial_order ||
-                                  app.count("--host-tail") > 0 || !c->cost_cl.empty() || !c->sizing_field.empty() ||
-                                  !c->placement_cl.empty() || !c->predicate_cl.empty();
-      CoarsenOptions probe;
-      probe.sizing_field = c->sizing_field;
-      c->method = !parallel_asked && auto_method(mesh, probe, "") == CollapseOptions::Sequential ? "sequential"
-                                                                                                : "parallel";
-    }
     opt.method = c->method == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
     opt.conflicts = c->conflicts == "atomic-min" ? CollapseOptions::AtomicMin
                     : c->conflicts == "two-pass" ? CollapseOptions::TwoPass
@@ -425,9 +407,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
     if (report_quality) quality_in = quality_summary(mesh);
     std::unique_ptr<Context> ctx;
     if (opt.method == CollapseOptions::Sequential) {
-      if (!c->quiet)
-        std::cerr << (auto_method_chosen ? "method: sequential (CPU; --method auto: a small mesh and a CPU device)\n"
-                                         : "method: sequential (CPU)\n");
+      if (!c->quiet) std::cerr << "method: sequential (CPU)\n";
     } else {
       ctx = open_device(c->device, c->quiet);
     }

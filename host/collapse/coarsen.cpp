@@ -33,18 +33,6 @@ struct FieldFirst {
 
 }  // namespace
 
-CollapseOptions::Method auto_method(const Mesh& mesh, const CoarsenOptions& options, const std::string& device_spec) {
-  if (mesh.num_tets() >= kAutoSequentialTets || options.collapse.has_user_functions() || !options.sizing_field.empty())
-    return CollapseOptions::Parallel;
-  try {
-    return select_device(device_spec).type == "CPU" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
-  } catch (const DeviceError&) {
-    // no OpenCL device at all: the sequential method needs none; a spec naming no device is
-    // for the parallel method to report
-    return list_devices().empty() ? CollapseOptions::Sequential : CollapseOptions::Parallel;
-  }
-}
-
 CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, const Mesh* original) {
   CollapseOptions co = options.collapse;
   if (!ctx && co.method != CollapseOptions::Sequential)

@@ -56,15 +56,6 @@ struct CoarsenReport {
 // surface).
 constexpr double kCollapseShareOfBound = 0.75;
 
-// The method of `--method auto` (and Python's method="auto"): the sequential method for a mesh of
-// fewer than kAutoSequentialTets tets when the device `device_spec` names (as Context takes it)
-// is a CPU, or when there is no OpenCL device at all, and nothing needs the device (a user cost,
-// placement or predicate, or a sizing field); else the parallel method. Why: on a small mesh the
-// sequential method's one thread beats a CPU device's fixed cost per iteration, with results of
-// the same quality (bench/README.md, "The method by mesh size"); a GPU is left to coarsen.
-constexpr int64_t kAutoSequentialTets = 40000;
-CollapseOptions::Method auto_method(const Mesh& mesh, const CoarsenOptions& options, const std::string& device_spec);
-
 // Coarsens `mesh` in place as described above. With ctx null, the collapse must use the
 // sequential method (CollapseOptions::Sequential) and the improvement runs on the CPU.
 // Throws as collapse() and improve() do; std::invalid_argument for a field option naming no

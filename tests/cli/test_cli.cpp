@@ -6,9 +6,7 @@
 #include <set>
 
 #include "test_support.hpp"
-#include "tetcollapse/device.hpp"
 #include "tetcollapse/io.hpp"
-#include "tetcollapse/mesh.hpp"
 
 namespace {
 
@@ -237,45 +235,15 @@ TEST(Cli, MaxBoundaryErrorHoldsAndIsRefusedWhereItCannot) {
   EXPECT_NE(out.find("--boundary features"), std::string::npos) << out;
 }
 
-// --method auto: the sequential method for a small mesh on a CPU device, the parallel method for
-// a mesh of 40,000 tets or more, or when an option of the parallel method is given.
-TEST(Cli, AutoMethodBySizeAndOptions) {
-  tc::test::TempDir dir;
-  std::string out;
-  const std::string small = q(tc::test::project_mesh("bracket.msh")), large = dir.file("cube.msh");
-  tc::write_mesh(large, tc::make_cube_mesh(20));  // 48,000 tets
-  auto method = [&](const std::string& in, const std::string& opts) {
-    EXPECT_EQ(run_command(cli() + " " + in + " " + q(dir.file("o.msh")) + " --target-factor 2 --stats " +
-                              q(dir.file("s.json")) + " " + opts,
-                          &out),
-              0)
-        << out;
-    const std::string stats = tc::test::read_text(dir.file("s.json"));
-    for (const char* m : {"sequential", "parallel"})
-      if (stats.find(std::string("\"method\":\"") + m + "\"") != std::string::npos) return std::string(m);
-    return std::string("?");
-  };
-  const bool cpu = tc::select_device().type == "CPU";
-  EXPECT_EQ(method(small, ""), cpu ? "sequential" : "parallel");
-  if (cpu) {
-    EXPECT_NE(out.find("--method auto: a small mesh and a CPU device"), std::string::npos) << out;
-  }
-  EXPECT_EQ(method(small, "--conflicts greedy"), "parallel");
-  EXPECT_EQ(method(small, "--method parallel"), "parallel");
-  EXPECT_EQ(method(q(large), "-q"), "parallel");
-}
-
 TEST(Cli, KernelProfileTableAndTheSameResult) {
   tc::test::TempDir dir;
   std::string out;
   const std::string in = q(tc::test::project_mesh("bracket.msh")), a = dir.file("a.vtu"), b = dir.file("b.vtu");
-  ASSERT_EQ(run_command("TETCOLLAPSE_PROFILE_KERNELS=1 " + cli() + " " + in + " " + q(a) + " -q --method parallel", &out),
-            0)
-      << out;
+  ASSERT_EQ(run_command("TETCOLLAPSE_PROFILE_KERNELS=1 " + cli() + " " + in + " " + q(a) + " -q", &out), 0) << out;
   EXPECT_NE(out.find("kernel profile (TETCOLLAPSE_PROFILE_KERNELS)"), std::string::npos) << out;
   for (const char* k : {"match_decide", "match_apply", "conn_ring_sort_and_gather", "cost_and_mark", "sguard_surface"})
     EXPECT_NE(out.find(std::string("\n  ") + k + " "), std::string::npos) << k << " not in " << out;
-  ASSERT_EQ(run_command(cli() + " " + in + " " + q(b) + " -q --method parallel", &out), 0) << out;
+  ASSERT_EQ(run_command(cli() + " " + in + " " + q(b) + " -q", &out), 0) << out;
   EXPECT_TRUE(out.empty()) << out;  // off by default: quiet stays quiet
   EXPECT_EQ(tc::test::read_text(a), tc::test::read_text(b));
 }
@@ -395,10 +363,7 @@ TEST(Cli, AMeshTooLargeForTheDeviceIsRefusedWithTheSizes) {
   tc::test::TempDir dir;
   std::string out;
   const std::string mesh = q(tc::test::project_mesh("bracket.msh"));
-  EXPECT_EQ(run_command("TETCOLLAPSE_TEST_GLOBAL_MEM=3000000 " + cli() + " " + mesh + " " + q(dir.file("o.msh")) +
-                            " --method parallel",
-                        &out),
-            3)
+  EXPECT_EQ(run_command("TETCOLLAPSE_TEST_GLOBAL_MEM=3000000 " + cli() + " " + mesh + " " + q(dir.file("o.msh")), &out), 3)
       << out;
   EXPECT_NE(out.find("too large for device"), std::string::npos) << out;
   EXPECT_NE(out.find("MiB of device memory, and the device has 2 MiB (CL_DEVICE_GLOBAL_MEM_SIZE)"), std::string::npos)
@@ -416,9 +381,7 @@ TEST(Cli, AMeshTooLargeForTheDeviceIsRefusedWithTheSizes) {
                         &out),
             0)
       << out;
-  EXPECT_EQ(run_command("TETCOLLAPSE_TEST_GLOBAL_MEM=lots " + cli() + " " + mesh + " " + q(dir.file("x.msh")) +
-                            " --method parallel",
-                        &out), 3)
+  EXPECT_EQ(run_command("TETCOLLAPSE_TEST_GLOBAL_MEM=lots " + cli() + " " + mesh + " " + q(dir.file("x.msh")), &out), 3)
       << out;
 }
 

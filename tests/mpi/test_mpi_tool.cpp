@@ -34,10 +34,8 @@ int run_mpi(int ranks, const std::string& args, std::string* log) {
   return tc::test::run_command(cmd, log);
 }
 
-// tetcollapse with the parallel method, which the MPI tool runs on every part (tetcollapse's
-// --method auto takes the sequential method for a small mesh on a CPU device)
 int run_single(const std::string& args, std::string* log) {
-  return tc::test::run_command(std::string(TC_CLI) + " " + args + " --method parallel", log);
+  return tc::test::run_command(std::string(TC_CLI) + " " + args, log);
 }
 
 // The boundary faces (in one tet) as sorted triples of vertex positions.
