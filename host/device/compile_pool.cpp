@@ -9,6 +9,7 @@
 #include <csignal>
 #include <cstdint>
 #include <cstring>
+#include <system_error>
 
 #include "device/program_cache.hpp"
 
@@ -171,7 +172,11 @@ void CompilePool::enqueue(const std::string& key, Job job, bool front) {
   }
   if (live_workers_ < max_workers_) {
     ++live_workers_;
-    threads_.emplace_back([this] { work(); });
+    try {
+      threads_.emplace_back([this] { work(); });
+    } catch (const std::system_error&) {
+      --live_workers_;  // no thread: take() leaves the build to its caller when none runs
+    }
   }
   changed_.notify_all();
 }
@@ -189,6 +194,11 @@ bool CompilePool::has(const std::string& key) {
 std::vector<unsigned char> CompilePool::take(const std::string& key, Job job) {
   std::unique_lock<std::mutex> lock(m_);
   enqueue(key, std::move(job), true);
+  if (live_workers_ == 0 && entries_.at(key).state == State::Queued) {  // no worker could start
+    queue_.erase(std::find(queue_.begin(), queue_.end(), key));
+    entries_.erase(key);
+    return {};
+  }
   changed_.wait(lock, [&] { return entries_.at(key).state == State::Done; });
   std::vector<unsigned char> out = std::move(entries_.at(key).binary);
   entries_.erase(key);
@@ -223,12 +233,13 @@ void CompilePool::work() {
     e.state = State::Done;
     changed_.notify_all();
   }
+  // no more jobs for this worker from here: one queued now starts another (the destructor joins
+  // this thread, which waits for its helper to end)
+  --live_workers_;
   if (pid > 0) helpers_.erase(std::find(helpers_.begin(), helpers_.end(), pid));
+  changed_.notify_all();
   lock.unlock();
   end_helper(helper);
-  lock.lock();
-  --live_workers_;
-  changed_.notify_all();
 }
 
 }  // namespace tc::device_detail
