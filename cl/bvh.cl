@@ -35,9 +35,9 @@ __kernel void bvh_keys(uint nt, __global const int* tets, __global const double*
                        double loz, double scale, __global ulong* keys) {
   uint t = get_global_id(0);
   if (t >= nt) return;
-  double3 lo = tc_point(pts, tets[4 * t]), hi = lo;
+  double3 lo = tc_point(pts, tets[4 * (ulong)t]), hi = lo;
   for (int k = 1; k < 4; ++k) {
-    double3 p = tc_point(pts, tets[4 * t + k]);
+    double3 p = tc_point(pts, tets[4 * (ulong)t + k]);
     lo = fmin(lo, p);
     hi = fmax(hi, p);
   }
@@ -91,23 +91,24 @@ __kernel void bvh_boxes(uint n_leaves, __global const ulong* keys, __global cons
   int j = (int)get_global_id(0), n = (int)n_leaves;
   if (j >= n) return;
   int t = (int)(keys[j] & 0xffffffffu);
-  double3 lo = tc_point(pts, tets[4 * t]), hi = lo;
+  double3 lo = tc_point(pts, tets[4 * (ulong)t]), hi = lo;
   for (int k = 1; k < 4; ++k) {
-    double3 p = tc_point(pts, tets[4 * t + k]);
+    double3 p = tc_point(pts, tets[4 * (ulong)t + k]);
     lo = fmin(lo, p);
     hi = fmax(hi, p);
   }
   int node = n - 1 + j;
-  boxes[6 * node] = lo.x - margin, boxes[6 * node + 1] = lo.y - margin, boxes[6 * node + 2] = lo.z - margin;
-  boxes[6 * node + 3] = hi.x + margin, boxes[6 * node + 4] = hi.y + margin, boxes[6 * node + 5] = hi.z + margin;
+  boxes[6 * (ulong)node] = lo.x - margin, boxes[6 * (ulong)node + 1] = lo.y - margin, boxes[6 * (ulong)node + 2] = lo.z - margin;
+  boxes[6 * (ulong)node + 3] = hi.x + margin, boxes[6 * (ulong)node + 4] = hi.y + margin, boxes[6 * (ulong)node + 5] = hi.z + margin;
   node = parent[node];
   while (node >= 0) {
     mem_fence(CLK_GLOBAL_MEM_FENCE);
     if (atomic_inc(&arrived[node]) == 0) return; /* the other child is not done: it comes up */
+    mem_fence(CLK_GLOBAL_MEM_FENCE);             /* its box before ours is read */
     int a = child[2 * node], b = child[2 * node + 1];
     for (int c = 0; c < 3; ++c) {
-      boxes[6 * node + c] = fmin(boxes[6 * a + c], boxes[6 * b + c]);
-      boxes[6 * node + 3 + c] = fmax(boxes[6 * a + 3 + c], boxes[6 * b + 3 + c]);
+      boxes[6 * (ulong)node + c] = fmin(boxes[6 * (ulong)a + c], boxes[6 * (ulong)b + c]);
+      boxes[6 * (ulong)node + 3 + c] = fmax(boxes[6 * (ulong)a + 3 + c], boxes[6 * (ulong)b + 3 + c]);
     }
     node = parent[node];
   }
@@ -131,15 +132,15 @@ __kernel void bvh_locate(uint nq, __global const double* queries, uint n_leaves,
   stack[sp++] = 0;
   while (sp > 0) {
     int node = stack[--sp];
-    if (!tcb_in_box(boxes + 6 * node, p)) continue;
+    if (!tcb_in_box(boxes + 6 * (ulong)node, p)) continue;
     if (node >= n - 1) {
       int t = (int)(keys[node - (n - 1)] & 0xffffffffu);
       if (best >= 0 && t >= best) continue;
-      double3 c0 = tc_point(pts, tets[4 * t]), c1 = tc_point(pts, tets[4 * t + 1]), c2 = tc_point(pts, tets[4 * t + 2]),
-              c3 = tc_point(pts, tets[4 * t + 3]);
+      double3 c0 = tc_point(pts, tets[4 * (ulong)t]), c1 = tc_point(pts, tets[4 * (ulong)t + 1]), c2 = tc_point(pts, tets[4 * (ulong)t + 2]),
+              c3 = tc_point(pts, tets[4 * (ulong)t + 3]);
       double b[4];
       tc_barycentric(c0, c1, c2, c3, p, b);
-      if (min(min(b[0], b[1]), min(b[2], b[3])) >= -1e-12) {
+      if (b[0] >= -1e-12 && b[1] >= -1e-12 && b[2] >= -1e-12 && b[3] >= -1e-12) { /* NaN: no */
         best = t;
         for (int k = 0; k < 4; ++k) bb[k] = b[k];
       }
@@ -149,7 +150,7 @@ __kernel void bvh_locate(uint nq, __global const double* queries, uint n_leaves,
     }
   }
   out_tet[q] = best;
-  for (int k = 0; k < 4; ++k) out_bary[4 * q + k] = bb[k];
+  for (int k = 0; k < 4; ++k) out_bary[4 * (ulong)q + k] = bb[k];
 }
 
 /* out[q * nc + c] = the field (nc components per vertex) at query q in its tet; queries in no
@@ -162,7 +163,7 @@ __kernel void bvh_interpolate(uint nq, __global const int* qtet, __global const 
   int t = qtet[q];
   for (uint c = 0; c < nc; ++c) {
     double x = 0.0;
-    for (int k = 0; k < 4; ++k) x += qbary[4 * q + k] * values[(ulong)tets[4 * t + k] * nc + c];
+    for (int k = 0; k < 4; ++k) x += qbary[4 * (ulong)q + k] * values[(ulong)tets[4 * (ulong)t + k] * nc + c];
     out[(ulong)q * nc + c] = x;
   }
 }

@@ -114,6 +114,7 @@ TetLocator::TetLocator(const Mesh& mesh) : mesh_(mesh) {
   cell_ = std::max(std::cbrt(volume / double(nt)) * 1.5, extent * 1e-6);
   if (!(cell_ > 0) || !std::isfinite(cell_)) cell_ = 1;
   for (int c = 0; c < 3; ++c) dim_[c] = std::max<int64_t>(1, int64_t((hi[c] - lo_[c]) / cell_) + 1);
+  const double margin = 1e-9 * extent;
   std::vector<int64_t> counts(size_t(dim_[0] * dim_[1] * dim_[2]) + 1, 0);
   auto each_cell = [&](int64_t t, auto&& fn) {
     int64_t a[3], b[3];
@@ -124,8 +125,10 @@ TetLocator::TetLocator(const Mesh& mesh) : mesh_(mesh) {
         l = std::min(l, x);
         h = std::max(h, x);
       }
-      a[c] = std::clamp<int64_t>(int64_t((l - lo_[c]) / cell_), 0, dim_[c] - 1);
-      b[c] = std::clamp<int64_t>(int64_t((h - lo_[c]) / cell_), 0, dim_[c] - 1);
+      // the box a little wider, as the device's BVH has it (DeviceTetLocator): a point the
+      // coordinates' tolerance accepts just outside the tet is then in one of its cells
+      a[c] = std::clamp<int64_t>(int64_t((l - margin - lo_[c]) / cell_), 0, dim_[c] - 1);
+      b[c] = std::clamp<int64_t>(int64_t((h + margin - lo_[c]) / cell_), 0, dim_[c] - 1);
     }
     for (int64_t k = a[2]; k <= b[2]; ++k)
       for (int64_t j = a[1]; j <= b[1]; ++j)
@@ -155,7 +158,7 @@ int64_t TetLocator::locate(const double p[3], double bary[4], bool* outside) con
     const int64_t t = tets_[size_t(e)];
     corners(mesh_, t, c);
     barycentric(c, q, b);
-    if (std::min({b[0], b[1], b[2], b[3]}) >= -1e-12) {
+    if (b[0] >= -1e-12 && b[1] >= -1e-12 && b[2] >= -1e-12 && b[3] >= -1e-12) {  // (a NaN fails)
       std::copy(b, b + 4, bary);
       if (outside) *outside = false;
       return t;

@@ -71,6 +71,7 @@ DeviceTetLocator::DeviceTetLocator(const Mesh& mesh, Context& ctx)
 void DeviceTetLocator::locate(const std::vector<double>& points, std::vector<int32_t>& tets,
                               std::vector<double>& bary) const {
   const size_t nq = points.size() / 3;
+  if (nq > (size_t{1} << 28)) throw std::invalid_argument("DeviceTetLocator::locate: more than 2^28 points");
   tets.assign(nq, -1);
   bary.assign(4 * nq, 0.0);
   if (nq == 0 || n_ == 0) return;

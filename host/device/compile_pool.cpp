@@ -9,7 +9,6 @@
 #include <csignal>
 #include <cstdint>
 #include <cstring>
-#include <system_error>
 
 #include "device/program_cache.hpp"
 
@@ -116,16 +115,14 @@ void end_helper(Helper& h) {
   h = {};
 }
 
-std::vector<unsigned char> compile_in(Helper& h, const CompilePool::Job& job) {
+// The binary, or nothing with *failed set when the helper is gone (the caller ends it).
+std::vector<unsigned char> compile_in(Helper& h, const CompilePool::Job& job, bool* failed) {
   std::vector<unsigned char> bin;
-  const bool ok = send_block(h.fd, job.source.data(), job.source.size()) &&
-                  send_block(h.fd, job.options.data(), job.options.size()) &&
-                  send_block(h.fd, job.cache_dir.data(), job.cache_dir.size()) &&
-                  send_block(h.fd, job.cache_key.data(), job.cache_key.size()) && recv_block(h.fd, bin);
-  if (!ok) {
-    end_helper(h);
-    return {};
-  }
+  *failed = !(send_block(h.fd, job.source.data(), job.source.size()) &&
+              send_block(h.fd, job.options.data(), job.options.size()) &&
+              send_block(h.fd, job.cache_dir.data(), job.cache_dir.size()) &&
+              send_block(h.fd, job.cache_key.data(), job.cache_key.size()) && recv_block(h.fd, bin));
+  if (*failed) bin.clear();
   return bin;
 }
 
@@ -174,7 +171,7 @@ void CompilePool::enqueue(const std::string& key, Job job, bool front) {
     ++live_workers_;
     try {
       threads_.emplace_back([this] { work(); });
-    } catch (const std::system_error&) {
+    } catch (...) {
       --live_workers_;  // no thread: take() leaves the build to its caller when none runs
     }
   }
@@ -211,7 +208,6 @@ void CompilePool::work() {
   bool have_ctx = false;
   std::unique_lock<std::mutex> lock(m_);
   if (helper.pid > 0) helpers_.push_back(helper.pid);
-  const pid_t pid = helper.pid;
   while (!stop_ && !queue_.empty()) {
     const std::string key = queue_.front();
     queue_.pop_front();
@@ -220,7 +216,15 @@ void CompilePool::work() {
     lock.unlock();
     std::vector<unsigned char> binary;
     if (helper.fd >= 0) {
-      binary = compile_in(helper, e.job);  // on failure the caller builds it (and the next jobs are ours)
+      bool failed = false;
+      binary = compile_in(helper, e.job, &failed);  // on failure the caller builds it (the next jobs are ours)
+      if (failed) {
+        // out of the destructor's list before it is reaped: its pid may be reused after
+        lock.lock();
+        helpers_.erase(std::find(helpers_.begin(), helpers_.end(), helper.pid));
+        lock.unlock();
+        end_helper(helper);
+      }
     } else {
       try {  // no helper (none set, none started, or one failed): in this process
         if (!have_ctx) ctx = cl::Context(device_), have_ctx = true;
@@ -236,7 +240,7 @@ void CompilePool::work() {
   // no more jobs for this worker from here: one queued now starts another (the destructor joins
   // this thread, which waits for its helper to end)
   --live_workers_;
-  if (pid > 0) helpers_.erase(std::find(helpers_.begin(), helpers_.end(), pid));
+  if (helper.pid > 0) helpers_.erase(std::find(helpers_.begin(), helpers_.end(), helper.pid));
   changed_.notify_all();
   lock.unlock();
   end_helper(helper);
