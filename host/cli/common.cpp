@@ -1,8 +1,10 @@
 #include "cli/common.hpp"
 
+#include <cstdio>
 #include <iostream>
 
 #include "io/io_util.hpp"
+#include "stopwatch.hpp"
 #ifdef TETCOLLAPSE_HAVE_CHECK
 #include "tetcollapse/check.hpp"
 #endif
@@ -22,12 +24,23 @@ std::unique_ptr<Context> open_device(const std::string& spec, bool quiet) {
   if (quiet) return ctx;
   std::cerr << "device: " << ctx->info().name << " (" << ctx->info().platform_name << ")\n";
   const std::string name = ctx->info().name;
-  ctx->set_compile_notice([name, said = false](const std::string&) mutable {
-    if (said) return;
-    said = true;
-    std::cerr << "compiling kernels for " << name
-              << " (a first run on this device, driver or cache; later runs read them from "
-              << Context::cache_dir() << ")...\n";
+  // One line when the first compile begins, then one as each program is done (other lines of
+  // the run come in between, so not updated in place).
+  ctx->set_compile_notice([name, said = false, last = 0, clock = Stopwatch()](const std::string& file, int done,
+                                                                             int total) mutable {
+    if (!said) {
+      said = true;
+      clock = Stopwatch();
+      std::cerr << "compiling kernels for " << name
+                << " (a first run on this device, driver or cache; later runs read them from "
+                << Context::cache_dir() << ")...\n";
+    }
+    if (done <= last) return;  // queued, not done
+    last = done;
+    char line[256];
+    std::snprintf(line, sizeof line, "  compiled %d of %d programs (%s), %.1f s\n", done, total, file.c_str(),
+                  clock.peek());
+    std::cerr << line;
   });
   return ctx;
 }

@@ -511,8 +511,11 @@ void Context::prefetch(const std::string& file, const std::string& options) {
   device_detail::ProgramCache cache(cache_dir(), u.cache_key);
   std::error_code ec;
   if (!cache.path().empty() && std::filesystem::exists(cache.path(), ec)) return;
-  if (compile_notice_) compile_notice_(file);
-  pool().prefetch(u.opts + '\n' + file, {u.source, u.opts, cache_dir(), u.cache_key});
+  const std::string pool_key = u.opts + '\n' + file;
+  if (pool().has(pool_key)) return;
+  ++compiles_total_;
+  if (compile_notice_) compile_notice_(file, compiles_done_, compiles_total_);
+  pool().prefetch(pool_key, {u.source, u.opts, cache_dir(), u.cache_key});
 }
 
 cl::Program& Context::build(const std::string& file, const std::string& text, const std::string& options) {
@@ -552,13 +555,21 @@ cl::Program& Context::build(const std::string& file, const std::string& text, co
     last_build_source_ = BuildSource::DiskCache;
     return programs_.emplace(key, std::move(prog)).first->second;
   }
-  if (compile_notice_) compile_notice_(file);
+  if (!prefetched) {
+    ++compiles_total_;
+    if (compile_notice_) compile_notice_(file, compiles_done_, compiles_total_);
+  }
   last_build_source_ = BuildSource::Source;
+  auto compiled = [&]() -> cl::Program& {
+    ++compiles_done_;
+    if (compile_notice_) compile_notice_(file, compiles_done_, compiles_total_);
+    return programs_.emplace(key, std::move(prog)).first->second;
+  };
   // on a worker (which also stores the binary on disk), while the others compile what was
   // prefetched; from source here when that gives no binary, with the build log on failure
   if (auto binary = pool().take(pool_key, {u.source, u.opts, cache_dir(), u.cache_key});
       !binary.empty() && from_binary(binary, prog))
-    return programs_.emplace(key, std::move(prog)).first->second;
+    return compiled();
   detail::cl_call(("clCreateProgramWithSource(" + file + ")").c_str(), [&] { prog = cl::Program(context_, u.source); });
   try {
     prog.build({device_}, opts.c_str());
@@ -572,7 +583,7 @@ cl::Program& Context::build(const std::string& file, const std::string& text, co
     throw DeviceError("clBuildProgram(" + file + "): " + cl_error_name(e.err()) + " on '" + info_.name +
                       "' with options '" + opts + "'; build log:\n" + log);
   }
-  return programs_.emplace(key, std::move(prog)).first->second;
+  return compiled();
 }
 
 cl::Kernel Context::kernel(const std::string& file, const std::string& name, const std::string& options) {

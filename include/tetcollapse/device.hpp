@@ -144,10 +144,13 @@ class Context {
   // How the last program() call that compiled something was satisfied (for tests and benches).
   enum class BuildSource { Memory, DiskCache, Source };
   BuildSource last_build_source() const { return last_build_source_; }
-  // Called before a program is compiled from source (not found in the disk cache), with the
-  // file's name: on a new device, a new driver or a cleared cache, the first run compiles
-  // every kernel it uses, which takes seconds (the CLI says so on stderr).
-  void set_compile_notice(std::function<void(const std::string& file)> fn) { compile_notice_ = std::move(fn); }
+  // Progress of the compiles from source (programs not in the disk cache): on a new device, a new
+  // driver or a cleared cache, the first run compiles every kernel it uses, which takes seconds
+  // (the CLI says so on stderr). Called with the program's file when it is queued or begun
+  // (done < total), and when it is compiled (done counts it); total counts those queued so far.
+  void set_compile_notice(std::function<void(const std::string& file, int done, int total)> fn) {
+    compile_notice_ = std::move(fn);
+  }
 
  private:
   void init(const DeviceInfo& info);
@@ -167,7 +170,8 @@ class Context {
   bool cpu_tuning_ = false;
   std::map<std::pair<std::string, std::string>, cl::Program> programs_;
   BuildSource last_build_source_ = BuildSource::Memory;
-  std::function<void(const std::string&)> compile_notice_;
+  std::function<void(const std::string&, int, int)> compile_notice_;
+  int compiles_done_ = 0, compiles_total_ = 0;
   std::unique_ptr<device_detail::CompilePool> pool_;  // made at the first compile from source
 };
 

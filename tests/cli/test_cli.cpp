@@ -1,6 +1,7 @@
 // The command line as a user meets it: exit codes, messages, --help, --json keys.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <iterator>
 #include <set>
@@ -233,6 +234,27 @@ TEST(Cli, MaxBoundaryErrorHoldsAndIsRefusedWhereItCannot) {
                         &out),
             2);
   EXPECT_NE(out.find("--boundary features"), std::string::npos) << out;
+}
+
+// A first run (empty kernel caches) says that it compiles, then each program as it is done, up to
+// all of them; a second run from the caches says nothing of it.
+TEST(Cli, AFirstRunShowsTheCompileProgress) {
+  tc::test::TempDir dir;
+  std::string out;
+  const std::string env = "POCL_CACHE_DIR=" + q(dir.file("pocl")) + " TETCOLLAPSE_CACHE_DIR=" + q(dir.file("tc")) + " ";
+  const std::string cmd = env + cli() + " " + q(tc::test::project_mesh("bracket.msh")) + " " + q(dir.file("o.msh")) +
+                          " --target-factor 2";
+  ASSERT_EQ(run_command(cmd, &out), 0) << out;
+  EXPECT_NE(out.find("compiling kernels for "), std::string::npos) << out;
+  const size_t first = out.find("  compiled 1 of ");
+  ASSERT_NE(first, std::string::npos) << out;
+  const int total = std::atoi(out.c_str() + first + std::string("  compiled 1 of ").size());
+  EXPECT_GT(total, 1);
+  EXPECT_NE(out.find("  compiled " + std::to_string(total) + " of " + std::to_string(total) + " programs"),
+            std::string::npos)
+      << out;
+  ASSERT_EQ(run_command(cmd, &out), 0) << out;
+  EXPECT_EQ(out.find("compil"), std::string::npos) << out;
 }
 
 TEST(Cli, KernelProfileTableAndTheSameResult) {
