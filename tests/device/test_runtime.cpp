@@ -383,6 +383,20 @@ TEST_F(RuntimeCtx, PrefetchedProgramsCompileInHelperProcesses) {
   }
 }
 
+// The collapse's stage files are built as two programs (one compiler front end each): a file of
+// a group gives its group's program, which holds every kernel of the group's files.
+TEST_F(RuntimeCtx, FilesOfAGroupShareOneProgram) {
+  cl::Program& cost = ctx_->program("collapse_cost.cl");
+  EXPECT_EQ(&ctx_->program("collapse_matching.cl"), &cost);
+  EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Memory);
+  ctx_->kernel("collapse_connectivity.cl", "conn_count");
+  ctx_->kernel("collapse_cost.cl", "cost_and_mark");
+  cl::Program& guard = ctx_->program("collapse_guard.cl");
+  EXPECT_NE(&guard, &cost);
+  EXPECT_EQ(&ctx_->program("collapse_update.cl"), &guard);
+  EXPECT_NE(&ctx_->program("scan.cl"), &cost) << "a file of no group is a program of its own";
+}
+
 TEST(Runtime, CacheDirFollowsTheEnvironment) {
   EnvVar a("TETCOLLAPSE_CACHE_DIR", "/tmp/tc-a");
   EXPECT_EQ(tc::Context::cache_dir(), "/tmp/tc-a");
