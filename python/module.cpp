@@ -6,6 +6,8 @@
 #include <pybind11/stl.h>
 
 #include <memory>
+#include <mutex>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -98,6 +100,23 @@ py::dict quality_dict(const QualitySummary& q) {
   return d;
 }
 
+// One context per device spec for the module's life: a new one per call would read every program
+// from the disk cache again (a tenth of a second and more, which a C++ caller keeping its Context
+// does not pay). Calls on one device take turns (a Context is not thread-safe). Never freed: the
+// OpenCL runtime may be gone before static destructors run at exit.
+struct DeviceSlot {
+  std::mutex m;
+  std::unique_ptr<Context> ctx;
+};
+DeviceSlot& device_slot(const std::string& spec) {
+  static std::mutex registry;
+  static auto* slots = new std::map<std::string, std::unique_ptr<DeviceSlot>>();
+  std::lock_guard<std::mutex> lock(registry);
+  std::unique_ptr<DeviceSlot>& s = (*slots)[spec];
+  if (!s) s = std::make_unique<DeviceSlot>();
+  return *s;
+}
+
 py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forcecast> points,
                      py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets, double target_factor,
                      py::object target_length, const std::string& boundary, py::object labels,
@@ -121,16 +140,19 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
   co.sizing_field = sizing_field;
   if (method != "parallel" && method != "sequential")
     throw InputError("<method>", "method must be 'parallel' or 'sequential', not '" + method + "'");
-  std::unique_ptr<Context> ctx;
+  const std::string spec = device.is_none() ? std::string() : device.cast<std::string>();
   CoarsenReport cr;
   {
     py::gil_scoped_release release;
     if (method == "sequential") {
       o.method = CollapseOptions::Sequential;
+      cr = coarsen(mesh, co, nullptr);
     } else {
-      ctx = std::make_unique<Context>(device.is_none() ? std::string() : device.cast<std::string>());
+      DeviceSlot& slot = device_slot(spec);
+      std::lock_guard<std::mutex> lock(slot.m);
+      if (!slot.ctx) slot.ctx = std::make_unique<Context>(spec);
+      cr = coarsen(mesh, co, slot.ctx.get());
     }
-    cr = coarsen(mesh, co, ctx.get());
   }
   const CollapseReport& r = cr.collapse;
   const ImproveReport& ir = cr.improvement;
@@ -169,13 +191,16 @@ py::dict improve_py(py::array_t<double, py::array::c_style | py::array::forcecas
   ImproveOptions io;
   io.boundary = boundary_of(boundary);
   ImproveReport ir;
+  const std::string spec = device.is_none() ? std::string() : device.cast<std::string>();
   {
     py::gil_scoped_release release;
     if (method == "sequential") {
       ir = improve(mesh, io);
     } else {
-      Context ctx(device.is_none() ? std::string() : device.cast<std::string>());
-      ir = improve(mesh, io, ctx);
+      DeviceSlot& slot = device_slot(spec);
+      std::lock_guard<std::mutex> lock(slot.m);
+      if (!slot.ctx) slot.ctx = std::make_unique<Context>(spec);
+      ir = improve(mesh, io, *slot.ctx);
     }
     if (!mesh.vertex_fields.empty()) resample_vertex_fields(input, mesh);
   }
