@@ -377,6 +377,7 @@ BLOCKS = {
     "boundary_error": lambda: recorded_block("boundary_error", "quality_peers"),
     "volume_rendering": lambda: recorded_block("volume_rendering", "volume_rendering"),
     "cold_start": lambda: recorded_block("cold_start", "cold_start"),
+    "python_overhead": lambda: recorded_block("python_overhead", "python_overhead"),
     "mpi_scale": lambda: printed_block("mpi_scale", "mpi_scale"),
     "mpi_scale_10m": lambda: printed_block("mpi_scale_10m", "mpi_scale"),
     "scale": lambda: printed_block("scale", "scale"),
