@@ -110,8 +110,9 @@ class Context {
   // and the device allow) or the default, always a power of two >= 1.
   size_t group_size_for(const cl::Kernel& kernel) const;
 
-  // The program made of the embedded file `file` (e.g. "scan.cl"); `#include "x.h"` lines are
-  // replaced by the embedded text of x.h. Options are appended to "-cl-std=CL1.2", followed by
+  // The program made of the embedded file `file` (e.g. "scan.cl"), or, for a stage file of the
+  // collapse, of the group of files built with it as one program (host/device/runtime.cpp,
+  // kProgramGroups); `#include "x.h"` lines are replaced by the embedded text of x.h. Options are appended to "-cl-std=CL1.2", followed by
   // the environment variable TETCOLLAPSE_CL_OPTIONS when set (e.g. "-cl-opt-disable"). Built from
   // the cache when possible; a build failure throws DeviceError with the build log.
   cl::Program& program(const std::string& file, const std::string& options = "");
