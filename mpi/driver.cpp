@@ -21,7 +21,7 @@ namespace {
 void bcast(double* values, int n, MPI_Comm comm) { MPI_Bcast(values, n, MPI_DOUBLE, 0, comm); }
 
 // The settings every rank runs with; rank 0 fills the absolute values from the whole mesh.
-Settings make_settings(const Options& o) {
+Settings make_settings(Options& o) {
   Settings s;
   CollapseOptions& c = s.collapse;
   c.boundary = cli::boundary_mode(o.boundary);
@@ -32,12 +32,15 @@ Settings make_settings(const Options& o) {
   c.eps_v_relative = o.eps_v_relative;
   c.min_quality = o.min_quality;
   if (o.target_factor > 0) c.target_factor = o.target_factor;
+  c.eps_c = o.eps_c;
+  c.max_iterations = o.max_iterations;
+  c.paper_boundary_rule = o.paper_boundary_rule;
   ImproveOptions& i = s.improve;
+  i = cli::improve_options(o.improve, true);  // (no progress lines: they would come from every rank)
   i.boundary = c.boundary;
   i.eps_f = c.eps_f;
   i.eps_r = c.eps_r;
   i.use_labels = c.use_labels;
-  i.max_boundary_move = o.max_boundary_move;
   return s;
 }
 

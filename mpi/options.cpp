@@ -37,11 +37,15 @@ void add_options(CLI::App& app, Options& o) {
   app.add_flag("--no-improve", o.no_improve,
                "Coarsen only (default: each rank improves its part after coarsening it, the interface\n"
                "frozen; the improvement's collapse step does not run, as with any vertex mask)");
-  app.add_option("--max-boundary-move", o.max_boundary_move,
-                 "Improvement, features and free modes: how far the boundary may move, as a share of the\n"
-                 "whole input's bounding-box diagonal")
-      ->capture_default_str()
+  cli::add_improve_options(app, o.improve);
+  app.add_option("--eps-c", o.eps_c, "Stop when an iteration collapses fewer than N edges (default 0: until none)")
       ->check(CLI::NonNegativeNumber);
+  app.add_option("--max-iterations", o.max_iterations, "Stop after N iterations (in each rank's part, per round)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--paper-boundary-rule", o.paper_boundary_rule,
+               "Refuse every non-boundary edge that touches the boundary, as the paper does\n"
+               "(default: an interior vertex may collapse onto a boundary vertex, which stays put)");
   app.add_flag("--average-fields", o.average_fields,
                "Vertex fields at a survivor: the average of the collapsed edge's ends (default: the\n"
                "input's piecewise linear field at the vertex's final place, on rank 0 at the end)");

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli/common.hpp"
+#include "cli/improve_cli.hpp"
 
 namespace tc::mpi {
 
@@ -15,7 +16,10 @@ struct Options {
   double target_length = 0, target_factor = 0;
   double eps_f = 0.01, eps_r = 0.1, eps_v = 2e-12, min_quality = 0.1;
   double max_boundary_error = 0, max_boundary_error_abs = 0;  // features mode only: see validate()
-  double max_boundary_move = 0.001;
+  int64_t eps_c = 0;
+  int max_iterations = 1000;
+  bool paper_boundary_rule = false;
+  cli::ImproveCli improve;  // the improvement's options, as tetcollapse's
   bool eps_v_relative = false, no_labels = false, no_improve = false, quiet = false, check = false,
        average_fields = false;
   int max_rounds = 5;

@@ -257,6 +257,23 @@ TEST(MpiToolOneRank, SameAsSingleDevice) {
   tc::test::expect_same_mesh(tc::read_mesh(dir.file("single.msh")), tc::read_mesh(dir.file("mpi.msh")), "one rank");
 }
 
+// The options of tetcollapse mean the same here: fewer iterations leave more tets, and the
+// improvement's switches are the command's (the improvement off in all its parts leaves the
+// collapse's mesh as --no-improve does).
+TEST(MpiToolOptions, TheCommandsOptionsMeanTheSame) {
+  TempDir dir;
+  const std::string in = tc::test::project_mesh("bracket.msh");
+  std::string log;
+  auto tets = [&](const std::string& opts) {
+    EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --target-factor 2 -q " + opts, &log), 0) << log;
+    return tc::read_mesh(dir.file("o.msh")).num_tets();
+  };
+  const int64_t all = tets(""), one = tets("--max-iterations 1");
+  EXPECT_GT(one, all) << "one iteration per part coarsens less";
+  EXPECT_EQ(tets("--no-flips --no-smoothing --no-improve-collapse --max-boundary-move 0"), tets("--no-improve"));
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --improve-iterations -1", &log), 2) << log;
+}
+
 // Exit codes as the README's, on every rank; nothing written on failure.
 TEST(MpiToolErrors, ExitCodesAndNothingWritten) {
   TempDir dir;
