@@ -35,6 +35,13 @@ Settings make_settings(Options& o) {
   c.eps_c = o.eps_c;
   c.max_iterations = o.max_iterations;
   c.paper_boundary_rule = o.paper_boundary_rule;
+  c.conflicts = o.conflicts == "atomic-min" ? CollapseOptions::AtomicMin
+                : o.conflicts == "two-pass" ? CollapseOptions::TwoPass
+                : o.conflicts == "greedy"   ? CollapseOptions::Greedy
+                                            : CollapseOptions::Matching;
+  if (o.priority_levels >= 0) c.tuning.priority_levels = o.priority_levels;
+  c.tuning.spatial_order = !o.no_spatial_order;
+  if (o.host_tail >= 0) c.tuning.host_tail = o.host_tail;
   ImproveOptions& i = s.improve;
   i = cli::improve_options(o.improve, true);  // (no progress lines: they would come from every rank)
   i.boundary = c.boundary;

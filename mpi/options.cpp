@@ -38,6 +38,21 @@ void add_options(CLI::App& app, Options& o) {
                "Coarsen only (default: each rank improves its part after coarsening it, the interface\n"
                "frozen; the improvement's collapse step does not run, as with any vertex mask)");
   cli::add_improve_options(app, o.improve);
+  app.add_option("--conflicts", o.conflicts,
+                 "Conflict detection of the parallel method, as tetcollapse's: matching (default), greedy,\n"
+                 "two-pass or atomic-min (needs 64-bit atomics on the device)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"greedy", "two-pass", "atomic-min", "matching"}));
+  app.add_option("--priority-levels", o.priority_levels,
+                 "Matching and greedy conflicts: edges ordered by their cost in steps of target / N, within a\n"
+                 "step in a fixed pseudo-random order (default 64; 0: exact cost order)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--no-spatial-order", o.no_spatial_order,
+               "Keep each part's numbering on the device (default: vertices along a Morton curve)");
+  app.add_option("--host-tail", o.host_tail,
+                 "With --eps-c 0 or 1: once an iteration collapses fewer than F x its tets, finish on the\n"
+                 "host (default: the device type's, as tetcollapse)")
+      ->check(CLI::Range(0.0, 1.0));
   app.add_option("--eps-c", o.eps_c, "Stop when an iteration collapses fewer than N edges (default 0: until none)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--max-iterations", o.max_iterations, "Stop after N iterations (in each rank's part, per round)")
@@ -84,6 +99,9 @@ void add_options(CLI::App& app, Options& o) {
 }
 
 void validate(const Options& o) {
+  if (o.priority_levels >= 0 && o.conflicts != "greedy" && o.conflicts != "matching")
+    throw CLI::ValidationError("--priority-levels",
+                               "applies to the greedy and matching conflict detections only (--conflicts greedy|matching)");
   if ((o.max_boundary_error > 0 || o.max_boundary_error_abs > 0) && o.boundary != "features")
     throw CLI::ValidationError("--max-boundary-error",
                                "applies to --boundary features (strict keeps the boundary exactly, free does not bound it)");

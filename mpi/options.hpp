@@ -18,7 +18,9 @@ struct Options {
   double max_boundary_error = 0, max_boundary_error_abs = 0;  // features mode only: see validate()
   int64_t eps_c = 0;
   int max_iterations = 1000;
-  bool paper_boundary_rule = false;
+  bool paper_boundary_rule = false, no_spatial_order = false;
+  std::string conflicts = "matching";
+  double priority_levels = -1, host_tail = -1;  // -1: not given (the library's defaults)
   cli::ImproveCli improve;  // the improvement's options, as tetcollapse's
   bool eps_v_relative = false, no_labels = false, no_improve = false, quiet = false, check = false,
        average_fields = false;

@@ -257,9 +257,9 @@ TEST(MpiToolOneRank, SameAsSingleDevice) {
   tc::test::expect_same_mesh(tc::read_mesh(dir.file("single.msh")), tc::read_mesh(dir.file("mpi.msh")), "one rank");
 }
 
-// The options of tetcollapse mean the same here: fewer iterations leave more tets, and the
+// The options of tetcollapse mean the same here: fewer iterations leave more tets, the
 // improvement's switches are the command's (the improvement off in all its parts leaves the
-// collapse's mesh as --no-improve does).
+// collapse's mesh as --no-improve does), the conflict detections and their checks are its.
 TEST(MpiToolOptions, TheCommandsOptionsMeanTheSame) {
   TempDir dir;
   const std::string in = tc::test::project_mesh("bracket.msh");
@@ -272,6 +272,11 @@ TEST(MpiToolOptions, TheCommandsOptionsMeanTheSame) {
   EXPECT_GT(one, all) << "one iteration per part coarsens less";
   EXPECT_EQ(tets("--no-flips --no-smoothing --no-improve-collapse --max-boundary-move 0"), tets("--no-improve"));
   EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --improve-iterations -1", &log), 2) << log;
+  // the conflict detections, each valid by the checker (--check fails the run otherwise)
+  for (const char* c : {"greedy", "two-pass"})
+    EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --target-factor 2 -q --check --conflicts " + c, &log), 0)
+        << c << "\n" << log;
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --conflicts two-pass --priority-levels 3", &log), 2) << log;
 }
 
 // Exit codes as the README's, on every rank; nothing written on failure.
