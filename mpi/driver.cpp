@@ -63,6 +63,7 @@ int run(Options& o, MPI_Comm comm) {
   RunStats stats;
   stats.input = o.in, stats.output = o.out, stats.ranks = nranks, stats.boundary = o.boundary;
   Mesh whole, input;  // rank 0: the mesh of the round; the input for --check and the fields
+  size_t field_front = 0;  // rank 0, --preserve-field: the field's place, which it leaves for the run
 
   // Rank 0 reads the input and turns every bound relative to the whole mesh into an absolute one.
   int code = guarded(rank, [&] {
@@ -78,6 +79,20 @@ int run(Options& o, MPI_Comm comm) {
     stats.median_edge_length = median_edge_length(whole);
     s.collapse.target_length = o.target_length > 0 ? o.target_length : s.collapse.target_factor * stats.median_edge_length;
     if (!(s.collapse.target_length > 0)) throw InputError(o.in, "the mesh has no edges: nothing to coarsen");
+    if (!o.preserve_field.empty()) {
+      // the paper's cost |f0 - f1| below T x (max f - min f), the field first for the run (the
+      // library's field cost reads the first vertex field), as tc::coarsen does
+      const Field* f = whole.find_vertex_field(o.preserve_field);
+      if (!f) throw InputError(o.in, "no vertex field named '" + o.preserve_field + "'");
+      double lo = INFINITY, hi = -INFINITY;
+      for (size_t i = 0; i < f->values.size(); i += size_t(f->components))
+        lo = std::min(lo, f->values[i]), hi = std::max(hi, f->values[i]);
+      if (!(hi > lo)) throw InputError(o.in, "vertex field '" + o.preserve_field + "' is constant: nothing bounds a collapse");
+      field_front = size_t(f - whole.vertex_fields.data());
+      std::swap(whole.vertex_fields[0], whole.vertex_fields[field_front]);
+      s.collapse.target_length = o.field_tolerance * (hi - lo);
+      s.collapse.field_difference_cost = true;
+    }
     s.collapse.eps_v = volume_threshold(whole, s.collapse);
     s.whole_diagonal = bbox_diagonal(whole);
   });
@@ -85,6 +100,7 @@ int run(Options& o, MPI_Comm comm) {
   double shared[3] = {s.collapse.target_length, s.collapse.eps_v, s.whole_diagonal};
   bcast(shared, 3, comm);
   s.collapse.target_length = shared[0], s.collapse.eps_v = shared[1], s.whole_diagonal = shared[2];
+  s.collapse.field_difference_cost = !o.preserve_field.empty();
   s.collapse.eps_v_relative = false;
   stats.target_length = s.collapse.target_length;
 
@@ -121,6 +137,7 @@ int run(Options& o, MPI_Comm comm) {
   int exit_code = cli::kOk;
   code = guarded(rank, [&] {
     if (rank != 0) return;
+    if (field_front > 0) std::swap(whole.vertex_fields[0], whole.vertex_fields[field_front]);
     if (!whole.vertex_fields.empty() && !o.average_fields) {
       const int64_t outside = resample_vertex_fields(input, whole);
       if (outside > 0 && talk)

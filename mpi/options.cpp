@@ -38,6 +38,13 @@ void add_options(CLI::App& app, Options& o) {
                "Coarsen only (default: each rank improves its part after coarsening it, the interface\n"
                "frozen; the improvement's collapse step does not run, as with any vertex mask)");
   cli::add_improve_options(app, o.improve);
+  app.add_option("--preserve-field", o.preserve_field,
+                 "Direct volume rendering (the paper's Section 4.5), as tetcollapse: collapse the edges whose\n"
+                 "two ends differ in vertex field NAME by less than --field-tolerance x its range over the\n"
+                 "whole input (instead of --target-length / --target-factor)");
+  app.add_option("--field-tolerance", o.field_tolerance, "With --preserve-field: T (the paper's 0.02)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--conflicts", o.conflicts,
                  "Conflict detection of the parallel method, as tetcollapse's: matching (default), greedy,\n"
                  "two-pass or atomic-min (needs 64-bit atomics on the device)")

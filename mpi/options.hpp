@@ -20,6 +20,8 @@ struct Options {
   int max_iterations = 1000;
   bool paper_boundary_rule = false, no_spatial_order = false;
   std::string conflicts = "matching";
+  std::string preserve_field;  // the paper's field cost on this vertex field (--field-tolerance)
+  double field_tolerance = 0.02;
   double priority_levels = -1, host_tail = -1;  // -1: not given (the library's defaults)
   cli::ImproveCli improve;  // the improvement's options, as tetcollapse's
   bool eps_v_relative = false, no_labels = false, no_improve = false, quiet = false, check = false,
