@@ -35,6 +35,13 @@ Settings make_settings(Options& o) {
   c.eps_c = o.eps_c;
   c.max_iterations = o.max_iterations;
   c.paper_boundary_rule = o.paper_boundary_rule;
+  if (!o.sizing_field.empty()) {  // tc::coarsen's sizing cost: the field first, the target 1
+    c.cost_cl_source =
+        "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) {\n"
+        "  double h = 0.5 * (f0 + f1);\n"
+        "  return h > 0.0 ? length(p1 - p0) / h : INFINITY;\n"
+        "}\n";
+  }
   c.conflicts = o.conflicts == "atomic-min" ? CollapseOptions::AtomicMin
                 : o.conflicts == "two-pass" ? CollapseOptions::TwoPass
                 : o.conflicts == "greedy"   ? CollapseOptions::Greedy
@@ -68,6 +75,10 @@ int run(Options& o, MPI_Comm comm) {
   // Rank 0 reads the input and turns every bound relative to the whole mesh into an absolute one.
   int code = guarded(rank, [&] {
     validate(o);
+    // the user's OpenCL C, read by every rank (a missing file is an input error on each)
+    if (!o.cost_cl.empty()) s.collapse.cost_cl_source = cli::cl_file(o.cost_cl);
+    if (!o.placement_cl.empty()) s.collapse.placement_cl_source = cli::cl_file(o.placement_cl);
+    if (!o.predicate_cl.empty()) s.collapse.predicate_cl_source = cli::cl_file(o.predicate_cl);
     if (rank != 0) return;
     cli::check_output_path(o.out, &o.output);
     cli::check_output_path(o.stats, nullptr);
@@ -79,6 +90,13 @@ int run(Options& o, MPI_Comm comm) {
     stats.median_edge_length = median_edge_length(whole);
     s.collapse.target_length = o.target_length > 0 ? o.target_length : s.collapse.target_factor * stats.median_edge_length;
     if (!(s.collapse.target_length > 0)) throw InputError(o.in, "the mesh has no edges: nothing to coarsen");
+    if (!o.sizing_field.empty()) {
+      const Field* f = whole.find_vertex_field(o.sizing_field);
+      if (!f) throw InputError(o.in, "no vertex field named '" + o.sizing_field + "'");
+      field_front = size_t(f - whole.vertex_fields.data());
+      std::swap(whole.vertex_fields[0], whole.vertex_fields[field_front]);
+      s.collapse.target_length = 1.0;
+    }
     if (!o.preserve_field.empty()) {
       // the paper's cost |f0 - f1| below T x (max f - min f), the field first for the run (the
       // library's field cost reads the first vertex field), as tc::coarsen does
@@ -118,10 +136,13 @@ int run(Options& o, MPI_Comm comm) {
   // the collapse, what the collapse left for the improvement.
   const double bound = o.max_boundary_error_abs > 0 ? o.max_boundary_error_abs : o.max_boundary_error * s.whole_diagonal;
   stats.boundary_error_bound = bound;
-  double bound_left = o.no_improve ? bound : kCollapseShareOfBound * bound;
+  // (a user's placement or predicate states rules the improvement cannot know: none then, as
+  // tc::coarsen)
+  const bool improve_phase = !o.no_improve && o.placement_cl.empty() && o.predicate_cl.empty();
+  double bound_left = improve_phase ? kCollapseShareOfBound * bound : bound;
   Round state{whole, {}, 0};
   code = run_phase(Phase::Collapse, state, s, o, device, stats, comm, bound_left);
-  if (code == cli::kOk && !o.no_improve) {
+  if (code == cli::kOk && improve_phase) {
     // the improvement's collapse step reaches as far as tc::improve's default on the whole mesh
     if (rank == 0) s.collapse_length = 1.5 * median_edge_length(whole);
     bcast(&s.collapse_length, 1, comm);

@@ -45,6 +45,18 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--field-tolerance", o.field_tolerance, "With --preserve-field: T (the paper's 0.02)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app.add_option("--sizing-field", o.sizing_field,
+                 "As tetcollapse: a vertex field giving the wanted edge length; an edge is collapsed when\n"
+                 "shorter than the field's mean at its ends");
+  app.add_option("--cost-cl", o.cost_cl,
+                 "As tetcollapse: an OpenCL C file defining double tc_user_cost(double3 p0, double3 p1,\n"
+                 "double f0, double f1); edges with a cost below --target-length are collapsed");
+  app.add_option("--placement-cl", o.placement_cl,
+                 "As tetcollapse: an OpenCL C file defining double3 tc_user_placement(...) (no improvement\n"
+                 "phase then)");
+  app.add_option("--predicate-cl", o.predicate_cl,
+                 "As tetcollapse: an OpenCL C file defining int tc_user_predicate(...); 0 refuses the\n"
+                 "collapse (no improvement phase then)");
   app.add_option("--conflicts", o.conflicts,
                  "Conflict detection of the parallel method, as tetcollapse's: matching (default), greedy,\n"
                  "two-pass or atomic-min (needs 64-bit atomics on the device)")
@@ -106,6 +118,12 @@ void add_options(CLI::App& app, Options& o) {
 }
 
 void validate(const Options& o) {
+  if (!o.preserve_field.empty() && !o.sizing_field.empty())
+    throw CLI::ValidationError("--preserve-field", "cannot be combined with --sizing-field");
+  if (!o.cost_cl.empty() && (!o.preserve_field.empty() || !o.sizing_field.empty()))
+    throw CLI::ValidationError("--cost-cl", "cannot be combined with --sizing-field or --preserve-field");
+  if (!o.cost_cl.empty() && !(o.target_length > 0))
+    throw CLI::ValidationError("--cost-cl", "needs --target-length");
   if (o.priority_levels >= 0 && o.conflicts != "greedy" && o.conflicts != "matching")
     throw CLI::ValidationError("--priority-levels",
                                "applies to the greedy and matching conflict detections only (--conflicts greedy|matching)");

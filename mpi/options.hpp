@@ -21,6 +21,7 @@ struct Options {
   bool paper_boundary_rule = false, no_spatial_order = false;
   std::string conflicts = "matching";
   std::string preserve_field;  // the paper's field cost on this vertex field (--field-tolerance)
+  std::string sizing_field, cost_cl, placement_cl, predicate_cl;
   double field_tolerance = 0.02;
   double priority_levels = -1, host_tail = -1;  // -1: not given (the library's defaults)
   cli::ImproveCli improve;  // the improvement's options, as tetcollapse's

@@ -172,18 +172,6 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, const Impr
   return w.str();
 }
 
-// An OpenCL C file of the user (--cost-cl, --placement-cl, --predicate-cl), headed by a #line
-// directive so that the compiler's messages name the file and its lines.
-std::string cl_file(const std::string& path) {
-  std::string quoted;
-  for (char ch : path) {
-    if (ch == '"' || ch == '\\') quoted += '\\';
-    quoted += ch;
-  }
-  return "#line 1 \"" + quoted + "\"\n" + io::load_file(path);
-}
-
-
 }  // namespace
 
 void register_collapse(CLI::App& app, int& exit_code) {

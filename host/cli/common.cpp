@@ -19,6 +19,17 @@ void add_input_options(CLI::App& cmd, InputOptions& o) {
   cmd.add_flag("--no-sol", o.no_sol, "Medit: do not read the .sol file beside the .mesh");
 }
 
+// An OpenCL C file of the user (--cost-cl, --placement-cl, --predicate-cl), headed by a #line
+// directive so that the compiler's messages name the file and its lines.
+std::string cl_file(const std::string& path) {
+  std::string quoted;
+  for (char ch : path) {
+    if (ch == '"' || ch == '\\') quoted += '\\';
+    quoted += ch;
+  }
+  return "#line 1 \"" + quoted + "\"\n" + io::load_file(path);
+}
+
 std::unique_ptr<Context> open_device(const std::string& spec, bool quiet) {
   auto ctx = std::make_unique<Context>(spec);
   if (quiet) return ctx;

@@ -11,6 +11,10 @@
 
 namespace tc::cli {
 
+// An OpenCL C file of the user (--cost-cl, --placement-cl, --predicate-cl), headed by a #line
+// directive so that the compiler's messages name the file and its lines.
+std::string cl_file(const std::string& path);
+
 // Exit codes, documented in README.md.
 enum ExitCode : int {
   kOk = 0,

@@ -170,6 +170,31 @@ TEST_P(MpiTool, PreserveFieldAsTetcollapse) {
   EXPECT_NE(log.find("no vertex field named 'none'"), std::string::npos) << log;
 }
 
+// The user's OpenCL C and the sizing field, as tetcollapse: a predicate refusing every collapse
+// leaves the input's tets (and no improvement runs after a predicate); a cost and a sizing field
+// coarsen as tetcollapse does with them (within 10% on this small mesh).
+TEST(MpiToolOptions, UserFunctionsAndSizingFieldAsTetcollapse) {
+  TempDir dir;
+  Mesh m = tc::read_mesh(tc::test::project_mesh("bracket.msh"));
+  m.vertex_fields = {{"h", 1, std::vector<double>(size_t(m.num_vertices()), 0.25)}};
+  tc::write_mesh(dir.file("in.vtu"), m);
+  tc::test::write_text(dir.file("refuse.cl"), "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) { return 0; }\n");
+  tc::test::write_text(dir.file("cost.cl"), "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return length(p1 - p0); }\n");
+  const std::string in = dir.file("in.vtu");
+  std::string log;
+  ASSERT_EQ(run_mpi(2, in + " " + dir.file("r.vtu") + " -q --predicate-cl " + dir.file("refuse.cl"), &log), 0) << log;
+  EXPECT_EQ(tc::read_mesh(dir.file("r.vtu")).num_tets(), m.num_tets());
+  for (const std::string& opts : {" --cost-cl " + dir.file("cost.cl") + " --target-length 0.25", std::string(" --sizing-field h")}) {
+    ASSERT_EQ(run_single(in + " " + dir.file("s.vtu") + " -q" + opts, &log), 0) << log;
+    ASSERT_EQ(run_mpi(2, in + " " + dir.file("m.vtu") + " -q --check" + opts, &log), 0) << log;
+    const int64_t single = tc::read_mesh(dir.file("s.vtu")).num_tets(), mpi = tc::read_mesh(dir.file("m.vtu")).num_tets();
+    EXPECT_LT(mpi, m.num_tets() / 2) << opts;
+    EXPECT_NEAR(double(mpi) / double(single), 1.0, 0.10) << opts << ": " << mpi << " against " << single;
+  }
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("x.vtu") + " --cost-cl " + dir.file("cost.cl"), &log), 2) << log;
+  EXPECT_NE(log.find("needs --target-length"), std::string::npos) << log;
+}
+
 // Two labels with an interface plane, a linear vertex field and a tet field: the labels' volumes
 // stay (material interfaces are kept), the vertex field is the input's at every output vertex
 // (the linear field resampled), the tet field goes with its tets.
