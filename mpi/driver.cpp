@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
 
 #include "agree.hpp"
 #include "cli/common.hpp"
@@ -35,13 +36,10 @@ Settings make_settings(Options& o) {
   c.eps_c = o.eps_c;
   c.max_iterations = o.max_iterations;
   c.paper_boundary_rule = o.paper_boundary_rule;
-  if (!o.sizing_field.empty()) {  // tc::coarsen's sizing cost: the field first, the target 1
-    c.cost_cl_source =
-        "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) {\n"
-        "  double h = 0.5 * (f0 + f1);\n"
-        "  return h > 0.0 ? length(p1 - p0) / h : INFINITY;\n"
-        "}\n";
-  }
+  // the cost of the field options on every rank (rank 0 adds the target from the whole mesh:
+  // tc::apply_field_options)
+  if (!o.sizing_field.empty()) c.cost_cl_source = sizing_cost_source();
+  c.field_difference_cost = !o.preserve_field.empty();
   c.conflicts = o.conflicts == "atomic-min" ? CollapseOptions::AtomicMin
                 : o.conflicts == "two-pass" ? CollapseOptions::TwoPass
                 : o.conflicts == "greedy"   ? CollapseOptions::Greedy
@@ -70,7 +68,7 @@ int run(Options& o, MPI_Comm comm) {
   RunStats stats;
   stats.input = o.in, stats.output = o.out, stats.ranks = nranks, stats.boundary = o.boundary;
   Mesh whole, input;  // rank 0: the mesh of the round; the input for --check and the fields
-  size_t field_front = 0;  // rank 0, --preserve-field: the field's place, which it leaves for the run
+  size_t field_front = 0;  // rank 0, the field options' field: its place, which it leaves for the run
 
   // Rank 0 reads the input and turns every bound relative to the whole mesh into an absolute one.
   int code = guarded(rank, [&] {
@@ -90,27 +88,16 @@ int run(Options& o, MPI_Comm comm) {
     stats.median_edge_length = median_edge_length(whole);
     s.collapse.target_length = o.target_length > 0 ? o.target_length : s.collapse.target_factor * stats.median_edge_length;
     if (!(s.collapse.target_length > 0)) throw InputError(o.in, "the mesh has no edges: nothing to coarsen");
-    if (!o.sizing_field.empty()) {
-      const Field* f = whole.find_vertex_field(o.sizing_field);
-      if (!f) throw InputError(o.in, "no vertex field named '" + o.sizing_field + "'");
-      field_front = size_t(f - whole.vertex_fields.data());
-      std::swap(whole.vertex_fields[0], whole.vertex_fields[field_front]);
-      s.collapse.target_length = 1.0;
+    // the field options' target over the whole mesh, their field first for the run (the
+    // library's field cost reads the first vertex field), as tc::coarsen does
+    CoarsenOptions fo;
+    fo.preserve_field = o.preserve_field, fo.sizing_field = o.sizing_field, fo.field_tolerance = o.field_tolerance;
+    try {
+      field_front = apply_field_options(whole, fo, s.collapse);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(o.in, e.what());
     }
-    if (!o.preserve_field.empty()) {
-      // the paper's cost |f0 - f1| below T x (max f - min f), the field first for the run (the
-      // library's field cost reads the first vertex field), as tc::coarsen does
-      const Field* f = whole.find_vertex_field(o.preserve_field);
-      if (!f) throw InputError(o.in, "no vertex field named '" + o.preserve_field + "'");
-      double lo = INFINITY, hi = -INFINITY;
-      for (size_t i = 0; i < f->values.size(); i += size_t(f->components))
-        lo = std::min(lo, f->values[i]), hi = std::max(hi, f->values[i]);
-      if (!(hi > lo)) throw InputError(o.in, "vertex field '" + o.preserve_field + "' is constant: nothing bounds a collapse");
-      field_front = size_t(f - whole.vertex_fields.data());
-      std::swap(whole.vertex_fields[0], whole.vertex_fields[field_front]);
-      s.collapse.target_length = o.field_tolerance * (hi - lo);
-      s.collapse.field_difference_cost = true;
-    }
+    if (field_front > 0) std::swap(whole.vertex_fields[0], whole.vertex_fields[field_front]);
     s.collapse.eps_v = volume_threshold(whole, s.collapse);
     s.whole_diagonal = bbox_diagonal(whole);
   });
@@ -118,7 +105,6 @@ int run(Options& o, MPI_Comm comm) {
   double shared[3] = {s.collapse.target_length, s.collapse.eps_v, s.whole_diagonal};
   bcast(shared, 3, comm);
   s.collapse.target_length = shared[0], s.collapse.eps_v = shared[1], s.whole_diagonal = shared[2];
-  s.collapse.field_difference_cost = !o.preserve_field.empty();
   s.collapse.eps_v_relative = false;
   stats.target_length = s.collapse.target_length;
 
@@ -136,9 +122,10 @@ int run(Options& o, MPI_Comm comm) {
   // the collapse, what the collapse left for the improvement.
   const double bound = o.max_boundary_error_abs > 0 ? o.max_boundary_error_abs : o.max_boundary_error * s.whole_diagonal;
   stats.boundary_error_bound = bound;
-  // (a user's placement or predicate states rules the improvement cannot know: none then, as
-  // tc::coarsen)
-  const bool improve_phase = !o.no_improve && o.placement_cl.empty() && o.predicate_cl.empty();
+  // (none after a user's placement or predicate, as tc::coarsen)
+  CoarsenOptions as_coarsen;
+  as_coarsen.collapse = s.collapse, as_coarsen.improve = !o.no_improve;
+  const bool improve_phase = improvement_follows(as_coarsen);
   double bound_left = improve_phase ? kCollapseShareOfBound * bound : bound;
   Round state{whole, {}, 0};
   code = run_phase(Phase::Collapse, state, s, o, device, stats, comm, bound_left);

@@ -33,6 +33,51 @@ struct FieldFirst {
 
 }  // namespace
 
+std::string sizing_cost_source() {
+  return "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) {\n"
+         "  double h = 0.5 * (f0 + f1);\n"
+         "  return h > 0.0 ? length(p1 - p0) / h : INFINITY;\n"
+         "}\n";
+}
+
+size_t apply_field_options(const Mesh& mesh, const CoarsenOptions& options, CollapseOptions& co) {
+  if (!options.preserve_field.empty() && co.max_field_error > 0) {
+    field_index(mesh, options.preserve_field, "preserve_field");
+    co.bounded_field = options.preserve_field;
+    return 0;
+  }
+  if (!options.preserve_field.empty()) {
+    // the paper's cost |Phi(v0) - Phi(v1)| below T x (max Phi - min Phi)
+    const size_t first = field_index(mesh, options.preserve_field, "preserve_field");
+    const Field& f = mesh.vertex_fields[first];
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < f.values.size(); i += size_t(f.components)) {
+      lo = std::min(lo, f.values[i]);
+      hi = std::max(hi, f.values[i]);
+    }
+    co.field_difference_cost = true;
+    co.target_length = options.field_tolerance * (hi - lo);
+    if (!(co.target_length > 0))
+      throw std::invalid_argument("vertex field '" + options.preserve_field + "' is constant: nothing bounds a collapse");
+    return first;
+  }
+  if (!options.sizing_field.empty()) {
+    const size_t first = field_index(mesh, options.sizing_field, "sizing_field");
+    co.cost_cl_source = sizing_cost_source();
+    co.target_length = 1.0;
+    return first;
+  }
+  return 0;
+}
+
+bool improvement_follows(const CoarsenOptions& options) {
+  // A user's predicate or placement states rules the improvement cannot know; the improvement's
+  // moves are not checked against a field error bound.
+  const CollapseOptions& co = options.collapse;
+  return options.improve && co.predicate_cl_source.empty() && co.placement_cl_source.empty() &&
+         !(co.max_field_error > 0);
+}
+
 CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, const Mesh* original) {
   CollapseOptions co = options.collapse;
   if (!ctx && co.method != CollapseOptions::Sequential)
@@ -50,36 +95,8 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
   Mesh copy;
   if (resample && !original) copy = mesh;
   const Mesh& input = original ? *original : copy;
-  size_t first = 0;
-  if (!options.preserve_field.empty() && co.max_field_error > 0) {
-    field_index(mesh, options.preserve_field, "preserve_field");
-    co.bounded_field = options.preserve_field;
-  } else if (!options.preserve_field.empty()) {
-    // the paper's cost |Phi(v0) - Phi(v1)| below T x (max Phi - min Phi)
-    first = field_index(mesh, options.preserve_field, "preserve_field");
-    const Field& f = mesh.vertex_fields[first];
-    double lo = INFINITY, hi = -INFINITY;
-    for (size_t i = 0; i < f.values.size(); i += size_t(f.components)) {
-      lo = std::min(lo, f.values[i]);
-      hi = std::max(hi, f.values[i]);
-    }
-    co.field_difference_cost = true;
-    co.target_length = options.field_tolerance * (hi - lo);
-    if (!(co.target_length > 0))
-      throw std::invalid_argument("vertex field '" + options.preserve_field + "' is constant: nothing bounds a collapse");
-  } else if (!options.sizing_field.empty()) {
-    first = field_index(mesh, options.sizing_field, "sizing_field");
-    co.cost_cl_source =
-        "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) {\n"
-        "  double h = 0.5 * (f0 + f1);\n"
-        "  return h > 0.0 ? length(p1 - p0) / h : INFINITY;\n"
-        "}\n";
-    co.target_length = 1.0;
-  }
-  // A user's predicate or placement states rules the improvement cannot know; the improvement's
-  // moves are not checked against a field error bound.
-  const bool improve_phase = options.improve && co.predicate_cl_source.empty() && co.placement_cl_source.empty() &&
-                             !(co.max_field_error > 0);
+  const size_t first = apply_field_options(mesh, options, co);
+  const bool improve_phase = improvement_follows(options);
   const double bound = boundary_error_bound(mesh, co);
   if (bound > 0 && improve_phase) {
     co.max_boundary_error_abs = kCollapseShareOfBound * bound;

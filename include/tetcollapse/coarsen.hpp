@@ -56,6 +56,19 @@ struct CoarsenReport {
 // surface).
 constexpr double kCollapseShareOfBound = 0.75;
 
+// What preserve_field and sizing_field make of the collapse's options `co` for `mesh` (the cost
+// and the target; with max_field_error, the bounded field), and the index of the vertex field
+// the cost reads, which must come first for the run (0 when none). coarsen() calls it, and so
+// does tetcollapse-mpi on the whole mesh before cutting it. std::invalid_argument for a field
+// the mesh lacks or a constant one.
+size_t apply_field_options(const Mesh& mesh, const CoarsenOptions& options, CollapseOptions& co);
+// The cost sizing_field stands for (OpenCL C in the user cost's slot: the edge's length over the
+// field's mean at its ends, target 1), for callers that set it on parts of a mesh.
+std::string sizing_cost_source();
+// Whether the improvement phase follows the collapse: options.improve, unless a user placement
+// or predicate, or a field error bound, states rules the improvement cannot know.
+bool improvement_follows(const CoarsenOptions& options);
+
 // Coarsens `mesh` in place as described above. With ctx null, the collapse must use the
 // sequential method (CollapseOptions::Sequential) and the improvement runs on the CPU.
 // Throws as collapse() and improve() do; std::invalid_argument for a field option naming no
