@@ -40,10 +40,7 @@ Settings make_settings(Options& o) {
   // tc::apply_field_options)
   if (!o.sizing_field.empty()) c.cost_cl_source = sizing_cost_source();
   c.field_difference_cost = !o.preserve_field.empty();
-  c.conflicts = o.conflicts == "atomic-min" ? CollapseOptions::AtomicMin
-                : o.conflicts == "two-pass" ? CollapseOptions::TwoPass
-                : o.conflicts == "greedy"   ? CollapseOptions::Greedy
-                                            : CollapseOptions::Matching;
+  c.conflicts = cli::conflicts_mode(o.conflicts);
   if (o.priority_levels >= 0) c.tuning.priority_levels = o.priority_levels;
   c.tuning.spatial_order = !o.no_spatial_order;
   if (o.host_tail >= 0) c.tuning.host_tail = o.host_tail;

@@ -322,10 +322,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
     opt.use_labels = !c->no_labels;
     opt.tuning.spatial_order = !c->no_spatial_order;
     opt.method = c->method == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
-    opt.conflicts = c->conflicts == "atomic-min" ? CollapseOptions::AtomicMin
-                    : c->conflicts == "two-pass" ? CollapseOptions::TwoPass
-                    : c->conflicts == "matching" ? CollapseOptions::Matching
-                                                 : CollapseOptions::Greedy;
+    opt.conflicts = conflicts_mode(c->conflicts);
     if (c->priority_levels >= 0) {
       if (opt.method == CollapseOptions::Sequential ||
           (opt.conflicts != CollapseOptions::Greedy && opt.conflicts != CollapseOptions::Matching))

@@ -101,6 +101,13 @@ CollapseOptions::Boundary boundary_mode(const std::string& name) {
   return name == "strict" ? CollapseOptions::Strict : name == "free" ? CollapseOptions::Free : CollapseOptions::Features;
 }
 
+CollapseOptions::Conflicts conflicts_mode(const std::string& name) {
+  return name == "atomic-min" ? CollapseOptions::AtomicMin
+         : name == "two-pass" ? CollapseOptions::TwoPass
+         : name == "matching" ? CollapseOptions::Matching
+                              : CollapseOptions::Greedy;
+}
+
 std::string check_result(const Mesh& result, const Mesh& input, bool hausdorff, bool quiet, int& exit_code) {
 #ifdef TETCOLLAPSE_HAVE_CHECK
   CheckOptions co;

@@ -57,6 +57,8 @@ void write_report(const std::string& path, const std::string& text);
 
 // --boundary strict|features|free (the option checks the name) as the options' enum.
 CollapseOptions::Boundary boundary_mode(const std::string& name);
+// --conflicts matching|greedy|two-pass|atomic-min (the option checks the name) as the options' enum.
+CollapseOptions::Conflicts conflicts_mode(const std::string& name);
 
 // --check of the commands that change a mesh: checks `result` against `input` (validity, the
 // boundary's topology; with `hausdorff` also the boundary distance, 0 expected in strict mode),
