@@ -25,10 +25,7 @@ template <class... A>
 void launch(Context& ctx, const char* name, size_t n, const A&... a) {
   if (n == 0) return;
   cl::Kernel k = ctx.kernel(kFile, name);
-  detail::cl_call(name, [&] {
-    cl_uint i = 0;
-    (k.setArg(i++, a), ...);
-  });
+  dev::set_args(k, name, a...);
   ctx.launch(k, n, name);
 }
 

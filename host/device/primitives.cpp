@@ -50,14 +50,6 @@ void check_size(const B& buf, size_t n, const char* what, const char* name) {
                                 " values, needs " + std::to_string(n));
 }
 
-template <class... A>
-void set_args(cl::Kernel& k, const char* what, const A&... a) {
-  detail::cl_call(what, [&] {
-    cl_uint i = 0;
-    (k.setArg(i++, a), ...);
-  });
-}
-
 cl_uint u32(size_t v) { return static_cast<cl_uint>(v); }
 
 // Work-group size for the scan kernels: the context's choice, shrunk until the tile and the

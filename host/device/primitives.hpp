@@ -11,6 +11,16 @@
 
 namespace tc::dev {
 
+// Sets a kernel's arguments in order (the device's own kernels; the collapse stages name theirs,
+// collapse/launch.hpp); an OpenCL failure is a DeviceError naming `what`.
+template <class... A>
+void set_args(cl::Kernel& k, const char* what, const A&... a) {
+  detail::cl_call(what, [&] {
+    cl_uint i = 0;
+    (k.setArg(i++, a), ...);
+  });
+}
+
 // How the primitives map onto a device. The default depends on Context::cpu_tuning (see
 // default_tuning); set_tuning_override lets tests and benches run every variant on any device.
 struct Tuning {
