@@ -116,6 +116,14 @@ DeviceSlot& device_slot(const std::string& spec) {
   if (!s) s = std::make_unique<DeviceSlot>();
   return *s;
 }
+// f(ctx) with the device's context, its turn taken.
+template <class F>
+auto on_device(const std::string& spec, F&& f) {
+  DeviceSlot& slot = device_slot(spec);
+  std::lock_guard<std::mutex> lock(slot.m);
+  if (!slot.ctx) slot.ctx = std::make_unique<Context>(spec);
+  return f(*slot.ctx);
+}
 
 py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forcecast> points,
                      py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets, double target_factor,
@@ -148,10 +156,7 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
       o.method = CollapseOptions::Sequential;
       cr = coarsen(mesh, co, nullptr);
     } else {
-      DeviceSlot& slot = device_slot(spec);
-      std::lock_guard<std::mutex> lock(slot.m);
-      if (!slot.ctx) slot.ctx = std::make_unique<Context>(spec);
-      cr = coarsen(mesh, co, slot.ctx.get());
+      cr = on_device(spec, [&](Context& ctx) { return coarsen(mesh, co, &ctx); });
     }
   }
   const CollapseReport& r = cr.collapse;
@@ -197,10 +202,7 @@ py::dict improve_py(py::array_t<double, py::array::c_style | py::array::forcecas
     if (method == "sequential") {
       ir = improve(mesh, io);
     } else {
-      DeviceSlot& slot = device_slot(spec);
-      std::lock_guard<std::mutex> lock(slot.m);
-      if (!slot.ctx) slot.ctx = std::make_unique<Context>(spec);
-      ir = improve(mesh, io, *slot.ctx);
+      ir = on_device(spec, [&](Context& ctx) { return improve(mesh, io, ctx); });
     }
     if (!mesh.vertex_fields.empty()) resample_vertex_fields(input, mesh);
   }
