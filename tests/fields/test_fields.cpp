@@ -82,16 +82,22 @@ TEST(TetLocator, FindsTheTetABruteForceSearchFinds) {
   EXPECT_NEAR(q.z, 0.25, 1e-9);
 }
 
+// `in` coarsened by the sequential method to 2.5 x its median edge length.
+Mesh coarsened(const Mesh& in, CollapseOptions::Boundary boundary) {
+  Mesh m = in;
+  CollapseOptions o;
+  o.method = CollapseOptions::Sequential;
+  o.target_factor = 2.5;
+  o.boundary = boundary;
+  collapse_sequential(m, o);
+  return m;
+}
+
 TEST(ResampleFields, AnyCoarseningKeepsALinearFieldExact) {
   Mesh in = jiggled(8, 7);
   add_linear_field(in);
   for (auto boundary : {CollapseOptions::Features, CollapseOptions::Free}) {
-    Mesh m = in;
-    CollapseOptions o;
-    o.method = CollapseOptions::Sequential;
-    o.target_factor = 2.5;
-    o.boundary = boundary;
-    collapse_sequential(m, o);
+    Mesh m = coarsened(in, boundary);
     ASSERT_LT(m.num_vertices(), in.num_vertices() / 2);
     const int64_t outside = resample_vertex_fields(in, m);
     double err = 0;
@@ -158,12 +164,7 @@ TEST(ResampleFields, TheDeviceGivesTheHostsValues) {
     in.vertex_fields.back().values.insert(in.vertex_fields.back().values.end(),
                                           {std::sin(9 * in.points[3 * size_t(v)]), double(v % 7)});
   for (auto boundary : {CollapseOptions::Features, CollapseOptions::Free}) {
-    Mesh m = in;
-    CollapseOptions o;
-    o.method = CollapseOptions::Sequential;
-    o.target_factor = 2.5;
-    o.boundary = boundary;
-    collapse_sequential(m, o);
+    Mesh m = coarsened(in, boundary);
     m.points[0] = 1.3;  // a vertex outside the original: the host's nearest-tet search
     Mesh d = m;
     const int64_t out_host = resample_vertex_fields(in, m), out_device = resample_vertex_fields(in, d, ctx);
