@@ -4,11 +4,10 @@
 #include <iostream>
 #include <limits>
 #include <memory>
-#include <set>
-#include <sstream>
 
 #include "cli/common.hpp"
 #include "cli/improve_cli.hpp"
+#include "cli/masks.hpp"
 #include "io/io_util.hpp"
 #include "json.hpp"
 #include "stopwatch.hpp"
@@ -17,11 +16,6 @@
 #include "tetcollapse/fields.hpp"
 
 namespace tc::cli {
-
-namespace {
-// Moves the vertex field `name` to the front (the user cost sees the first); returns where it was.
-}  // namespace
-
 
 namespace {
 
@@ -41,71 +35,6 @@ struct CollapseCli {
   CLI::Option* field_tolerance_option = nullptr;
   ImproveCli improve;
 };
-
-std::vector<double> parse_numbers(const std::string& s, const std::string& what) {
-  std::vector<double> v;
-  std::stringstream ss(s);
-  std::string tok;
-  while (std::getline(ss, tok, ',')) {
-    char* end = nullptr;
-    double x = std::strtod(tok.c_str(), &end);
-    if (tok.empty() || *end != '\0' || !std::isfinite(x))
-      throw CLI::ValidationError(what, "'" + tok + "' is not a number");
-    v.push_back(x);
-  }
-  return v;
-}
-
-// --region box:X0,Y0,Z0,X1,Y1,Z1 | sphere:X,Y,Z,R -> per-vertex mask (1 inside).
-std::vector<uint8_t> region_mask(const Mesh& m, const std::string& spec) {
-  auto colon = spec.find(':');
-  std::string kind = spec.substr(0, colon);
-  if (colon == std::string::npos || (kind != "box" && kind != "sphere"))
-    throw CLI::ValidationError("--region", "expected box:X0,Y0,Z0,X1,Y1,Z1 or sphere:X,Y,Z,R");
-  std::vector<double> v = parse_numbers(spec.substr(colon + 1), "--region");
-  std::vector<uint8_t> mask(static_cast<size_t>(m.num_vertices()), 0);
-  if (kind == "box") {
-    if (v.size() != 6) throw CLI::ValidationError("--region", "box needs 6 numbers");
-    for (int64_t i = 0; i < m.num_vertices(); ++i) {
-      bool in = true;
-      for (int k = 0; k < 3; ++k) {
-        double x = m.points[3 * i + k];
-        in = in && x >= std::min(v[k], v[k + 3]) && x <= std::max(v[k], v[k + 3]);
-      }
-      mask[i] = in;
-    }
-  } else {
-    if (v.size() != 4 || v[3] < 0) throw CLI::ValidationError("--region", "sphere needs X,Y,Z,R with R >= 0");
-    for (int64_t i = 0; i < m.num_vertices(); ++i) {
-      double d2 = 0;
-      for (int k = 0; k < 3; ++k) d2 += (m.points[3 * i + k] - v[k]) * (m.points[3 * i + k] - v[k]);
-      mask[i] = d2 <= v[3] * v[3];
-    }
-  }
-  return mask;
-}
-
-// --labels A,B,...: a vertex is selected when every tet around it has a selected primary label,
-// so material interfaces to unselected labels stay where they are.
-std::vector<uint8_t> label_mask(const Mesh& m, const std::string& spec) {
-  if (m.tet_labels.empty()) throw InputError("--labels", "the mesh has no labels");
-  std::set<int32_t> wanted;
-  for (double x : parse_numbers(spec, "--labels")) wanted.insert(static_cast<int32_t>(x));
-  std::vector<uint8_t> mask(static_cast<size_t>(m.num_vertices()), 1);
-  const auto& lab = m.tet_labels[0].values;
-  for (int64_t t = 0; t < m.num_tets(); ++t)
-    if (!wanted.count(lab[t]))
-      for (int k = 0; k < 4; ++k) mask[m.tets[4 * t + k]] = 0;
-  return mask;
-}
-
-void combine(std::vector<uint8_t>& mask, const std::vector<uint8_t>& more) {
-  if (mask.empty()) {
-    mask = more;
-    return;
-  }
-  for (size_t i = 0; i < mask.size(); ++i) mask[i] = mask[i] && more[i];
-}
 
 std::string stats_json(const CollapseCli& c, const CollapseReport& r, const ImproveReport* ir,
                        const QualitySummary& quality_in, const QualitySummary& quality_collapsed, double seconds_total,
@@ -220,12 +149,11 @@ void register_collapse(CLI::App& app, int& exit_code) {
       ->check(CLI::Range(0.0, 1.0));
   app.add_flag("--eps-v-relative", c->opt.eps_v_relative,
                "Read --eps-v relative to the cube of the bounding-box diagonal");
-  app.add_option("--region", c->region,
-                 "Only collapse edges inside a region: box:X0,Y0,Z0,X1,Y1,Z1 or sphere:X,Y,Z,R");
+  app.add_option("--region", c->region, kRegionHelp);
   app.add_option("--sizing-field", c->sizing_field,
                  "Per-vertex field of the input giving the wanted edge length: an edge is collapsed\n"
                  "when shorter than the mean of the field at its ends (replaces --target-*)");
-  app.add_option("--labels", c->labels, "Only coarsen inside these primary labels, e.g. 1,3");
+  app.add_option("--labels", c->labels, kLabelsHelp);
   app.add_option("--preserve-field", c->preserve_field,
                  "Coarsen for volume rendering of this per-vertex field (the paper's Section 4.5): an\n"
                  "edge is collapsed when its ends' values differ by less than --field-tolerance x the\n"
@@ -256,9 +184,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
   app.add_option("--predicate-cl", c->predicate_cl,
                  "OpenCL C file defining int tc_user_predicate(double3 p0, double3 p1, double f0, double f1);\n"
                  "0 refuses the collapse of the edge (besides the built-in checks)");
-  app.add_option("--method", c->method,
-                 "parallel (default): the OpenCL pipeline; sequential: the CPU priority-queue baseline\n"
-                 "with the same checks (no OpenCL device needed)")
+  app.add_option("--method", c->method, kMethodHelp)
       ->check(CLI::IsMember({"parallel", "sequential"}));
   app.add_flag("--sequential-skip-invalidated", c->opt.sequential_skip_invalidated,
                "Sequential method: skip (until the next iteration) an edge whose star an earlier\n"
@@ -339,20 +265,15 @@ void register_collapse(CLI::App& app, int& exit_code) {
       throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
     if (opt.max_field_error > 0 && c->preserve_field.empty())
       throw CLI::ValidationError("--max-field-error", "needs --preserve-field NAME (the field it bounds)");
-    if (opt.method == CollapseOptions::Sequential)
-      for (const auto& [name, value] : {std::pair<const char*, const std::string*>{"--cost-cl", &c->cost_cl},
-                                        {"--sizing-field", &c->sizing_field},
-                                        {"--placement-cl", &c->placement_cl},
-                                        {"--predicate-cl", &c->predicate_cl}})
-        if (!value->empty())
-          throw CLI::ValidationError(name,
-                                     "needs the parallel method (it is compiled as OpenCL C); not with --method sequential");
+    check_method(c->method, {{"--cost-cl", &c->cost_cl},
+                             {"--sizing-field", &c->sizing_field},
+                             {"--placement-cl", &c->placement_cl},
+                             {"--predicate-cl", &c->predicate_cl}});
     if (!c->placement_cl.empty()) opt.placement_cl_source = cl_file(c->placement_cl);
     if (!c->predicate_cl.empty()) opt.predicate_cl_source = cl_file(c->predicate_cl);
     if (c->target_length > 0) opt.target_length = c->target_length;
     if (c->target_factor > 0) opt.target_factor = c->target_factor;
-    if (!c->region.empty()) combine(opt.vertex_mask, region_mask(mesh, c->region));
-    if (!c->labels.empty()) combine(opt.vertex_mask, label_mask(mesh, c->labels));
+    combine(opt.vertex_mask, region_and_label_mask(mesh, c->region, c->labels));
     CoarsenOptions co;
     co.preserve_field = c->preserve_field;
     co.sizing_field = c->sizing_field;
@@ -400,12 +321,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
     co.improve = !c->no_improve;
     co.improvement = improve_options(c->improve, c->quiet);
     // --region, --labels: improve there only (the masks of the coarse mesh)
-    co.improve_mask = [c](const Mesh& coarse) {
-      std::vector<uint8_t> mask;
-      if (!c->region.empty()) combine(mask, region_mask(coarse, c->region));
-      if (!c->labels.empty()) combine(mask, label_mask(coarse, c->labels));
-      return mask;
-    };
+    co.improve_mask = [c](const Mesh& coarse) { return region_and_label_mask(coarse, c->region, c->labels); };
     const CoarsenReport cr = coarsen(mesh, co, ctx.get(), input.num_tets() > 0 ? &input : nullptr);
     const CollapseReport& r = cr.collapse;
     const ImproveReport& ir = cr.improvement;

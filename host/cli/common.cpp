@@ -108,6 +108,13 @@ CollapseOptions::Conflicts conflicts_mode(const std::string& name) {
                               : CollapseOptions::Greedy;
 }
 
+void check_method(const std::string& method, const std::vector<std::pair<const char*, const std::string*>>& needs_parallel) {
+  if (method != "sequential") return;
+  for (const auto& [name, value] : needs_parallel)
+    if (!value->empty())
+      throw CLI::ValidationError(name, "needs the parallel method (it is compiled as OpenCL C); not with --method sequential");
+}
+
 std::string check_result(const Mesh& result, const Mesh& input, bool hausdorff, bool quiet, int& exit_code) {
 #ifdef TETCOLLAPSE_HAVE_CHECK
   CheckOptions co;

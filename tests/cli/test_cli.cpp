@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iterator>
 #include <set>
+#include <string>
 
 #include "test_support.hpp"
 #include "tetcollapse/io.hpp"
@@ -234,6 +235,34 @@ TEST(Cli, MaxBoundaryErrorHoldsAndIsRefusedWhereItCannot) {
                         &out),
             2);
   EXPECT_NE(out.find("--boundary features"), std::string::npos) << out;
+}
+
+// --region and --labels: the tets with no vertex in the region (or of the labels left out) come
+// out as they went in, bit for bit, improvement phase included; the rest coarsens. A bad region
+// or labels on a mesh without any: exit 2, naming the option.
+TEST(Cli, RegionAndLabelsLeaveTheRestAsItWas) {
+  tc::test::TempDir dir;
+  tc::write_mesh(dir.file("in.vtu"), tc::test::two_material_bracket());
+  const tc::Mesh in = tc::read_mesh(dir.file("in.vtu"));
+  std::string out;
+  for (const auto& [opts, untouched] : tc::test::restricted_runs(in)) {
+    ASSERT_EQ(run_command(cli() + " " + q(dir.file("in.vtu")) + " " + q(dir.file("o.vtu")) + " --target-factor 2 -q " +
+                              opts,
+                          &out),
+              0)
+        << out;
+    const tc::Mesh o = tc::read_mesh(dir.file("o.vtu"));
+    const auto [kept, asked] = tc::test::tets_kept(in, o, untouched);
+    EXPECT_GT(asked, in.num_tets() / 10) << opts;
+    EXPECT_EQ(kept, asked) << opts << ": tets outside changed";
+    EXPECT_LT(o.num_tets() - asked, (in.num_tets() - asked) / 2) << opts << ": the rest did not coarsen";
+  }
+  EXPECT_EQ(run_command(cli() + " " + q(dir.file("in.vtu")) + " " + q(dir.file("x.vtu")) + " --region cube:1", &out), 2);
+  EXPECT_NE(out.find("--region"), std::string::npos) << out;
+  tc::write_mesh(dir.file("nolabels.vtu"), tc::test::cube_tets(2));
+  EXPECT_EQ(run_command(cli() + " " + q(dir.file("nolabels.vtu")) + " " + q(dir.file("x.vtu")) + " --labels 1", &out), 2);
+  EXPECT_NE(out.find("no labels"), std::string::npos) << out;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.vtu")));
 }
 
 // A first run (empty kernel caches) says that it compiles, then each program as it is done, up to

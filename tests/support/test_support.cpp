@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 
 #include "geometry.h"
+#include "tetcollapse/io.hpp"
 #include "tetcollapse/topology.hpp"
 
 namespace tc::test {
@@ -203,6 +204,55 @@ std::set<Point3> vertex_positions(const Mesh& m) {
   std::set<Point3> s;
   for (int64_t v = 0; v < m.num_vertices(); ++v) s.insert({m.points[3 * v], m.points[3 * v + 1], m.points[3 * v + 2]});
   return s;
+}
+
+std::pair<int64_t, int64_t> tets_kept(const Mesh& in, const Mesh& out, const std::function<bool(int64_t)>& which) {
+  using Quad = std::array<Point3, 4>;
+  auto quad = [](const Mesh& m, int64_t t) {
+    Quad q;
+    for (int k = 0; k < 4; ++k) {
+      const int64_t v = m.tets[size_t(4 * t + k)];
+      q[size_t(k)] = {m.points[size_t(3 * v)], m.points[size_t(3 * v + 1)], m.points[size_t(3 * v + 2)]};
+    }
+    std::sort(q.begin(), q.end());
+    return q;
+  };
+  std::set<Quad> have;
+  for (int64_t t = 0; t < out.num_tets(); ++t) have.insert(quad(out, t));
+  std::pair<int64_t, int64_t> r{0, 0};
+  for (int64_t t = 0; t < in.num_tets(); ++t)
+    if (which(t)) {
+      ++r.second;
+      r.first += have.count(quad(in, t)) > 0;
+    }
+  return r;
+}
+
+Mesh two_material_bracket() {
+  Mesh m = read_mesh(project_mesh("bracket.msh"));
+  m.tet_labels.clear();
+  m.tet_fields.clear();
+  m.vertex_fields.clear();
+  double cx = 0;
+  for (int64_t v = 0; v < m.num_vertices(); ++v) cx += m.points[size_t(3 * v)] / double(m.num_vertices());
+  Labels lab{"material", {}};
+  for (int64_t t = 0; t < m.num_tets(); ++t) {
+    double x = 0;
+    for (int k = 0; k < 4; ++k) x += m.points[size_t(3 * m.tets[size_t(4 * t + k)])] / 4;
+    lab.values.push_back(x < cx ? 7 : 9);
+  }
+  m.tet_labels.push_back(lab);
+  return m;
+}
+
+std::vector<std::pair<std::string, std::function<bool(int64_t)>>> restricted_runs(const Mesh& in) {
+  const auto outside_region = [&in](int64_t t) {
+    for (int k = 0; k < 4; ++k)
+      if (in.points[size_t(3 * in.tets[size_t(4 * t + k)])] <= 2) return false;
+    return true;
+  };
+  const auto label_9 = [&in](int64_t t) { return in.tet_labels[0].values[size_t(t)] == 9; };
+  return {{"--region box:0,0,0,2,2,1.3", outside_region}, {"--labels 7", label_9}};
 }
 
 std::set<std::array<int32_t, 3>> sface_keys(const Mesh& m) {

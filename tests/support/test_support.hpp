@@ -8,6 +8,7 @@
 #include <set>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "tetcollapse/mesh.hpp"
@@ -79,6 +80,16 @@ using Point3 = std::tuple<double, double, double>;
 std::vector<uint8_t> mask_x_below(const Mesh& m, double x_max, std::set<Point3>* unselected);
 // The vertex positions of a mesh.
 std::set<Point3> vertex_positions(const Mesh& m);
+// How many of the tets t of `in` with which(t) `out` has too, with the same four vertex
+// positions bit for bit (in any order): {found, asked}.
+std::pair<int64_t, int64_t> tets_kept(const Mesh& in, const Mesh& out, const std::function<bool(int64_t)>& which);
+// bracket.msh with a primary label "material" of 7 where a tet's centroid has x below the mean
+// vertex x and 9 elsewhere (a plane interface); its other labels and fields dropped.
+Mesh two_material_bracket();
+// Options that keep a run to part of `in` (two_material_bracket() as read back), each with the
+// tets of `in` it must leave as they are: --region box:0,0,0,2,2,1.3 (the tets with every
+// vertex at x > 2) and --labels 7 (the tets labelled 9). `in` must outlive the tests.
+std::vector<std::pair<std::string, std::function<bool(int64_t)>>> restricted_runs(const Mesh& in);
 // The faces of the feature surface S (tc::build_topology) as sorted vertex triples, and the
 // indices of the triangles of m.tris that are not among them.
 std::set<std::array<int32_t, 3>> sface_keys(const Mesh& m);
