@@ -6,6 +6,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "cli/masks.hpp"
 #include "improve_collapse.hpp"
 #include "stopwatch.hpp"
 
@@ -30,7 +31,7 @@ std::vector<uint8_t> selected_by_field(const Mesh& m) {
 
 }  // namespace
 
-RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context& ctx) {
+RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context* ctx) {
   Mesh& m = part.mesh;
   RankReport r;
   r.tets_in = m.num_tets();
@@ -40,12 +41,13 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context& ctx
   std::unordered_map<int64_t, size_t> frozen_at;
   Field id{kIdField, 1, std::vector<double>(nv, kSelected)};
   std::vector<uint8_t> mask(nv, 1);
+  const std::vector<uint8_t> chosen = cli::region_and_label_mask(m, s.region, s.labels);
   for (size_t v = 0; v < nv; ++v)
     if (part.frozen[v]) {
       mask[v] = 0;
       id.values[v] = double(part.gid[v]);
       frozen_at.emplace(part.gid[v], v);
-    } else if (!part.select.empty() && !part.select[v]) {
+    } else if ((!part.select.empty() && !part.select[v]) || (!chosen.empty() && !chosen[v])) {
       mask[v] = 0;
       id.values[v] = kLeft;
     }
@@ -54,13 +56,13 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context& ctx
   m.vertex_fields.push_back(std::move(id));
 
   // An all-ones mask would only stop the improvement's collapse step: no mask then.
-  const bool masked = !frozen_at.empty() || !part.select.empty();
+  const bool masked = !frozen_at.empty() || !part.select.empty() || !chosen.empty();
   Stopwatch clock;
   if (m.num_tets() > 0 && phase == Phase::Collapse) {
     CollapseOptions co = s.collapse;
     if (masked) co.vertex_mask = mask;
     if (s.boundary_bound > 0) co.max_boundary_error = 0, co.max_boundary_error_abs = s.boundary_bound;
-    r.boundary_error = collapse(m, co, ctx).boundary_error;
+    r.boundary_error = (ctx ? collapse(m, co, *ctx) : collapse_sequential(m, co)).boundary_error;
     r.seconds_collapse = clock.lap();
   } else if (m.num_tets() > 0) {
     ImproveOptions io = s.improve;
@@ -76,7 +78,7 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context& ctx
       io.max_boundary_error_abs = step ? s.boundary_bound / 3 : s.boundary_bound;
       r.boundary_error = s.boundary_bound;  // not measured: all of it
     }
-    improve(m, io, ctx);
+    ctx ? improve(m, io, *ctx) : improve(m, io);
     // Under a mask the library leaves out its collapse step: run it here, then the passes again.
     // The improvement keeps the numbering under a mask but gives a moved vertex the fields
     // interpolated at its new place (-1 from -1s need not come out exact): mark the vertices
@@ -87,7 +89,7 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context& ctx
         if (!part.frozen[v]) marks[v] = mask[v] ? kSelected : kLeft;
       if (collapse_bad_tets(m, selected_by_field(m), io, s.collapse_length) > 0) {
         io.vertex_mask = selected_by_field(m);
-        improve(m, io, ctx);
+        ctx ? improve(m, io, *ctx) : improve(m, io);
       }
     }
     r.seconds_improve = clock.lap();

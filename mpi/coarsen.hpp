@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 #include "part.hpp"
 #include "tetcollapse/collapse.hpp"
@@ -21,6 +22,9 @@ struct Settings {
   // (the Hausdorff distance obeys the triangle inequality; the parts' boundaries are disjoint
   // but for the frozen interfaces, which do not change).
   double boundary_bound = 0;
+  // --region and --labels: only their vertices change (tetcollapse's masks, found on each part:
+  // a vertex that is not frozen has its whole star in the part)
+  std::string region, labels;
 };
 
 struct RankReport {
@@ -38,6 +42,7 @@ enum class Phase { Collapse, Improve };
 // found again by a vertex field carrying their global id; on return part.gid holds that id for
 // them and -1 for every other vertex, part.frozen says which are which. Throws what the
 // library throws, and std::runtime_error when a frozen vertex was lost (a library fault).
-RankReport coarsen_part(Part& part, Phase phase, const Settings& settings, Context& ctx);
+// ctx null: on the CPU (the sequential method, CollapseOptions::method).
+RankReport coarsen_part(Part& part, Phase phase, const Settings& settings, Context* ctx);
 
 }  // namespace tc::mpi

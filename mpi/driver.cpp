@@ -9,6 +9,7 @@
 
 #include "agree.hpp"
 #include "cli/common.hpp"
+#include "cli/masks.hpp"
 #include "report.hpp"
 #include "rounds.hpp"
 #include "tetcollapse/coarsen.hpp"
@@ -41,9 +42,11 @@ Settings make_settings(Options& o) {
   if (!o.sizing_field.empty()) c.cost_cl_source = sizing_cost_source();
   c.field_difference_cost = !o.preserve_field.empty();
   c.conflicts = cli::conflicts_mode(o.conflicts);
+  c.method = o.method == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
   if (o.priority_levels >= 0) c.tuning.priority_levels = o.priority_levels;
   c.tuning.spatial_order = !o.no_spatial_order;
   if (o.host_tail >= 0) c.tuning.host_tail = o.host_tail;
+  s.region = o.region, s.labels = o.labels;
   ImproveOptions& i = s.improve;
   i = cli::improve_options(o.improve, true);  // (no progress lines: they would come from every rank)
   i.boundary = c.boundary;
@@ -82,6 +85,7 @@ int run(Options& o, MPI_Comm comm) {
     stats.seconds_read = clock.lap();
     if (o.check || (!whole.vertex_fields.empty() && !o.average_fields)) input = whole;
     stats.vertices_in = whole.num_vertices(), stats.tets_in = whole.num_tets();
+    cli::region_and_label_mask(whole, o.region, o.labels);  // (fails here on a mesh without labels)
     stats.median_edge_length = median_edge_length(whole);
     s.collapse.target_length = o.target_length > 0 ? o.target_length : s.collapse.target_factor * stats.median_edge_length;
     if (!(s.collapse.target_length > 0)) throw InputError(o.in, "the mesh has no edges: nothing to coarsen");
@@ -107,7 +111,9 @@ int run(Options& o, MPI_Comm comm) {
 
   // Every rank its own device context: the device chosen now (a --device naming none fails
   // before any work), the context opened when the rank first coarsens.
-  code = guarded(rank, [&] { stats.device = select_device(o.device).name; });
+  code = guarded(rank, [&] {
+    stats.device = s.collapse.method == CollapseOptions::Sequential ? "cpu-sequential" : select_device(o.device).name;
+  });
   if ((code = agree(code, comm))) return code;
   LazyDevice device(o.device, talk);
   if (talk)

@@ -1,5 +1,7 @@
 #include "options.hpp"
 
+#include "cli/masks.hpp"
+
 namespace tc::mpi {
 
 void add_options(CLI::App& app, Options& o) {
@@ -14,6 +16,8 @@ void add_options(CLI::App& app, Options& o) {
                  "ridge vertices along ridges, corners never; free: no protection")
       ->check(CLI::IsMember({"strict", "features", "free"}));
   app.add_flag("--no-labels", o.no_labels, "Do not protect material interfaces between labels");
+  app.add_option("--region", o.region, cli::kRegionHelp);
+  app.add_option("--labels", o.labels, cli::kLabelsHelp);
   app.add_option("--eps-f", o.eps_f, "Face-vertex threshold on 1 - dot of normals")->capture_default_str();
   app.add_option("--eps-r", o.eps_r, "Ridge-edge threshold on 1 - dot of normals")->capture_default_str();
   app.add_option("--eps-v", o.eps_v, "Refuse collapses leaving a tet with volume below this")->capture_default_str();
@@ -57,6 +61,7 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--predicate-cl", o.predicate_cl,
                  "As tetcollapse: an OpenCL C file defining int tc_user_predicate(...); 0 refuses the\n"
                  "collapse (no improvement phase then)");
+  app.add_option("--method", o.method, cli::kMethodHelp)->check(CLI::IsMember({"parallel", "sequential"}));
   app.add_option("--conflicts", o.conflicts,
                  "Conflict detection of the parallel method, as tetcollapse's: matching (default), greedy,\n"
                  "two-pass or atomic-min (needs 64-bit atomics on the device)")
@@ -118,6 +123,16 @@ void add_options(CLI::App& app, Options& o) {
 }
 
 void validate(const Options& o) {
+  cli::check_region_and_labels(o.region, o.labels);
+  cli::check_method(o.method, {{"--cost-cl", &o.cost_cl},
+                               {"--sizing-field", &o.sizing_field},
+                               {"--placement-cl", &o.placement_cl},
+                               {"--predicate-cl", &o.predicate_cl}});
+  if (o.method == "sequential" && !o.device.empty())
+    throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
+  if (o.method == "sequential" && o.priority_levels >= 0)
+    throw CLI::ValidationError("--priority-levels",
+                               "applies to the greedy and matching conflict detections only (--conflicts greedy|matching)");
   if (!o.preserve_field.empty() && !o.sizing_field.empty())
     throw CLI::ValidationError("--preserve-field", "cannot be combined with --sizing-field");
   if (!o.cost_cl.empty() && (!o.preserve_field.empty() || !o.sizing_field.empty()))

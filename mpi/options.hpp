@@ -19,9 +19,10 @@ struct Options {
   int64_t eps_c = 0;
   int max_iterations = 1000;
   bool paper_boundary_rule = false, no_spatial_order = false;
-  std::string conflicts = "matching";
+  std::string conflicts = "matching", method = "parallel";
   std::string preserve_field;  // the paper's field cost on this vertex field (--field-tolerance)
   std::string sizing_field, cost_cl, placement_cl, predicate_cl;
+  std::string region, labels;  // only there (tetcollapse's --region, --labels)
   double field_tolerance = 0.02;
   double priority_levels = -1, host_tail = -1;  // -1: not given (the library's defaults)
   cli::ImproveCli improve;  // the improvement's options, as tetcollapse's

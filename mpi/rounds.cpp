@@ -65,7 +65,9 @@ int run_round(Phase phase, Round& st, const Settings& s, const Options& o, LazyD
   // Every rank works on its part.
   RankReport rr;
   Stopwatch own;
-  code = guarded(rank, [&] { rr = coarsen_part(mine, phase, s, device.get()); });
+  code = guarded(rank, [&] {
+    rr = coarsen_part(mine, phase, s, s.collapse.method == CollapseOptions::Sequential ? nullptr : &device.get());
+  });
   const RankStats mine_stats{double(rr.tets_in),   double(rr.tets_out),     double(rr.frozen),
                              own.lap(),             rr.seconds_collapse,     rr.seconds_improve,
                              double(peak_rss_kb()), rr.boundary_error};

@@ -8,9 +8,11 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tetcollapse/check.hpp"
@@ -200,23 +202,11 @@ TEST(MpiToolOptions, UserFunctionsAndSizingFieldAsTetcollapse) {
 // (the linear field resampled), the tet field goes with its tets.
 TEST_P(MpiTool, KeepsLabelsAndFields) {
   TempDir dir;
-  Mesh m = tc::read_mesh(tc::test::project_mesh("bracket.msh"));
-  m.tet_labels.clear();
-  m.tet_fields.clear();
-  m.vertex_fields.clear();
-  double cx = 0;
-  for (int64_t v = 0; v < m.num_vertices(); ++v) cx += m.points[size_t(3 * v)] / double(m.num_vertices());
-  tc::Labels lab{"material", {}};
+  Mesh m = tc::test::two_material_bracket();
   tc::Field tf{"heat", 1, {}};
-  for (int64_t t = 0; t < m.num_tets(); ++t) {
-    double x = 0;
-    for (int k = 0; k < 4; ++k) x += m.points[size_t(3 * m.tets[size_t(4 * t + k)])] / 4;
-    lab.values.push_back(x < cx ? 7 : 9);
-    tf.values.push_back(x < cx ? 1.5 : 2.5);
-  }
+  for (int32_t l : m.tet_labels[0].values) tf.values.push_back(l == 7 ? 1.5 : 2.5);
   tc::Field vf{"potential", 1, {}};
   for (int64_t v = 0; v < m.num_vertices(); ++v) vf.values.push_back(m.points[size_t(3 * v)] + 2 * m.points[size_t(3 * v + 1)]);
-  m.tet_labels.push_back(lab);
   m.tet_fields.push_back(tf);
   m.vertex_fields.push_back(vf);
   tc::write_mesh(dir.file("in.vtu"), m);
@@ -256,6 +246,27 @@ TEST_P(MpiTool, KeepsLabelsAndFields) {
   const auto& mat = out.find_labels("material")->values;
   for (int64_t t = 0; t < out.num_tets(); ++t)
     ASSERT_EQ(out.tet_fields[0].values[size_t(t)], mat[size_t(t)] == 7 ? 1.5 : 2.5) << "tet " << t;
+}
+
+// --region and --labels as tetcollapse's: the tets with no vertex in the region (or of the labels
+// left out) come out as they went in, the rest coarsens, within 5% of tetcollapse's tets.
+TEST_P(MpiTool, RegionAndLabelsAsTetcollapse) {
+  TempDir dir;
+  tc::write_mesh(dir.file("in.vtu"), tc::test::two_material_bracket());
+  const Mesh in = tc::read_mesh(dir.file("in.vtu"));
+  for (const auto& [opts, untouched] : tc::test::restricted_runs(in)) {
+    std::string log;
+    const std::string args = " --target-factor 2 -q " + opts;
+    ASSERT_EQ(run_single(dir.file("in.vtu") + " " + dir.file("s.vtu") + args, &log), 0) << log;
+    ASSERT_EQ(run_mpi(GetParam(), dir.file("in.vtu") + " " + dir.file("m.vtu") + args + " --check", &log), 0) << log;
+    const Mesh single = tc::read_mesh(dir.file("s.vtu")), out = tc::read_mesh(dir.file("m.vtu"));
+    const auto [kept, asked] = tc::test::tets_kept(in, out, untouched);
+    EXPECT_GT(asked, in.num_tets() / 10) << opts;
+    EXPECT_EQ(kept, asked) << opts << ": tets outside changed";
+    EXPECT_LT(out.num_tets() - asked, (in.num_tets() - asked) / 2) << opts << ": the rest did not coarsen";
+    EXPECT_NEAR(double(out.num_tets()) / double(single.num_tets()), 1.0, 0.05)
+        << opts << ": " << out.num_tets() << " against " << single.num_tets();
+  }
 }
 
 // The same input, options and ranks: the same file, byte for byte.
@@ -341,6 +352,26 @@ TEST(MpiToolOptions, TheCommandsOptionsMeanTheSame) {
   EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --conflicts two-pass --priority-levels 3", &log), 2) << log;
 }
 
+// --method sequential: every rank on the CPU, with no device opened; valid and within 5% of
+// tetcollapse --method sequential; the options that need the parallel method refused as there.
+TEST(MpiToolOptions, SequentialMethodAsTetcollapse) {
+  TempDir dir;
+  const std::string in = tc::test::project_mesh("bracket.msh");
+  std::string log;
+  const std::string args = " --target-factor 2 -q --method sequential";
+  ASSERT_EQ(run_single(in + " " + dir.file("s.msh") + args, &log), 0) << log;
+  ASSERT_EQ(run_mpi(2, in + " " + dir.file("m.msh") + args + " --check --stats " + dir.file("s.json"), &log), 0) << log;
+  const int64_t single = tc::read_mesh(dir.file("s.msh")).num_tets(), mpi = tc::read_mesh(dir.file("m.msh")).num_tets();
+  EXPECT_NEAR(double(mpi) / double(single), 1.0, 0.05) << mpi << " against " << single;
+  EXPECT_NE(tc::test::read_text(dir.file("s.json")).find("\"device\":\"cpu-sequential\""), std::string::npos);
+  tc::test::write_text(dir.file("cost.cl"), "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return 1; }\n");
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("x.msh") + " --method sequential --cost-cl " + dir.file("cost.cl") +
+                           " --target-length 1", &log), 2);
+  EXPECT_NE(log.find("needs the parallel method"), std::string::npos) << log;
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("x.msh") + args + " --device 0", &log), 2);
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x.msh")));
+}
+
 // Exit codes as the README's, on every rank; nothing written on failure.
 TEST(MpiToolErrors, ExitCodesAndNothingWritten) {
   TempDir dir;
@@ -356,11 +387,16 @@ TEST(MpiToolErrors, ExitCodesAndNothingWritten) {
   EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --device no-such-device -q", &log), 3);
   EXPECT_EQ(run_mpi(2, in + " " + dir.file("nowhere/o.msh") + " -q", &log), 4);
   EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --no-such-option", &log), 2);
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --region cube:1", &log), 2);
+  EXPECT_NE(log.find("--region"), std::string::npos) << log;
+  tc::write_mesh(dir.file("nolabels.vtu"), tc::test::cube_tets(2));
+  EXPECT_EQ(run_mpi(2, dir.file("nolabels.vtu") + " " + dir.file("o.msh") + " --labels 1 -q", &log), 2);
+  EXPECT_NE(log.find("no labels"), std::string::npos) << log;
   EXPECT_EQ(run_mpi(2, "--help", &log), 0);
   EXPECT_NE(log.find("--round-threshold"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir.file("o.msh")));
-  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1)
-      << "only bad.msh is left";
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 2)
+      << "only bad.msh and nolabels.vtu are left";
 }
 
 }  // namespace
