@@ -42,7 +42,7 @@ Settings make_settings(Options& o) {
   if (!o.sizing_field.empty()) c.cost_cl_source = sizing_cost_source();
   c.field_difference_cost = !o.preserve_field.empty();
   c.conflicts = cli::conflicts_mode(o.conflicts);
-  c.method = o.method == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
+  c.method = cli::method_mode(o.method);
   if (o.priority_levels >= 0) c.tuning.priority_levels = o.priority_levels;
   c.tuning.spatial_order = !o.no_spatial_order;
   if (o.host_tail >= 0) c.tuning.host_tail = o.host_tail;
@@ -85,7 +85,7 @@ int run(Options& o, MPI_Comm comm) {
     stats.seconds_read = clock.lap();
     if (o.check || (!whole.vertex_fields.empty() && !o.average_fields)) input = whole;
     stats.vertices_in = whole.num_vertices(), stats.tets_in = whole.num_tets();
-    cli::region_and_label_mask(whole, o.region, o.labels);  // (fails here on a mesh without labels)
+    if (!o.labels.empty()) cli::require_labels(whole);
     stats.median_edge_length = median_edge_length(whole);
     s.collapse.target_length = o.target_length > 0 ? o.target_length : s.collapse.target_factor * stats.median_edge_length;
     if (!(s.collapse.target_length > 0)) throw InputError(o.in, "the mesh has no edges: nothing to coarsen");

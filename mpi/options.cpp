@@ -124,22 +124,19 @@ void add_options(CLI::App& app, Options& o) {
 
 void validate(const Options& o) {
   cli::check_region_and_labels(o.region, o.labels);
-  cli::check_method(o.method, {{"--cost-cl", &o.cost_cl},
-                               {"--sizing-field", &o.sizing_field},
-                               {"--placement-cl", &o.placement_cl},
-                               {"--predicate-cl", &o.predicate_cl}});
-  if (o.method == "sequential" && !o.device.empty())
-    throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
-  if (o.method == "sequential" && o.priority_levels >= 0)
-    throw CLI::ValidationError("--priority-levels",
-                               "applies to the greedy and matching conflict detections only (--conflicts greedy|matching)");
+  cli::check_method(o.method, o.device,
+                    {{"--cost-cl", &o.cost_cl},
+                     {"--sizing-field", &o.sizing_field},
+                     {"--placement-cl", &o.placement_cl},
+                     {"--predicate-cl", &o.predicate_cl}});
   if (!o.preserve_field.empty() && !o.sizing_field.empty())
     throw CLI::ValidationError("--preserve-field", "cannot be combined with --sizing-field");
   if (!o.cost_cl.empty() && (!o.preserve_field.empty() || !o.sizing_field.empty()))
     throw CLI::ValidationError("--cost-cl", "cannot be combined with --sizing-field or --preserve-field");
   if (!o.cost_cl.empty() && !(o.target_length > 0))
     throw CLI::ValidationError("--cost-cl", "needs --target-length");
-  if (o.priority_levels >= 0 && o.conflicts != "greedy" && o.conflicts != "matching")
+  if (o.priority_levels >= 0 &&
+      (o.method == "sequential" || (o.conflicts != "greedy" && o.conflicts != "matching")))
     throw CLI::ValidationError("--priority-levels",
                                "applies to the greedy and matching conflict detections only (--conflicts greedy|matching)");
   if ((o.max_boundary_error > 0 || o.max_boundary_error_abs > 0) && o.boundary != "features")

@@ -247,7 +247,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
     opt.boundary = boundary_mode(c->boundary);
     opt.use_labels = !c->no_labels;
     opt.tuning.spatial_order = !c->no_spatial_order;
-    opt.method = c->method == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
+    opt.method = method_mode(c->method);
     opt.conflicts = conflicts_mode(c->conflicts);
     if (c->priority_levels >= 0) {
       if (opt.method == CollapseOptions::Sequential ||
@@ -261,14 +261,13 @@ void register_collapse(CLI::App& app, int& exit_code) {
         throw CLI::ValidationError("--max-boundary-error",
                                    "applies to --boundary features (strict keeps the boundary exactly, free does not bound it)");
     }
-    if (opt.method == CollapseOptions::Sequential && !c->device.empty())
-      throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
     if (opt.max_field_error > 0 && c->preserve_field.empty())
       throw CLI::ValidationError("--max-field-error", "needs --preserve-field NAME (the field it bounds)");
-    check_method(c->method, {{"--cost-cl", &c->cost_cl},
-                             {"--sizing-field", &c->sizing_field},
-                             {"--placement-cl", &c->placement_cl},
-                             {"--predicate-cl", &c->predicate_cl}});
+    check_method(c->method, c->device,
+                 {{"--cost-cl", &c->cost_cl},
+                  {"--sizing-field", &c->sizing_field},
+                  {"--placement-cl", &c->placement_cl},
+                  {"--predicate-cl", &c->predicate_cl}});
     if (!c->placement_cl.empty()) opt.placement_cl_source = cl_file(c->placement_cl);
     if (!c->predicate_cl.empty()) opt.predicate_cl_source = cl_file(c->predicate_cl);
     if (c->target_length > 0) opt.target_length = c->target_length;

@@ -108,8 +108,14 @@ CollapseOptions::Conflicts conflicts_mode(const std::string& name) {
                               : CollapseOptions::Greedy;
 }
 
-void check_method(const std::string& method, const std::vector<std::pair<const char*, const std::string*>>& needs_parallel) {
-  if (method != "sequential") return;
+CollapseOptions::Method method_mode(const std::string& name) {
+  return name == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
+}
+
+void check_method(const std::string& method, const std::string& device,
+                  const std::vector<std::pair<const char*, const std::string*>>& needs_parallel) {
+  if (method_mode(method) != CollapseOptions::Sequential) return;
+  if (!device.empty()) throw CLI::ValidationError("--device", "the sequential method runs on the CPU without a device");
   for (const auto& [name, value] : needs_parallel)
     if (!value->empty())
       throw CLI::ValidationError(name, "needs the parallel method (it is compiled as OpenCL C); not with --method sequential");

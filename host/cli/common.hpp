@@ -60,13 +60,15 @@ void write_report(const std::string& path, const std::string& text);
 CollapseOptions::Boundary boundary_mode(const std::string& name);
 // --conflicts matching|greedy|two-pass|atomic-min (the option checks the name) as the options' enum.
 CollapseOptions::Conflicts conflicts_mode(const std::string& name);
-// --method parallel|sequential: its help, and the options that need the parallel method, refused
-// with the sequential one (CLI::ValidationError naming the first given); a name with an empty
-// value is not given.
+// --method parallel|sequential: its help, the name (the option checks it) as the options' enum,
+// and, with the sequential method, a --device or an option that needs the parallel method
+// refused (CLI::ValidationError naming the first given; an empty value is not given).
 inline constexpr const char* kMethodHelp =
     "parallel (default): the OpenCL pipeline; sequential: the CPU priority-queue baseline\n"
     "with the same checks (no OpenCL device needed)";
-void check_method(const std::string& method, const std::vector<std::pair<const char*, const std::string*>>& needs_parallel);
+CollapseOptions::Method method_mode(const std::string& name);
+void check_method(const std::string& method, const std::string& device,
+                  const std::vector<std::pair<const char*, const std::string*>>& needs_parallel);
 
 // --check of the commands that change a mesh: checks `result` against `input` (validity, the
 // boundary's topology; with `hausdorff` also the boundary distance, 0 expected in strict mode),

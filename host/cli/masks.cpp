@@ -52,8 +52,12 @@ std::vector<uint8_t> region_mask(const Mesh& m, const std::string& spec) {
   return mask;
 }
 
-std::vector<uint8_t> label_mask(const Mesh& m, const std::string& spec) {
+void require_labels(const Mesh& m) {
   if (m.tet_labels.empty()) throw InputError("--labels", "the mesh has no labels");
+}
+
+std::vector<uint8_t> label_mask(const Mesh& m, const std::string& spec) {
+  require_labels(m);
   std::set<int32_t> wanted;
   for (double x : parse_numbers(spec, "--labels")) wanted.insert(static_cast<int32_t>(x));
   std::vector<uint8_t> mask(static_cast<size_t>(m.num_vertices()), 1);

@@ -23,6 +23,9 @@ std::vector<uint8_t> region_mask(const Mesh& m, const std::string& spec);
 // --labels A,B,...: a vertex is selected when every tet around it has a selected primary label,
 // so material interfaces to unselected labels stay where they are. InputError without labels.
 std::vector<uint8_t> label_mask(const Mesh& m, const std::string& spec);
+// InputError naming --labels when m has none (label_mask's own check, for a caller that only
+// wants to fail early).
+void require_labels(const Mesh& m);
 // Both, as one mask (a vertex selected by each given); empty when neither is given.
 std::vector<uint8_t> region_and_label_mask(const Mesh& m, const std::string& region, const std::string& labels);
 // The two specs' syntax alone, before any mesh is read (CLI::ValidationError).
