@@ -49,7 +49,8 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
                          __global const int* nb_edge, __global const int* labels, int use_labels,
                          __global const double* pts, __global const double* vfield, uint vfield_stride,
                          __global const uchar* vflags, __global const uchar* vclass, __global const uchar* eflags,
-                         int mode, int paper_rule, double eps_v, double q_min, __global const double* tets2quality,
+                         int mode, int paper_rule, double eps_v, double q_min, double field_eps,
+                         __global const double* tets2quality,
                          __global uint* edges_are_admissible, __global uchar* edges2dir, __global uchar* edges2reason,
                          __global uint* counters) {
   uint e = get_global_id(0);
@@ -69,7 +70,7 @@ __kernel void admissible(uint ne, __global const int* edges, __global const uint
   }
   atomic_inc(&counters[5]);  /* passed Q: IterationStats::candidates */
   uchar r = tcc_link_and_volume(a, b, fa, fb, fe, dir, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels,
-                                use_labels, pts, vfield, vfield_stride, vflags, eflags, eps_v, q_min, tets2quality);
+                                use_labels, pts, vfield, vfield_stride, vflags, eflags, eps_v, q_min, field_eps, tets2quality);
   edges2reason[e] = r;
   if (r != TCC_OK) return;
   edges_are_admissible[e] = 1u;

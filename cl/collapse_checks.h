@@ -27,6 +27,8 @@
  *   TCS_POINT(v)                    the position of v
  *   TCS_OLD_QUALITY(t, p0, p1, p2, p3)  tc_tet_quality of tet t = (p0, p1, p2, p3) as it is
  *                                   (or a value kept of it)
+ *   TCS_FIELD_EPS, TCS_FIELD(v)     the field check's threshold (0: off) and the first vertex
+ *                                   field's value at v (read only when the threshold is > 0)
  * The common neighbours of the edge are gathered by the caller (tcc_link_holds): the device
  * merges the sorted neighbour lists it has, the host marks the vertices of the rings (it keeps no
  * sorted lists). The device's live gatherings (cl/collapse_select.h) stay there: the host's rings
@@ -83,16 +85,45 @@ inline tcs_q4 tcs_q4_load(const int* tets, int t) {
 
 /* --- the volume test --- */
 
+/* The field check's search: when the tet c holds x better than the best so far (a larger
+ * smallest barycentric coordinate), it becomes the best, and *at the field f interpolated at x. */
+TC_FN void tcc_field_in_tet(const tc_d3* c, const double* f, tc_d3 x, double* best, double* at) {
+  double l[4];
+  tc_barycentric(c[0], c[1], c[2], c[3], x, l);
+  const double m = fmin(fmin(l[0], l[1]), fmin(l[2], l[3]));
+  if (m > *best) {
+    *best = m;
+    *at = l[0] * f[0] + l[1] * f[1] + l[2] * f[2] + l[3] * f[3];
+  }
+}
+
 /* The volume test and the quality guard of the collapse of (a, b) in which the survivor goes to
  * p (the vertex that moves there is a, b or both): TCC_OK, TCC_REFUSED_VOLUME or
  * TCC_REFUSED_QUALITY. Every tet of ring(a) U ring(b) that survives (holds one end point only)
  * must keep a volume of at least eps_v with its end point at p; with the quality guard
  * (q_min > 0), the worst mean ratio among the tets that change shape may not fall below
  * min(its value before the collapse, q_min): a collapse never makes a good neighbourhood bad,
- * nor a bad one worse. */
+ * nor a bad one worse. With the field check (TCS_FIELD_EPS > 0; TCS_FIELD(v) the first vertex
+ * field, both defined by the includer): an end point that moves may not find the new piecewise
+ * linear field at its old place off its value by more than TCS_FIELD_EPS (TCC_REFUSED_QUALITY:
+ * docs/algorithm.md, the field check). */
 TC_FN int tcc_volume_verdict(TCS_VOL_PARAMS, int a, int b, tc_d3 p, double eps_v, double q_min) {
   tc_d3 pa = TCS_POINT(a), pb = TCS_POINT(b);
   double q_old = 1.0, q_new = 1.0;
+  /* The field check (TCS_FIELD_EPS > 0): the survivor's value interpolated along the edge at the
+   * placement's parameter, as the collapse sets it; for each end point that moves, the new tet
+   * that holds its old place best (largest smallest barycentric coordinate) and the new field's
+   * value there. */
+  const double f_eps = TCS_FIELD_EPS;
+  double f_a = 0.0, f_b = 0.0, f_p = 0.0, best_a = -INFINITY, best_b = -INFINITY, at_a = 0.0, at_b = 0.0;
+  if (f_eps > 0.0) {
+    f_a = TCS_FIELD(a);
+    f_b = TCS_FIELD(b);
+    tc_d3 e = pb - pa;
+    double ee = dot(e, e), t = ee > 0.0 ? dot(p - pa, e) / ee : 0.0;
+    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+    f_p = f_a + (f_b - f_a) * t;
+  }
   for (int side = 0; side < 2; ++side) {
     int x = side == 0 ? a : b, y = side == 0 ? b : a;
     tc_d3 px = side == 0 ? pa : pb;
@@ -123,6 +154,12 @@ TC_FN int tcc_volume_verdict(TCS_VOL_PARAMS, int a, int b, tc_d3 p, double eps_v
 #ifdef TCC_USER_PLACEMENT
         if (!(vol < INFINITY)) return TCC_REFUSED_VOLUME; /* a finite placement far enough overflows */
 #endif
+        if (f_eps > 0.0) {
+          const double f[4] = {q.x == x ? f_p : TCS_FIELD(q.x), q.y == x ? f_p : TCS_FIELD(q.y),
+                               q.z == x ? f_p : TCS_FIELD(q.z), q.w == x ? f_p : TCS_FIELD(q.w)};
+          if (pa.x != p.x || pa.y != p.y || pa.z != p.z) tcc_field_in_tet(c, f, pa, &best_a, &at_a);
+          if (pb.x != p.x || pb.y != p.y || pb.z != p.z) tcc_field_in_tet(c, f, pb, &best_b, &at_b);
+        }
         if (q_min > 0.0) {
           double qn = tc_tet_quality_v(c[0], c[1], c[2], c[3], vol);
           double qo = TCS_OLD_QUALITY(ts[j], q.x == x ? px : c[0], q.y == x ? px : c[1], q.z == x ? px : c[2],
@@ -134,6 +171,9 @@ TC_FN int tcc_volume_verdict(TCS_VOL_PARAMS, int a, int b, tc_d3 p, double eps_v
     }
   }
   if (q_min > 0.0 && q_new < (q_old < q_min ? q_old : q_min)) return TCC_REFUSED_QUALITY;
+  if (f_eps > 0.0 && ((best_a > -INFINITY && !(fabs(at_a - f_a) <= f_eps)) ||
+                          (best_b > -INFINITY && !(fabs(at_b - f_b) <= f_eps))))
+    return TCC_REFUSED_QUALITY;
   return TCC_OK;
 }
 

@@ -56,8 +56,8 @@
       __global const uint *nb_off, __global const int *nb, __global const int *nb_edge, __global const int *labels,    \
       int use_labels, __global double *pts, __global double *vfield, uint vfield_stride, __global const uchar *vflags, \
       __global const uchar *vclass, __global const uchar *eflags, int mode, int paper_rule, double eps_v,              \
-      double q_min, __global const double *tets2quality, __global uchar *edges2dir, __global uchar *edges2reason,      \
-      __global uint *counters, __global uchar *edges2verdict, double eps_r, double eps_f,                              \
+      double q_min, double field_eps, __global const double *tets2quality, __global uchar *edges2dir,                  \
+      __global uchar *edges2reason, __global uint *counters, __global uchar *edges2verdict, double eps_r, double eps_f, \
       __global uchar *tets_are_dead
 #define TCC_MATCH_ARGS TCC_TEST_ARGS, eps_r, eps_f, tets_are_dead
 
@@ -150,7 +150,7 @@ inline uchar tcc_match_test(int e, int a, int b, int live, int full, int* dir, T
               : tcc_lazy_dir(e, a, b, TCC_TEST_ARGS);
   if (*dir < 0 || !tcc_user_allows(pts, vfield, vfield_stride, a, b)) return TCC_REFUSED_Q;
   atomic_inc(&counters[4]);
-  uchar r = tcc_volume_test(a, b, *dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tets2quality, 1,
+  uchar r = tcc_volume_test(a, b, *dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, field_eps, tets2quality, 1,
                             tets_are_dead);
   if (r != TCC_OK || !full) return r;
   return tcc_link_test(a, b, fa, fb, fe, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, vflags,

@@ -32,8 +32,9 @@
 #define TCS_LINK_ARGS tets, vt_off, vt, tet_nbr, labels, use_labels, vflags, eflags, live, tets_are_dead
 #define TCS_VOL_PARAMS                                                                                       \
   __global const int *tets, __global const uint *vt_off, __global const int *vt, __global const double *pts, \
-      __global const double *tets2quality, int live, __global const uchar *tets_are_dead
-#define TCS_VOL_ARGS tets, vt_off, vt, pts, tets2quality, live, tets_are_dead
+      __global const double *tets2quality, int live, __global const uchar *tets_are_dead,                     \
+      __global const double *vfield, uint vfield_stride, double field_eps
+#define TCS_VOL_ARGS tets, vt_off, vt, pts, tets2quality, live, tets_are_dead, vfield, vfield_stride, field_eps
 #define TCS_RING_BEGIN(x) vt_off[x]
 #define TCS_RING_END(x) vt_off[(x) + 1]
 #define TCS_RING_TET(i) vt[i]
@@ -50,6 +51,8 @@
 #define TCS_POINT(v) tc_point(pts, (v))
 /* tets2quality holds the qualities of the iteration's start */
 #define TCS_OLD_QUALITY(t, p0, p1, p2, p3) (live ? tc_tet_quality(p0, p1, p2, p3) : tets2quality[t])
+#define TCS_FIELD_EPS field_eps
+#define TCS_FIELD(v) vfield[(size_t)(v) * vfield_stride]
 
 /* The link condition and the volume test themselves: shared with the sequential CPU method. */
 #include "collapse_checks.h"
@@ -63,8 +66,8 @@
  * the iteration's start). */
 inline uchar tcc_volume_test(int a, int b, int dir, __global const int* tets, __global const uint* vt_off,
                              __global const int* vt, __global const double* pts, __global const double* vfield,
-                             uint vfield_stride, double eps_v, double q_min, __global const double* tets2quality,
-                             int live, __global const uchar* tets_are_dead) {
+                             uint vfield_stride, double eps_v, double q_min, double field_eps,
+                             __global const double* tets2quality, int live, __global const uchar* tets_are_dead) {
   double3 p = tcc_placement(pts, vfield, vfield_stride, a, b, (uint)dir);
 #ifdef TCC_USER_PLACEMENT
   /* a user placement may be no point at all (inf, nan: e.g. a division by a zero field
@@ -204,9 +207,9 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
                                  __global const uint* nb_off, __global const int* nb, __global const int* nb_edge,
                                  __global const int* labels, int use_labels, __global const double* pts,
                                  __global const double* vfield, uint vfield_stride, __global const uchar* vflags,
-                                 __global const uchar* eflags, double eps_v, double q_min,
+                                 __global const uchar* eflags, double eps_v, double q_min, double field_eps,
                                  __global const double* tets2quality) {
-  uchar r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tets2quality, 0,
+  uchar r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, field_eps, tets2quality, 0,
                             TCC_NO_DEAD);
   if (r != TCC_OK) return r;
   return tcc_link_test(a, b, fa, fb, fe, tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, vflags,
@@ -220,11 +223,12 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
       __global const uint *nb_off, __global const int *nb, __global const int *nb_edge, __global const int *labels, \
       int use_labels, __global const double *pts, __global const double *vfield, uint vfield_stride,                \
       __global const uchar *vflags, __global const uchar *vclass, __global const uchar *eflags, int mode,           \
-      int paper_rule, double eps_v, double q_min, __global const double *tets2quality, __global uchar *edges2dir,   \
-      __global uchar *edges2reason, __global uint *counters, __global uchar *edges2verdict
+      int paper_rule, double eps_v, double q_min, double field_eps, __global const double *tets2quality,            \
+      __global uchar *edges2dir, __global uchar *edges2reason, __global uint *counters, __global uchar *edges2verdict
 #define TCC_TEST_ARGS                                                                                             \
   tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vfield, vfield_stride, vflags, vclass, \
-      eflags, mode, paper_rule, eps_v, q_min, tets2quality, edges2dir, edges2reason, counters, edges2verdict
+      eflags, mode, paper_rule, eps_v, q_min, field_eps, tets2quality, edges2dir, edges2reason, counters,         \
+      edges2verdict
 
 /* Q's direction bits of the candidate e = (a, b), with the user's placement (tcc_user_dir). */
 inline int tcc_lazy_dir(int e, int a, int b, TCC_TEST_PARAMS) {
@@ -240,7 +244,7 @@ inline int tcc_lazy_dir(int e, int a, int b, TCC_TEST_PARAMS) {
 inline int tcc_lazy_volume(int e, int a, int b, int dir, TCC_TEST_PARAMS) {
   uchar r = edges2verdict[e];
   if (r == TCC_VERDICT_UNKNOWN) {
-    r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, tets2quality, 0,
+    r = tcc_volume_test(a, b, dir, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v, q_min, field_eps, tets2quality, 0,
                         TCC_NO_DEAD);
     if (r == TCC_OK) r = TCC_VOLUME_OK;
     edges2verdict[e] = r;

@@ -130,7 +130,8 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
                      py::object target_length, const std::string& boundary, py::object labels,
                      py::object vertex_fields, py::object device, const std::string& method, bool improve_phase,
                      double min_quality, double max_boundary_error, bool average_fields,
-                     const std::string& preserve_field, double field_tolerance, double max_field_error,
+                     const std::string& preserve_field, double field_tolerance, double field_check,
+                     double max_field_error,
                      const std::string& sizing_field) {
   Mesh mesh = from_numpy(points, tets, labels, vertex_fields);
   CoarsenOptions co;
@@ -145,6 +146,7 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
   co.resample_fields = !average_fields;
   co.preserve_field = preserve_field;
   co.field_tolerance = field_tolerance;
+  co.field_check = field_check;
   co.sizing_field = sizing_field;
   if (method != "parallel" && method != "sequential")
     throw InputError("<method>", "method must be 'parallel' or 'sequential', not '" + method + "'");
@@ -245,7 +247,7 @@ PYBIND11_MODULE(_core, mod) {
           py::arg("vertex_fields") = py::none(), py::arg("device") = py::none(), py::arg("method") = "parallel",
           py::arg("improve") = true, py::arg("min_quality") = 0.1, py::arg("max_boundary_error") = 0.0,
           py::arg("average_fields") = false, py::arg("preserve_field") = "", py::arg("field_tolerance") = 0.02,
-          py::arg("max_field_error") = 0.0, py::arg("sizing_field") = "",
+          py::arg("field_check") = CoarsenOptions{}.field_check, py::arg("max_field_error") = 0.0, py::arg("sizing_field") = "",
           "Coarsens a tet mesh; returns a dict: points, tets, labels (if given), vertex_fields, stats.");
   mod.def("improve", &improve_py, py::arg("points"), py::arg("tets"), py::kw_only(), py::arg("boundary") = "features",
           py::arg("labels") = py::none(), py::arg("vertex_fields") = py::none(), py::arg("device") = py::none(),

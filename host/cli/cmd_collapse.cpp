@@ -33,6 +33,8 @@ struct CollapseCli {
   std::string preserve_field;
   double field_tolerance = 0.02;
   CLI::Option* field_tolerance_option = nullptr;
+  double field_check = CoarsenOptions{}.field_check;
+  CLI::Option* field_check_option = nullptr;
   ImproveCli improve;
 };
 
@@ -162,6 +164,13 @@ void register_collapse(CLI::App& app, int& exit_code) {
       app.add_option("--field-tolerance", c->field_tolerance, "With --preserve-field: T (the paper: 0.02)")
           ->capture_default_str()
           ->check(CLI::PositiveNumber);
+  c->field_check_option =
+      app.add_option("--field-check", c->field_check,
+                     "With --preserve-field (beyond the paper): also refuse a collapse that would change the\n"
+                     "field at an end point's old place by more than K x T x the range (the edge's two ends\n"
+                     "alike says nothing where the field bends, e.g. at a peak); 0: the paper's cost alone")
+          ->capture_default_str()
+          ->check(CLI::NonNegativeNumber);
   app.add_option("--max-field-error", c->opt.max_field_error,
                  "With --preserve-field NAME, in place of --field-tolerance: collapse every edge (up to\n"
                  "--target-length or --target-factor when given) while each input vertex keeps its value of\n"
@@ -277,6 +286,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
     co.preserve_field = c->preserve_field;
     co.sizing_field = c->sizing_field;
     co.field_tolerance = c->field_tolerance;
+    co.field_check = c->field_check;
     co.resample_fields = !c->average_fields;
     if (!c->cost_cl.empty()) {
       if (!c->sizing_field.empty() || !c->preserve_field.empty())
@@ -292,6 +302,8 @@ void register_collapse(CLI::App& app, int& exit_code) {
     if (opt.max_field_error > 0) {
       if (c->field_tolerance_option->count() > 0)
         throw CLI::ValidationError("--field-tolerance", "cannot be combined with --max-field-error (the bound decides)");
+      if (c->field_check_option->count() > 0)
+        throw CLI::ValidationError("--field-check", "cannot be combined with --max-field-error (the bound decides)");
       // the bound alone decides, unless a target is given
       if (opt.target_length <= 0 && c->target_factor > 0)
         opt.target_length = c->target_factor * median_edge_length(mesh);

@@ -57,6 +57,7 @@ size_t apply_field_options(const Mesh& mesh, const CoarsenOptions& options, Coll
     }
     co.field_difference_cost = true;
     co.target_length = options.field_tolerance * (hi - lo);
+    co.field_check = options.field_check;
     if (!(co.target_length > 0))
       throw std::invalid_argument("vertex field '" + options.preserve_field + "' is constant: nothing bounds a collapse");
     return first;

@@ -17,6 +17,7 @@ CheckParams check_params_from(const CollapseOptions& o) {
   p.eps_r = o.eps_r;
   p.eps_v = o.eps_v;
   p.min_quality = o.min_quality;
+  p.field_eps = o.field_difference_cost && o.field_check > 0 ? o.field_check * o.target_length : 0;
   return p;
 }
 

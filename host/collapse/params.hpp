@@ -25,6 +25,9 @@ struct CheckParams {
   bool use_labels = true;
   double eps_f = 0.01, eps_r = 0.1, eps_v = 2e-12;
   double min_quality = 0;  // quality guard, 0 = off
+  // the field check (CollapseOptions::field_check) in field units, 0 = off; the first vertex
+  // field (TCS_FIELD, cl/collapse_checks.h)
+  double field_eps = 0;
 };
 CheckParams check_params_from(const CollapseOptions& o);
 

@@ -57,7 +57,7 @@ void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, con
            arg("use_labels", use_labels), arg("pts", dm.points), arg("vfield", dm.vfields),
            arg("vfield_stride", dm.vfield_comps), arg("vflags", c.vflags), arg("vclass", c.vclass),
            arg("eflags", c.eflags), arg("mode", mode), arg("paper_rule", paper_rule), arg("eps_v", p.eps_v),
-           arg("q_min", p.min_quality), arg("tets2quality", quality), arg("edges2dir", s.result.edges2dir), arg("edges2reason", s.result.edges2reason),
+           arg("q_min", p.min_quality), arg("field_eps", p.field_eps), arg("tets2quality", quality), arg("edges2dir", s.result.edges2dir), arg("edges2reason", s.result.edges2reason),
            arg("counters", s.cost.counters), arg("edges2verdict", s.carry.edges2verdict));
 }
 

@@ -27,6 +27,8 @@
 #define TCS_SEDGE(x, c, e) tcc_ring_sedge(s, (x), (c))
 #define TCS_POINT(v) tc_point(s.pts, (v))
 #define TCS_OLD_QUALITY(t, p0, p1, p2, p3) ((void)(t), tc_tet_quality(p0, p1, p2, p3))
+#define TCS_FIELD_EPS s.field_eps
+#define TCS_FIELD(v) s.field[size_t(v) * s.field_stride]
 #include "collapse_checks.h"  // the link and volume tests, the device's own
 
 namespace tc::sequential_detail {
@@ -78,7 +80,8 @@ bool SeqMesh::admissible(int32_t a, int32_t b, uint8_t fe, int dir) { return lin
 
 SeqStar SeqMesh::star() const {
   return {pool_.data(), roff_.data(), rlen_.data(), tets_->data(), nbr_.data(), labels_ ? labels_->data() : nullptr,
-          vflags_.data(), points_->data()};
+          vflags_.data(), points_->data(), p_.field_eps > 0 ? mesh_.vertex_fields[0].values.data() : nullptr,
+          p_.field_eps > 0 ? size_t(mesh_.vertex_fields[0].components) : 0, p_.field_eps};
 }
 
 // The link condition (a < b): cl/collapse_checks.h's, over the common neighbours gathered here

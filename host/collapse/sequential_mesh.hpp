@@ -62,6 +62,9 @@ struct SeqStar {
   const int32_t* labels;
   const uint8_t* vflags;
   const double* pts;
+  const double* field;  // the first vertex field (with field_eps > 0)
+  size_t field_stride;
+  double field_eps;
 };
 
 class SeqMesh {
@@ -341,6 +344,7 @@ class SeqMesh {
   geo::tc_d3 placement(int32_t a, int32_t b, unsigned dir) const;
 
   std::function<bool(int32_t, int32_t, geo::tc_d3*)> free_placement_;
+
   Mesh& mesh_;
   std::vector<double>* points_;
   std::vector<int32_t>* tets_;

@@ -39,6 +39,10 @@ struct CoarsenOptions {
   // collapse.max_field_error, while the field stays within that bound at every input vertex.
   std::string preserve_field;
   double field_tolerance = 0.02;
+  // With preserve_field and field_tolerance (beyond the paper): a collapse is also refused when
+  // the field at an end point's old place would change by more than field_check x
+  // field_tolerance x the range (CollapseOptions::field_check); 0: the paper's cost alone.
+  double field_check = 0.25;
   // A vertex field giving the wanted edge length: an edge is collapsed when shorter than the
   // field's mean at its ends.
   std::string sizing_field;

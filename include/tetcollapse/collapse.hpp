@@ -255,6 +255,12 @@ struct CollapseOptions {
   // required) are marked. Unlike the same cost as a cost_cl_source, the host tail and the
   // sequential method evaluate it too. Not with cost_cl_source.
   bool field_difference_cost = false;
+  // With field_difference_cost (beyond the paper): a collapse is also refused when an end point
+  // that moves would find, at its old place, the new piecewise linear field (the survivor's
+  // value interpolated along the edge) off its value by more than field_check x target_length.
+  // The edge-end difference is blind where the field bends (at a peak both ends are alike): this
+  // step's error is what flattens it. 0: the paper's cost alone.
+  double field_check = 0;
   // The paper's collapse for mesh improvement (Section 4.6), sequential method only: the cost of
   // an edge is minus the drop of the sum of the harmonic indices eta = (sum of the squared face
   // areas) / volume (Alexa 2019) over the tets the collapse reshapes, an edge whose collapse

@@ -237,6 +237,11 @@ TEST(FieldsCli, PreserveFieldCoarsensAndChecksTheField) {
   EXPECT_NE(log.find("field 'rho'"), std::string::npos) << log;
   EXPECT_EQ(run_command(std::string("'") + TC_CLI + "' '" + src + "' '" + out + "' --preserve-field nope", &log), 2);
   EXPECT_NE(log.find("nope"), std::string::npos) << log;
+  EXPECT_EQ(run_command(std::string("'") + TC_CLI + "' '" + src + "' '" + out +
+                            "' --preserve-field rho --max-field-error 0.01 --field-check 0.5",
+                        &log),
+            2);
+  EXPECT_NE(log.find("--field-check"), std::string::npos) << log;
 }
 
 Mesh with_bump(int n, unsigned seed) {
@@ -353,6 +358,68 @@ TEST(FieldCost, CollapsesWhereTheFieldIsFlatOnBothMethods) {
   bad.target_length = 0.01;
   bad.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return 0.0; }";
   EXPECT_THROW(collapse(m, bad, ctx), std::invalid_argument) << "two costs";
+}
+
+// The field check (CollapseOptions::field_check), the shared volume test's (cl/collapse_checks.h):
+// a linear field is interpolated exactly, so even a check of 1e-9 refuses nothing and both
+// methods give what they give without it, bit for bit.
+TEST(FieldCheck, RefusesNothingOnALinearField) {
+  Mesh in = jiggled(8, 23);
+  add_linear_field(in);
+  Context ctx;
+  for (auto method : {CollapseOptions::Sequential, CollapseOptions::Parallel})
+    for (auto boundary : {CollapseOptions::Features, CollapseOptions::Free}) {
+      CollapseOptions o;
+      o.method = method;
+      o.boundary = boundary;
+      o.field_difference_cost = true;
+      o.target_length = 0.5;
+      Mesh plain = in, checked = in;
+      collapse(plain, o, ctx);
+      o.field_check = 1e-9;
+      collapse(checked, o, ctx);
+      ASSERT_LT(plain.num_vertices(), in.num_vertices() / 2) << "it coarsens";
+      EXPECT_EQ(checked.tets, plain.tets);
+      EXPECT_EQ(checked.points, plain.points);
+    }
+}
+
+// A peak the edges' end differences do not see: every edge is marked (|1 - 0| below the
+// target), so the paper's cost alone removes the peak's vertex; the check keeps it where it was,
+// with its value, on both methods.
+TEST(FieldCheck, KeepsAPeakTheEdgeDifferenceMisses) {
+  Mesh in = jiggled(6, 29);
+  in.vertex_fields.push_back({"phi", 1, std::vector<double>(size_t(in.num_vertices()), 0.0)});
+  int64_t peak = -1;
+  double nearest = INFINITY;
+  for (int64_t v = 0; v < in.num_vertices(); ++v) {
+    const double* p = &in.points[3 * size_t(v)];
+    const double d = std::pow(p[0] - 0.5, 2) + std::pow(p[1] - 0.5, 2) + std::pow(p[2] - 0.5, 2);
+    if (d < nearest) nearest = d, peak = v;
+  }
+  in.vertex_fields[0].values[size_t(peak)] = 1.0;
+  const double* at = &in.points[3 * size_t(peak)];
+  auto kept = [&](const Mesh& m) {
+    for (int64_t v = 0; v < m.num_vertices(); ++v)
+      if (m.points[3 * size_t(v)] == at[0] && m.points[3 * size_t(v) + 1] == at[1] &&
+          m.points[3 * size_t(v) + 2] == at[2] && m.vertex_fields[0].values[size_t(v)] == 1.0)
+        return true;
+    return false;
+  };
+  Context ctx;
+  for (auto method : {CollapseOptions::Sequential, CollapseOptions::Parallel}) {
+    CollapseOptions o;
+    o.method = method;
+    o.field_difference_cost = true;
+    o.target_length = 2;
+    Mesh plain = in, checked = in;
+    collapse(plain, o, ctx);
+    EXPECT_FALSE(kept(plain)) << "the paper's cost alone flattens the peak";
+    o.field_check = 0.25;  // 0.5 in field units: any collapse at the peak moves it by more
+    collapse(checked, o, ctx);
+    EXPECT_TRUE(kept(checked));
+    EXPECT_LT(checked.num_vertices(), in.num_vertices() / 2) << "the rest coarsens";
+  }
 }
 
 TEST(FieldsCli, MaxFieldErrorBoundsTheNamedFieldAtTheInputVertices) {

@@ -76,6 +76,11 @@ class Module(unittest.TestCase):
         tol = tetcollapse.collapse(points, tets, vertex_fields={"rho": bump}, preserve_field="rho",
                                    field_tolerance=0.05)
         self.assertLess(tol["points"].shape[0], points.shape[0])
+        paper = tetcollapse.collapse(points, tets, vertex_fields={"rho": bump}, preserve_field="rho",
+                                     field_tolerance=0.05, field_check=0)
+        self.assertLessEqual(tol["points"].shape[0] - paper["points"].shape[0], points.shape[0] // 4,
+                             "the check refuses some collapses, not most")
+        self.assertGreaterEqual(tol["points"].shape[0], paper["points"].shape[0])
         with self.assertRaises(ValueError):
             tetcollapse.collapse(points, tets, vertex_fields={"rho": bump}, preserve_field="nope")
 
