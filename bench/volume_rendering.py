@@ -16,7 +16,7 @@ at T = 0.02 (the paper) in `features` and `free` modes, with `--field-check 0` (
 alone: "paper cost" rows) and `--average-fields` (the survivor's value the average of the edge's
 ends) as the befores, and the pocket's Gaussians over a sweep of T; and with the field error
 bound in place of T (`--max-field-error E`, E = 0.01: the "E" column). The robot (514k tets) in
-`features` mode only, without rendering.
+`features` mode only.
 Recorded per run: vertices and tets in and out, the tool's time without I/O, the volume kept,
 and `tetcollapse check OUT --reference IN`'s field error (largest and RMS difference of the two
 piecewise linear fields at every input vertex and 100,000 random points, as a share of the
@@ -177,8 +177,8 @@ def main():
                    "seconds": st["seconds_collapse"]}
             if t is None:
                 row["E"] = BOUND
-            if render and (t == 0.02 or t is None) and "robot" not in mesh:
-                tag = f"{field}_{mode}" + ("_bound" if t is None else "")
+            if render and (t == 0.02 or t is None):
+                tag = ("robot_" if "robot" in mesh else "") + f"{field}_{mode}" + ("_bound" if t is None else "")
                 m = render.compare(vtu, out, field, None if variant else os.path.join(a.images, f"{tag}.png"))
                 row.update(psnr=m["psnr"], ssim=m["ssim"])
             print(row)
