@@ -41,6 +41,7 @@ Settings make_settings(Options& o) {
   // tc::apply_field_options)
   if (!o.sizing_field.empty()) c.cost_cl_source = sizing_cost_source();
   c.field_difference_cost = !o.preserve_field.empty();
+  c.field_check = o.field_check;
   c.conflicts = cli::conflicts_mode(o.conflicts);
   c.method = cli::method_mode(o.method);
   if (o.priority_levels >= 0) c.tuning.priority_levels = o.priority_levels;
@@ -93,6 +94,7 @@ int run(Options& o, MPI_Comm comm) {
     // library's field cost reads the first vertex field), as tc::coarsen does
     CoarsenOptions fo;
     fo.preserve_field = o.preserve_field, fo.sizing_field = o.sizing_field, fo.field_tolerance = o.field_tolerance;
+    fo.field_check = o.field_check;
     try {
       field_front = apply_field_options(whole, fo, s.collapse);
     } catch (const std::invalid_argument& e) {

@@ -49,6 +49,11 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--field-tolerance", o.field_tolerance, "With --preserve-field: T (the paper's 0.02)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  app.add_option("--field-check", o.field_check,
+                 "With --preserve-field, as tetcollapse: also refuse a collapse that would change the field at an\n"
+                 "end point's old place by more than K x T x the range; 0: the paper's cost alone")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--sizing-field", o.sizing_field,
                  "As tetcollapse: a vertex field giving the wanted edge length; an edge is collapsed when\n"
                  "shorter than the field's mean at its ends");

@@ -8,6 +8,7 @@
 
 #include "cli/common.hpp"
 #include "cli/improve_cli.hpp"
+#include "tetcollapse/coarsen.hpp"
 
 namespace tc::mpi {
 
@@ -24,6 +25,7 @@ struct Options {
   std::string sizing_field, cost_cl, placement_cl, predicate_cl;
   std::string region, labels;  // only there (tetcollapse's --region, --labels)
   double field_tolerance = 0.02;
+  double field_check = CoarsenOptions{}.field_check;  // tetcollapse's --field-check
   double priority_levels = -1, host_tail = -1;  // -1: not given (the library's defaults)
   cli::ImproveCli improve;  // the improvement's options, as tetcollapse's
   bool eps_v_relative = false, no_labels = false, no_improve = false, quiet = false, check = false,

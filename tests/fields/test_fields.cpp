@@ -402,7 +402,7 @@ TEST(FieldCheck, KeepsAPeakTheEdgeDifferenceMisses) {
   auto kept = [&](const Mesh& m) {
     for (int64_t v = 0; v < m.num_vertices(); ++v)
       if (m.points[3 * size_t(v)] == at[0] && m.points[3 * size_t(v) + 1] == at[1] &&
-          m.points[3 * size_t(v) + 2] == at[2] && m.vertex_fields[0].values[size_t(v)] == 1.0)
+          m.points[3 * size_t(v) + 2] == at[2] && std::fabs(m.vertex_fields[0].values[size_t(v)] - 1.0) < 1e-12)
         return true;
     return false;
   };

@@ -155,7 +155,9 @@ TEST_P(MpiTool, PreserveFieldAsTetcollapse) {
   m.vertex_fields = {other, bump};
   tc::write_mesh(dir.file("in.vtu"), m);
   std::string log;
-  const std::string opts = " --preserve-field bump -q";
+  // (the paper's cost alone: the bump spans about one edge, and a small mesh's count moves with
+  // what the field check refuses by more than the band rounds' spread; the check has its test)
+  const std::string opts = " --preserve-field bump --field-check 0 -q";
   ASSERT_EQ(run_single(dir.file("in.vtu") + " " + dir.file("single.vtu") + opts, &log), 0) << log;
   ASSERT_EQ(run_mpi(GetParam(), dir.file("in.vtu") + " " + dir.file("mpi.vtu") + opts + " --check", &log), 0) << log;
   const Mesh single = tc::read_mesh(dir.file("single.vtu")), out = tc::read_mesh(dir.file("mpi.vtu"));
@@ -170,6 +172,67 @@ TEST_P(MpiTool, PreserveFieldAsTetcollapse) {
   EXPECT_EQ(run_mpi(GetParam(), dir.file("in.vtu") + " " + dir.file("x.vtu") + " --preserve-field none", &log), 2)
       << log;
   EXPECT_NE(log.find("no vertex field named 'none'"), std::string::npos) << log;
+}
+
+// --field-check on every rank, as tetcollapse: a field of single-vertex peaks (1 at interior
+// vertices far apart, 0 elsewhere) with every edge marked (T = 2): with the check every peak
+// keeps its place and value in whatever part it falls; the paper's cost alone flattens some.
+TEST_P(MpiTool, FieldCheckKeepsThePeaksOnEveryRank) {
+  TempDir dir;
+  Mesh m = tc::read_mesh(tc::test::project_mesh("bracket.msh"));
+  m.vertex_fields.clear();
+  std::map<std::array<int32_t, 3>, int> faces;
+  for (int64_t t = 0; t < m.num_tets(); ++t)
+    for (int f = 0; f < 4; ++f) {
+      std::array<int32_t, 3> k;
+      for (int j = 0, n = 0; j < 4; ++j)
+        if (j != f) k[size_t(n++)] = m.tets[size_t(4 * t + j)];
+      std::sort(k.begin(), k.end());
+      ++faces[k];
+    }
+  std::vector<uint8_t> on_boundary(size_t(m.num_vertices()), 0);
+  for (const auto& [k, n] : faces)
+    if (n == 1)
+      for (int32_t v : k) on_boundary[size_t(v)] = 1;
+  tc::Field peaks{"peaks", 1, std::vector<double>(size_t(m.num_vertices()), 0.0)};
+  std::vector<int64_t> at;
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    if (on_boundary[size_t(v)]) continue;
+    bool far = true;
+    for (int64_t u : at) {
+      double d2 = 0;
+      for (int k = 0; k < 3; ++k) d2 += std::pow(m.points[size_t(3 * v + k)] - m.points[size_t(3 * u + k)], 2);
+      far = far && d2 > 0.6 * 0.6;
+    }
+    if (far) at.push_back(v), peaks.values[size_t(v)] = 1.0;
+  }
+  ASSERT_GE(at.size(), 6u);
+  m.vertex_fields = {peaks};
+  tc::write_mesh(dir.file("in.vtu"), m);
+  auto kept = [&](const Mesh& out) {
+    size_t n = 0;
+    for (int64_t v : at)
+      for (int64_t w = 0; w < out.num_vertices(); ++w)
+        if (out.points[size_t(3 * w)] == m.points[size_t(3 * v)] &&
+            out.points[size_t(3 * w + 1)] == m.points[size_t(3 * v + 1)] &&
+            out.points[size_t(3 * w + 2)] == m.points[size_t(3 * v + 2)] &&
+            std::fabs(out.vertex_fields[0].values[size_t(w)] - 1.0) < 1e-12) {  // (resampled at its place)
+          ++n;
+          break;
+        }
+    return n;
+  };
+  std::string log;
+  const std::string opts = " --preserve-field peaks --field-tolerance 2 --no-improve -q";
+  ASSERT_EQ(run_mpi(GetParam(), dir.file("in.vtu") + " " + dir.file("mpi.vtu") + opts, &log), 0) << log;
+  ASSERT_EQ(run_single(dir.file("in.vtu") + " " + dir.file("single.vtu") + opts, &log), 0) << log;
+  const Mesh out = tc::read_mesh(dir.file("mpi.vtu")), single = tc::read_mesh(dir.file("single.vtu"));
+  EXPECT_LT(out.num_tets(), m.num_tets() / 2) << "the rest coarsens";
+  EXPECT_EQ(kept(single), at.size());
+  EXPECT_EQ(kept(out), at.size()) << GetParam() << " ranks";
+  ASSERT_EQ(run_mpi(GetParam(), dir.file("in.vtu") + " " + dir.file("paper.vtu") + opts + " --field-check 0", &log), 0)
+      << log;
+  EXPECT_LT(kept(tc::read_mesh(dir.file("paper.vtu"))), at.size()) << "without the check peaks go";
 }
 
 // The user's OpenCL C and the sizing field, as tetcollapse: a predicate refusing every collapse
