@@ -394,6 +394,10 @@ bool SequentialRun::step() {
       eps_.resize(kept_.size());
     }
     for (int32_t& x : origin_) x = vmap_[x];
+    if (!source_.empty()) {
+      for (size_t i = 0; i < kept_.size(); ++i) source_[i] = source_[kept_[i]];
+      source_.resize(kept_.size());
+    }
     for (int32_t& x : refused_) x = vmap_[x];  // their end points are alive (above)
   }
   const double t4 = seconds_since(t0);
@@ -413,6 +417,14 @@ bool SequentialRun::step() {
   // nearby may have moved since): only then another iteration.
   if (greedy_ && guard_refusals == 0) done_ = true;
   return !done_;
+}
+
+void SequentialRun::keep_origin() {
+  if (it_ > 0) throw std::logic_error("SequentialRun::keep_origin: after the first step");
+  const size_t n = size_t(mesh_.num_vertices());
+  origin_.resize(n);
+  source_.resize(n);
+  for (size_t i = 0; i < n; ++i) origin_[i] = source_[i] = int32_t(i);
 }
 
 CollapseReport SequentialRun::finish() {

@@ -98,6 +98,13 @@ class SequentialRun {
   // iteration, which the next one lists (alone).
   const std::vector<int32_t>& guard_refused() const { return refused_; }
   double target() const { return target_; }
+  // origin(): where each vertex of the mesh the run was given is now, its index or its
+  // survivor's when a collapse removed it (mesh.tris and mesh.edges are remapped through it);
+  // source(): which vertex of that mesh each vertex now is. keep_origin(), before the first
+  // step, keeps both (origin is kept anyway for a mesh with triangles or edges).
+  void keep_origin();
+  const std::vector<int32_t>& origin() const { return origin_; }
+  const std::vector<int32_t>& source() const { return source_; }
 
  private:
   // The edge's cost: its length, or CollapseOptions::field_difference_cost's |f0 - f1| (the
@@ -156,6 +163,7 @@ class SequentialRun {
   std::unique_ptr<FieldBound> field_;  // the field error bound (null: none)
   std::vector<int32_t> tmap_;
   std::vector<int32_t> origin_;    // input vertex -> current vertex (only with tris or edges)
+  std::vector<int32_t> source_;    // current vertex -> input vertex (keep_origin)
   std::vector<uint32_t> touched_;  // per vertex: 1 + the last iteration that touched its star (0: none)
   std::vector<QueueEntry> edges_, heap_;
   std::vector<int32_t> seed_edges_;  // TailSeed::edges, for the first iteration (then cleared)

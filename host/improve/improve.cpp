@@ -5,7 +5,9 @@
 #include <cmath>
 
 #include "collapse/programs.hpp"
+#include "collapse/sequential_run.hpp"
 #include "improve/improve_mesh.hpp"
+#include "improve/star_mesh.hpp"
 #include "stopwatch.hpp"
 
 namespace tc {
@@ -132,7 +134,8 @@ void passes(Mesh& mesh, const ImproveOptions& options, Context* ctx, int max_pas
 // The collapse step: edges between vertices of tets below 13 degrees, by the harmonic index's
 // drop (CollapseOptions::harmonic_cost) or the shortest first. On the CPU even with a
 // device: a few hundred edges, where the parallel method takes as long (it uploads and connects
-// the whole mesh) and its order of collapses left more bad tets on W1.
+// the whole mesh) and its order of collapses left more bad tets on W1. On the star mesh of
+// those vertices (star_mesh), spliced back: the same collapses as on the whole mesh.
 int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options, bool harmonic) {
   std::vector<uint8_t> mask(size_t(mesh.num_vertices()), 0);
   int64_t bad = 0;
@@ -156,12 +159,22 @@ int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options, bool harmonic) {
   // (with 1, the guard at its strictest, a short edge's slivers were never collapsed); the
   // dihedral figures are checked after the step.
   o.min_quality = 0.3;
-  o.target_length = options.collapse_length > 0 ? options.collapse_length : 1.5 * median_edge_length(mesh);
+  // (the harmonic cost marks by the sum's drop, not by a length: no median needed)
+  o.target_length = options.collapse_length > 0 ? options.collapse_length
+                    : harmonic                  ? 1.0
+                                                : 1.5 * median_edge_length(mesh);
   o.harmonic_cost = harmonic;
-  o.vertex_mask = std::move(mask);
   if (options.boundary == CollapseOptions::Features) o.max_boundary_error_abs = options.max_boundary_error_abs;
+  StarMesh star = star_mesh(mesh, mask);
+  o.vertex_mask.resize(star.verts.size());
+  for (size_t i = 0; i < star.verts.size(); ++i) o.vertex_mask[i] = mask[size_t(star.verts[i])];
+  sequential_detail::SequentialRun run(star.mesh, o);
+  run.keep_origin();
+  while (run.step()) {
+  }
   int64_t collapsed = 0;
-  for (const IterationStats& it : collapse_sequential(mesh, o).iterations) collapsed += it.collapsed;
+  for (const IterationStats& it : run.finish().iterations) collapsed += it.collapsed;
+  if (collapsed > 0) splice(mesh, star, run);
   return collapsed;
 }
 

@@ -9,6 +9,7 @@
 
 #include "geometry.h"
 #include "improve/improve_mesh.hpp"
+#include "improve/star_mesh.hpp"
 #include "test_support.hpp"
 #include "tetcollapse/check.hpp"
 #include "tetcollapse/collapse.hpp"
@@ -543,6 +544,68 @@ TEST(ImprovePhase, SharedMeshesCoarsenedAndImprovedAreValid) {
     EXPECT_TRUE(cr.valid) << path << "\n" << check_report_text(cr);
   }
   EXPECT_GT(tried, 2);
+}
+
+// The collapse step on the stars of its vertices (improve/star_mesh.hpp) leaves the whole mesh
+// as the sequential method run on the whole mesh with the same vertex mask does, bit for bit:
+// points, tets in order, labels, vertex and tet fields, tagged triangles; a two-material mesh
+// with the bracket's curved boundary, the harmonic and the shortest-edge costs, with and
+// without a boundary error bound; the vertices of the worst tets masked, as the step does.
+TEST(StarMesh, TheStepOnTheStarsIsTheStepOnTheWholeMesh) {
+  Mesh whole = two_material_bracket();
+  whole.vertex_fields.push_back({"x", 1, {}});
+  for (int64_t v = 0; v < whole.num_vertices(); ++v) whole.vertex_fields[0].values.push_back(whole.points[size_t(3 * v)]);
+  whole.tet_fields.push_back({"t", 1, {}});
+  for (int64_t t = 0; t < whole.num_tets(); ++t) whole.tet_fields[0].values.push_back(double(t));
+  // tagged triangles: a face of each of the first thousand tets
+  for (int64_t t = 0; t < std::min<int64_t>(whole.num_tets(), 1000); ++t)
+    whole.tris.insert(whole.tris.end(), &whole.tets[size_t(4 * t)], &whole.tets[size_t(4 * t + 3)]),
+        whole.tri_tags.push_back(int32_t(t % 3));
+  std::vector<std::pair<double, int64_t>> worst;
+  for (int64_t t = 0; t < whole.num_tets(); ++t) {
+    geo::tc_d3 p[4];
+    for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(whole.points.data(), whole.tets[size_t(4 * t + k)]);
+    worst.push_back({-geo::tc_tet_max_dihedral_cos(p[0], p[1], p[2], p[3]), t});
+  }
+  std::sort(worst.begin(), worst.end());
+  std::vector<uint8_t> mask(size_t(whole.num_vertices()), 0);
+  for (size_t i = 0; i < worst.size() / 10; ++i)
+    for (int k = 0; k < 4; ++k) mask[size_t(whole.tets[size_t(4 * worst[i].second + k)])] = 1;
+  for (bool harmonic : {true, false})
+    for (double bound : {0.0, 0.01}) {
+      CollapseOptions o;
+      o.method = CollapseOptions::Sequential;
+      o.min_quality = 0.3;
+      o.target_length = 1.5 * median_edge_length(whole);
+      o.harmonic_cost = harmonic;
+      o.max_boundary_error_abs = bound;
+      Mesh ref = whole;
+      o.vertex_mask = mask;
+      const CollapseReport r = collapse_sequential(ref, o);
+      int64_t collapsed = 0;
+      for (const IterationStats& it : r.iterations) collapsed += it.collapsed;
+      ASSERT_GT(collapsed, 20) << "the step collapses";
+      improve_detail::StarMesh star = improve_detail::star_mesh(whole, mask);
+      ASSERT_LT(star.mesh.num_tets(), whole.num_tets());
+      o.vertex_mask.assign(star.verts.size(), 0);
+      for (size_t i = 0; i < star.verts.size(); ++i) o.vertex_mask[i] = mask[size_t(star.verts[i])];
+      sequential_detail::SequentialRun run(star.mesh, o);
+      run.keep_origin();
+      while (run.step()) {
+      }
+      run.finish();
+      Mesh out = whole;
+      improve_detail::splice(out, star, run);
+      const std::string what = std::string(harmonic ? "harmonic" : "shortest") + (bound > 0 ? ", bounded" : "");
+      EXPECT_EQ(out.points, ref.points) << what;
+      EXPECT_EQ(out.tets, ref.tets) << what;
+      ASSERT_EQ(out.tet_labels.size(), 1u);
+      EXPECT_EQ(out.tet_labels[0].values, ref.tet_labels[0].values) << what;
+      EXPECT_EQ(out.vertex_fields[0].values, ref.vertex_fields[0].values) << what;
+      EXPECT_EQ(out.tet_fields[0].values, ref.tet_fields[0].values) << what;
+      EXPECT_EQ(out.tris, ref.tris) << what;
+      EXPECT_EQ(out.tri_tags, ref.tri_tags) << what;
+    }
 }
 
 }  // namespace
