@@ -113,6 +113,12 @@ void add_options(CLI::App& app, Options& o) {
                  "higher keeps the next cut further from the last")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000000));
+  app.add_option("--partition-nodes", o.partition_nodes,
+                 "A mesh of more tets is cut by METIS as about N clusters of nearby tets (cells of a grid),\n"
+                 "each weighted by its tets, instead of tet by tet: METIS's time and memory on rank 0 grow\n"
+                 "with its graph")
+      ->capture_default_str()
+      ->check(CLI::Range(int64_t(1), int64_t(1) << 30));
   app.add_option("--device", o.device,
                  "OpenCL device of every rank: index or name substring (see 'tetcollapse devices');\n"
                  "default: $TETCOLLAPSE_DEVICE, else the first GPU, else the first CPU");

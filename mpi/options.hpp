@@ -8,6 +8,7 @@
 
 #include "cli/common.hpp"
 #include "cli/improve_cli.hpp"
+#include "partition.hpp"
 #include "tetcollapse/coarsen.hpp"
 
 namespace tc::mpi {
@@ -33,6 +34,7 @@ struct Options {
   int max_rounds = 5;
   double round_threshold = 0.01;
   int seed = 1, avoid_weight = 50, rings = 2;
+  int64_t partition_nodes = PartitionOptions{}.max_graph_nodes;
   cli::InputOptions input;
   cli::OutputOptions output;
 };

@@ -22,6 +22,8 @@ struct PartitionOptions {
   // Faces with a vertex in `avoid` (the vertices frozen in the round before) weigh this much in
   // the cut, other faces 1, so that METIS cuts elsewhere and the old interface is coarsened.
   int avoid_weight = 50;
+  // Meshes of more tets are cut as clusters of tets, at most about this many (partition.cpp).
+  int64_t max_graph_nodes = 1 << 20;
 };
 
 // One part index per tet, in [0, nparts). Throws std::runtime_error when METIS fails.

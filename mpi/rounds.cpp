@@ -32,6 +32,7 @@ int run_round(Phase phase, Round& st, const Settings& s, const Options& o, LazyD
     if (rank != 0) return;
     PartitionOptions po;
     po.nparts = nranks, po.seed = o.seed + st.number - 1, po.avoid_weight = o.avoid_weight;
+    po.max_graph_nodes = o.partition_nodes;
     tet_part = partition_tets(st.whole, po, st.band);
   });
   if ((code = agree(code, comm))) return code;

@@ -92,6 +92,20 @@ TEST_P(MpiTool, ValidAndWithinFivePercentOfSingleDevice) {
     const double ratio = double(out.num_tets()) / double(single.num_tets());
     EXPECT_NEAR(ratio, 1.0, 0.05) << name << ": " << out.num_tets() << " tets with " << ranks << " ranks, "
                                   << single.num_tets() << " with tetcollapse";
+    // METIS cutting clusters of about ten tets (as it does past --partition-nodes tets, by
+    // default on meshes of ten million): the same criteria, and another cut
+    const std::string nodes = std::to_string(input.num_tets() / 10);
+    ASSERT_EQ(run_mpi(ranks, in + " " + dir.file("clusters.msh") + " --target-factor 2 -q --partition-nodes " + nodes, &log),
+              0)
+        << log;
+    const Mesh clustered = tc::read_mesh(dir.file("clusters.msh"));
+    const tc::CheckReport rc = tc::check_mesh(clustered, co, &input);
+    EXPECT_TRUE(rc.valid) << name << ", clusters\n" << tc::check_report_text(rc);
+    EXPECT_FALSE(rc.reference.topology_changed) << name << ", clusters";
+    EXPECT_NEAR(double(clustered.num_tets()) / double(single.num_tets()), 1.0, 0.05)
+        << name << ": " << clustered.num_tets() << " tets with " << ranks << " ranks cutting clusters, "
+        << single.num_tets() << " with tetcollapse";
+    EXPECT_NE(clustered.tets, out.tets) << name << ": the clusters cut elsewhere";
   }
   if (tested == 0) GTEST_SKIP() << "../shared/meshes (ipc_hammer.msh, gen_gmsh_wrenchnut_27k.msh) not present";
 }
@@ -337,11 +351,13 @@ TEST_P(MpiTool, SameOutputTwice) {
   TempDir dir;
   const std::string in = tc::test::project_mesh("bracket.msh");
   std::string log;
-  for (const char* out : {"a.msh", "b.msh"})
-    ASSERT_EQ(run_mpi(GetParam(), in + " " + dir.file(out) + " --target-factor 2 -q", &log), 0) << log;
-  const std::string a = tc::test::read_text(dir.file("a.msh")), b = tc::test::read_text(dir.file("b.msh"));
-  EXPECT_GT(a.size(), 1000u);
-  EXPECT_TRUE(a == b) << "two runs with " << GetParam() << " ranks differ";
+  for (const char* nodes : {"", " --partition-nodes 2000"}) {  // (2000: METIS cuts clusters of tets)
+    for (const char* out : {"a.msh", "b.msh"})
+      ASSERT_EQ(run_mpi(GetParam(), in + " " + dir.file(out) + " --target-factor 2 -q" + nodes, &log), 0) << log;
+    const std::string a = tc::test::read_text(dir.file("a.msh")), b = tc::test::read_text(dir.file("b.msh"));
+    EXPECT_GT(a.size(), 1000u);
+    EXPECT_TRUE(a == b) << "two runs with " << GetParam() << " ranks differ" << nodes;
+  }
 }
 
 // --stats: every round with its phase, every rank's tets, seconds and peak memory; the rounds
