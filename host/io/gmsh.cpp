@@ -222,6 +222,7 @@ class AsciiSource {
   AsciiSource(std::string_view text, const std::string& file, size_t start) : c_(text, file), file_(file) {
     c_.set_pos(start);
   }
+  void release_through(io::FileBytes* f) { c_.release_through(f); }
   int64_t integer() { return c_.next_int(); }
   int64_t size() {
     int64_t v = c_.next_int();
@@ -268,6 +269,14 @@ class BinarySource {
   BinarySource(std::string_view data, const std::string& file, size_t start, bool swap, int data_size)
       : c_(data, file, swap), ds_(data_size) {
     c_.set_pos(start);
+  }
+  void release_through(io::FileBytes* f) {
+    c_.release_through(f);
+    file_ = f;
+  }
+  // Within a block decoded in place (take): the bytes before pos are done with.
+  void done_before(size_t pos) {
+    if (file_) file_->done_before(pos);
   }
   int64_t integer() {
     last_ = c_.pos();
@@ -337,6 +346,7 @@ class BinarySource {
   BinaryCursor c_;
   int ds_;
   size_t last_ = 0;
+  io::FileBytes* file_ = nullptr;
 };
 
 // ---------------------------------------------------------------- tag -> index maps
@@ -676,6 +686,7 @@ void read_elements_41(Src& s, ReaderState& st, int ds) {
       const char* p = s.take(static_cast<size_t>(count) * rec);
       for (int64_t i = 0; i < count; ++i) {
         const char* r = p + static_cast<size_t>(i) * rec;
+        s.done_before(start + static_cast<size_t>(i) * rec);
         const int64_t elem_tag = static_cast<int64_t>(s.decode_size(r));
         for (int k = 0; k < info.nodes; ++k) {
           const uint64_t tag = s.decode_size(r + static_cast<size_t>(1 + k) * ds);
@@ -932,7 +943,8 @@ void finish(ReaderState& st) {
 }  // namespace
 
 Mesh read_gmsh(const std::string& path, ReadNotes& notes) {
-  const std::string data = io::load_file(path);
+  io::FileBytes file(path);
+  const std::string_view data = file.view();
   const MshFormat f = read_format(data, path);
   ReaderState st;
   st.file = path;
@@ -940,9 +952,11 @@ Mesh read_gmsh(const std::string& path, ReadNotes& notes) {
   st.notes = &notes;
   if (f.binary) {
     BinarySource s(data, path, f.body, f.swap, f.data_size);
+    s.release_through(&file);
     read_sections(s, st, f.data_size);
   } else {
     AsciiSource s(data, path, f.body);
+    s.release_through(&file);
     read_sections(s, st, 8);
   }
   finish(st);

@@ -9,6 +9,9 @@
 #include <filesystem>
 #include <random>
 #include <system_error>
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace tc::io {
@@ -27,9 +30,54 @@ std::string load_file(const std::string& path) {
   return data;
 }
 
+// ---------------------------------------------------------------- FileBytes
+
+namespace {
+size_t file_bytes_step = size_t(16) << 20;
+}  // namespace
+
+void FileBytes::set_step(size_t step) { file_bytes_step = std::max<size_t>(step, 1); }
+
+FileBytes::FileBytes(const std::string& path) : step_(file_bytes_step), next_(file_bytes_step) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a directory, not a mesh file");
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  struct stat st {};
+  if (fd >= 0 && ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0) {
+    void* p = ::mmap(nullptr, size_t(st.st_size), PROT_READ, MAP_PRIVATE, fd, 0);
+    if (p != MAP_FAILED) {
+      map_ = p;
+      size_ = size_t(st.st_size);
+      ::madvise(map_, size_, MADV_SEQUENTIAL);
+      view_ = std::string_view(static_cast<const char*>(map_), size_);
+    }
+  }
+  if (fd >= 0) ::close(fd);
+  if (!map_) {  // empty, not a regular file, or not mappable: read as before
+    owned_ = load_file(path);
+    view_ = owned_;
+  }
+}
+
+FileBytes::~FileBytes() {
+  if (map_) ::munmap(map_, size_);
+}
+
+void FileBytes::release(size_t pos) {
+  next_ = pos + step_;
+  if (!map_) return;
+  // whole pages, a step behind (a reader may look back a little: it would only read again)
+  const size_t page = size_t(::sysconf(_SC_PAGESIZE));
+  const size_t end = pos > step_ ? (pos - step_) / page * page : 0;
+  if (end <= released_) return;
+  ::madvise(static_cast<char*>(map_) + released_, end - released_, MADV_DONTNEED);
+  released_ = end;
+}
+
 // ---------------------------------------------------------------- TextCursor
 
 void TextCursor::skip_space() {
+  if (release_) release_->done_before(pos_);
   while (pos_ < text_.size()) {
     char c = text_[pos_];
     if (c == '\n') {

@@ -22,6 +22,34 @@ namespace tc::io {
 // Whole file in memory. Throws InputError when it cannot be opened.
 std::string load_file(const std::string& path);
 
+// A file's bytes, mapped read-only (read into memory where it cannot be mapped), which a reader
+// gives back behind itself as it goes (the cursors' release_through): the pages before where it
+// is are dropped from the process (looked at again, they are read from the file again), so a
+// reader's peak memory is the mesh it builds and a window of the file, not the whole file.
+// Throws InputError as load_file.
+class FileBytes {
+ public:
+  explicit FileBytes(const std::string& path);
+  ~FileBytes();
+  FileBytes(const FileBytes&) = delete;
+  FileBytes& operator=(const FileBytes&) = delete;
+  std::string_view view() const { return view_; }
+  // The reader is done with the bytes before `pos` (a hint): every `step` bytes, the pages more
+  // than a step behind are given back.
+  void done_before(size_t pos) {
+    if (pos >= next_) release(pos);
+  }
+  // The step of the files opened after (tests make it small); 16 MB.
+  static void set_step(size_t step);
+
+ private:
+  void release(size_t pos);
+  std::string owned_;
+  void* map_ = nullptr;
+  size_t size_ = 0, released_ = 0, step_ = 0, next_ = 0;
+  std::string_view view_;
+};
+
 // Reads whitespace-separated tokens while tracking the line number, for error messages.
 class TextCursor {
  public:
@@ -46,6 +74,8 @@ class TextCursor {
   const std::string& file() const { return file_; }
 
   [[noreturn]] void fail(const std::string& reason) const { throw InputError(file_, line_, reason); }
+  // Gives the pages of `f` (whose view this cursor reads) back behind the cursor as it goes.
+  void release_through(FileBytes* f) { release_ = f; }
 
   // Upper bound for a count of items that each take at least `min_chars` characters.
   int64_t max_items(int64_t min_chars) const {
@@ -58,6 +88,7 @@ class TextCursor {
   std::string file_;
   size_t pos_ = 0;
   int64_t line_ = 1;
+  FileBytes* release_ = nullptr;
 };
 
 // Reads binary data with bounds checks; errors name the byte offset.
@@ -73,8 +104,11 @@ class BinaryCursor {
     std::memcpy(&v, data_.data() + pos_, sizeof(T));
     pos_ += sizeof(T);
     if (swap_) v = byteswap_value(v);
+    if (release_) release_->done_before(pos_);
     return v;
   }
+  // Gives the pages of `f` (whose view this cursor reads) back behind the cursor as it goes.
+  void release_through(FileBytes* f) { release_ = f; }
   // Reads n items into out (resized), checked against the bytes left.
   template <class T>
   void get_array(std::vector<T>& out, int64_t n) {
@@ -83,6 +117,7 @@ class BinaryCursor {
     out.resize(static_cast<size_t>(n));
     if (n) std::memcpy(out.data(), data_.data() + pos_, static_cast<size_t>(n) * sizeof(T));
     pos_ += static_cast<size_t>(n) * sizeof(T);
+    if (release_) release_->done_before(pos_);
     if (swap_)
       for (auto& v : out) v = byteswap_value(v);
   }
@@ -117,6 +152,7 @@ class BinaryCursor {
   std::string file_;
   size_t pos_ = 0;
   bool swap_ = false;
+  FileBytes* release_ = nullptr;
 };
 
 // The format write_mesh writes `path` in: f, or when Auto the one its extension names (an

@@ -4,8 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <random>
 #include <string>
@@ -733,6 +735,76 @@ TEST(GmshMeshio, SeesTheSamePointsAndTets) {
                          tc::io::format_double(m.vertex_fields[0].values[7]);
     EXPECT_NE(out.find(expect), std::string::npos) << "meshio printed: " << out << "expected: " << expect;
   }
+}
+
+}  // namespace
+
+namespace {
+
+// The resident kB of the mapping holding `p` (/proc/self/smaps), -1 when not found.
+long mapping_rss_kb(const void* p) {
+  std::ifstream in("/proc/self/smaps");
+  std::string line;
+  bool inside = false;
+  while (std::getline(in, line)) {
+    unsigned long lo = 0, hi = 0;
+    if (std::sscanf(line.c_str(), "%lx-%lx ", &lo, &hi) == 2) {  // a mapping's first line
+      inside = lo <= reinterpret_cast<uintptr_t>(p) && reinterpret_cast<uintptr_t>(p) < hi;
+      continue;
+    }
+    long kb = 0;
+    if (inside && std::sscanf(line.c_str(), "Rss: %ld kB", &kb) == 1) return kb;
+  }
+  return -1;
+}
+
+// The readers give back the file's pages behind them (io::FileBytes): with a step of a few pages
+// every gmsh variant reads the same mesh as with the default step, and bytes given back are read
+// again from the file when looked at.
+TEST(FileBytes, PagesGivenBackAreReadAgainAndTheMeshIsTheSame) {
+  tc::test::TempDir dir;
+  tc::Mesh m = tc::make_cube_mesh(14);  // 16k tets: a few hundred kB
+  m.tet_labels.push_back({"gmsh:physical", std::vector<int32_t>(size_t(m.num_tets()), 3)});
+  for (int version : {22, 41})
+    for (bool binary : {true, false}) {
+      tc::WriteOptions w;
+      w.binary = binary;
+      w.gmsh_version = version;
+      const std::string path = dir.file("m" + std::to_string(version) + (binary ? "b" : "a") + ".msh");
+      tc::write_mesh(path, m, w);
+      const tc::Mesh whole = tc::read_mesh(path);
+      tc::io::FileBytes::set_step(4096);
+      const tc::Mesh stepped = tc::read_mesh(path);
+      tc::io::FileBytes::set_step(size_t(16) << 20);
+      EXPECT_EQ(stepped.points, whole.points) << path;
+      EXPECT_EQ(stepped.tets, whole.tets) << path;
+      EXPECT_EQ(stepped.tets, m.tets) << path;
+      ASSERT_EQ(stepped.tet_labels.size(), whole.tet_labels.size()) << path;
+      EXPECT_EQ(stepped.tet_labels[0].values, whole.tet_labels[0].values) << path;
+    }
+  // the bytes themselves
+  const std::string path = dir.file("bytes.bin");
+  std::string text(size_t(1) << 20, '\0');
+  for (size_t i = 0; i < text.size(); ++i) text[i] = char(i * 2654435761u >> 24);
+  tc::test::write_text(path, text);
+  tc::io::FileBytes::set_step(4096);
+  tc::io::FileBytes f(path);
+  tc::io::FileBytes::set_step(size_t(16) << 20);
+  ASSERT_EQ(f.view().size(), text.size());
+  tc::io::BinaryCursor c(f.view(), path);
+  c.release_through(&f);
+  uint64_t sum = 0, expected = 0;
+  while (c.remaining() >= 8) sum += c.get<uint64_t>();
+  for (size_t i = 0; i + 8 <= text.size(); i += 8) {
+    uint64_t v;
+    std::memcpy(&v, text.data() + i, 8);
+    expected += v;
+  }
+  EXPECT_EQ(sum, expected);
+  const long rss = mapping_rss_kb(f.view().data());
+  EXPECT_GE(rss, 0) << "no mapping found";
+  EXPECT_LE(rss, 64) << "kB of the 1 MB file still held after reading it through";
+  EXPECT_TRUE(f.view() == std::string_view(text)) << "the pages given back read the same";
 }
 
 }  // namespace
