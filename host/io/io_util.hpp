@@ -26,7 +26,8 @@ std::string load_file(const std::string& path);
 // gives back behind itself as it goes (the cursors' release_through): the pages before where it
 // is are dropped from the process (looked at again, they are read from the file again), so a
 // reader's peak memory is the mesh it builds and a window of the file, not the whole file.
-// Throws InputError as load_file.
+// Throws InputError as load_file. (As with any mapped reading, a file cut short by another
+// process while it is read ends the process with SIGBUS; load_file's copy did not have this.)
 class FileBytes {
  public:
   explicit FileBytes(const std::string& path);
