@@ -68,7 +68,9 @@ void FileBytes::release(size_t pos) {
   if (!map_) return;
   // whole pages, a step behind (a reader may look back a little: it would only read again)
   const size_t page = size_t(::sysconf(_SC_PAGESIZE));
-  const size_t end = pos > step_ ? (pos - step_) / page * page : 0;
+  // never past the mapping's last page: what lies beyond is another mapping's (madvise would
+  // drop its pages too, a library's relocated data among them)
+  const size_t end = std::min(pos > step_ ? (pos - step_) / page * page : 0, (size_ + page - 1) / page * page);
   if (end <= released_) return;
   ::madvise(static_cast<char*>(map_) + released_, end - released_, MADV_DONTNEED);
   released_ = end;

@@ -40,6 +40,10 @@ class FileBytes {
   void done_before(size_t pos) {
     if (pos >= next_) release(pos);
   }
+  // The reader is done with all of it (e.g. it copied it).
+  void done() { release(size_ + 2 * step_); }
+  // The reader starts again from the beginning (after a scan that gave the pages back).
+  void rewind() { released_ = 0, next_ = step_; }
   // The step of the files opened after (tests make it small); 16 MB.
   static void set_step(size_t step);
 

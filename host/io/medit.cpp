@@ -434,9 +434,10 @@ class BinaryReader {
   int ver_ = 0;
 };
 
-Mesh read_meshb(std::string_view data, const std::string& file, ReadNotes& notes) {
+Mesh read_meshb(std::string_view data, const std::string& file, ReadNotes& notes, io::FileBytes* bytes) {
   BinaryReader r(data, file);
   BinaryCursor& b = r.cursor();
+  if (bytes) b.release_through(bytes);
   Mesh m;
   int64_t nv = -1, nonzero_refs = 0;
   std::vector<Pending> pending;
@@ -523,9 +524,11 @@ Mesh read_meshb(std::string_view data, const std::string& file, ReadNotes& notes
   return m;
 }
 
-void read_solb(std::string_view data, const std::string& file, int64_t nv, int64_t nt, Mesh& m, ReadNotes& notes) {
+void read_solb(std::string_view data, const std::string& file, int64_t nv, int64_t nt, Mesh& m, ReadNotes& notes,
+               io::FileBytes* bytes) {
   BinaryReader r(data, file);
   BinaryCursor& b = r.cursor();
+  if (bytes) b.release_through(bytes);
   int field_index = 0;
   r.for_each_keyword([&](int code, const Keyword* k, int64_t n, size_t at) {
     if (code == kDimension) {
@@ -787,16 +790,26 @@ uint64_t binary_size_estimate(const Mesh& m) {
 
 // ------------------------------------------------------------------------------ entry points
 
+// The text of `file` without its comments, and a cursor over it that gives the file's pages back
+// behind itself (blank_comments' copy, when it makes one, has taken them all).
+TextCursor text_cursor(io::FileBytes& file, const std::string& path, std::string& storage) {
+  TextCursor c(io::blank_comments(file.view(), storage, &file), path);
+  if (storage.empty()) c.release_through(&file);
+  else file.done();
+  return c;
+}
+
 Mesh read_medit(const std::string& path, ReadNotes& notes, bool read_sol) {
-  const std::string data = io::load_file(path);
+  io::FileBytes file(path);
+  const std::string_view data = file.view();
   if (data.empty()) throw InputError(path, "empty file");
   const bool binary = looks_binary(data);
   Mesh m;
   if (binary) {
-    m = read_meshb(data, path, notes);
+    m = read_meshb(data, path, notes, &file);
   } else {
     std::string storage;
-    TextCursor c(io::blank_comments(data, storage), path);
+    TextCursor c = text_cursor(file, path, storage);
     AsciiReader r(c, notes);
     m = r.read();
   }
@@ -814,13 +827,14 @@ Mesh read_medit(const std::string& path, ReadNotes& notes, bool read_sol) {
     }
   }
   if (sol.empty()) return m;
-  const std::string sdata = io::load_file(sol);
+  io::FileBytes sfile(sol);
+  const std::string_view sdata = sfile.view();
   if (sdata.empty()) throw InputError(sol, "empty solution file");
   if (looks_binary(sdata)) {
-    read_solb(sdata, sol, m.num_vertices(), m.num_tets(), m, notes);
+    read_solb(sdata, sol, m.num_vertices(), m.num_tets(), m, notes, &sfile);
   } else {
     std::string storage;
-    TextCursor c(io::blank_comments(sdata, storage), sol);
+    TextCursor c = text_cursor(sfile, sol, storage);
     read_sol_ascii(c, m.num_vertices(), m.num_tets(), m, notes);
   }
   notes.notes.push_back("read " + plural(static_cast<int64_t>(m.vertex_fields.size()), "vertex fields") + " and " +

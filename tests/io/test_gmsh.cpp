@@ -782,6 +782,27 @@ TEST(FileBytes, PagesGivenBackAreReadAgainAndTheMeshIsTheSame) {
       ASSERT_EQ(stepped.tet_labels.size(), whole.tet_labels.size()) << path;
       EXPECT_EQ(stepped.tet_labels[0].values, whole.tet_labels[0].values) << path;
     }
+  // Medit, ASCII (with and without comments) and binary, and its solution files
+  m.vertex_fields.push_back({"x", 1, {}});
+  for (int64_t v = 0; v < m.num_vertices(); ++v) m.vertex_fields[0].values.push_back(m.points[size_t(3 * v)]);
+  for (const char* name : {"m.mesh", "m.meshb"}) {
+    const std::string path = dir.file(name);
+    tc::write_mesh(path, m);
+    const tc::Mesh whole = tc::read_mesh(path);
+    tc::io::FileBytes::set_step(4096);
+    const tc::Mesh stepped = tc::read_mesh(path);
+    tc::io::FileBytes::set_step(size_t(16) << 20);
+    EXPECT_EQ(stepped.points, whole.points) << path;
+    EXPECT_EQ(stepped.tets, m.tets) << path;
+    ASSERT_EQ(stepped.vertex_fields.size(), 1u) << path;
+    EXPECT_EQ(stepped.vertex_fields[0].values, whole.vertex_fields[0].values) << path;
+  }
+  const std::string commented = dir.file("c.mesh");
+  tc::test::write_text(commented, "# a comment\n" + tc::test::read_text(dir.file("m.mesh")));
+  tc::io::FileBytes::set_step(4096);
+  const tc::Mesh with_comment = tc::read_mesh(commented);
+  tc::io::FileBytes::set_step(size_t(16) << 20);
+  EXPECT_EQ(with_comment.tets, m.tets);
   // the bytes themselves
   const std::string path = dir.file("bytes.bin");
   std::string text(size_t(1) << 20, '\0');
