@@ -758,6 +758,14 @@ long mapping_rss_kb(const void* p) {
   return -1;
 }
 
+// The mesh at `path` read with FileBytes' step set to one page.
+tc::Mesh read_with_small_step(const std::string& path) {
+  tc::io::FileBytes::set_step(4096);
+  tc::Mesh m = tc::read_mesh(path);
+  tc::io::FileBytes::set_step(size_t(16) << 20);
+  return m;
+}
+
 // The readers give back the file's pages behind them (io::FileBytes): with a step of a few pages
 // every gmsh variant reads the same mesh as with the default step, and bytes given back are read
 // again from the file when looked at.
@@ -772,10 +780,7 @@ TEST(FileBytes, PagesGivenBackAreReadAgainAndTheMeshIsTheSame) {
       w.gmsh_version = version;
       const std::string path = dir.file("m" + std::to_string(version) + (binary ? "b" : "a") + ".msh");
       tc::write_mesh(path, m, w);
-      const tc::Mesh whole = tc::read_mesh(path);
-      tc::io::FileBytes::set_step(4096);
-      const tc::Mesh stepped = tc::read_mesh(path);
-      tc::io::FileBytes::set_step(size_t(16) << 20);
+      const tc::Mesh whole = tc::read_mesh(path), stepped = read_with_small_step(path);
       EXPECT_EQ(stepped.points, whole.points) << path;
       EXPECT_EQ(stepped.tets, whole.tets) << path;
       EXPECT_EQ(stepped.tets, m.tets) << path;
@@ -788,10 +793,7 @@ TEST(FileBytes, PagesGivenBackAreReadAgainAndTheMeshIsTheSame) {
   for (const char* name : {"m.mesh", "m.meshb"}) {
     const std::string path = dir.file(name);
     tc::write_mesh(path, m);
-    const tc::Mesh whole = tc::read_mesh(path);
-    tc::io::FileBytes::set_step(4096);
-    const tc::Mesh stepped = tc::read_mesh(path);
-    tc::io::FileBytes::set_step(size_t(16) << 20);
+    const tc::Mesh whole = tc::read_mesh(path), stepped = read_with_small_step(path);
     EXPECT_EQ(stepped.points, whole.points) << path;
     EXPECT_EQ(stepped.tets, m.tets) << path;
     ASSERT_EQ(stepped.vertex_fields.size(), 1u) << path;
@@ -799,10 +801,7 @@ TEST(FileBytes, PagesGivenBackAreReadAgainAndTheMeshIsTheSame) {
   }
   const std::string commented = dir.file("c.mesh");
   tc::test::write_text(commented, "# a comment\n" + tc::test::read_text(dir.file("m.mesh")));
-  tc::io::FileBytes::set_step(4096);
-  const tc::Mesh with_comment = tc::read_mesh(commented);
-  tc::io::FileBytes::set_step(size_t(16) << 20);
-  EXPECT_EQ(with_comment.tets, m.tets);
+  EXPECT_EQ(read_with_small_step(commented).tets, m.tets);
   // the bytes themselves
   const std::string path = dir.file("bytes.bin");
   std::string text(size_t(1) << 20, '\0');
