@@ -46,7 +46,11 @@ using io::TextCursor;
 // so that a short line is reported where it is rather than as garbage further on.
 class Records {
  public:
-  Records(std::string_view text, const std::string& file) : c_(io::blank_comments(text, storage_), file) {}
+  // Over `file`'s bytes, given back behind the cursor (or at once, when blank_comments copied them).
+  Records(io::FileBytes& file, const std::string& path) : c_(io::blank_comments(file.view(), storage_, &file), path) {
+    if (storage_.empty()) c_.release_through(&file);
+    else file.done();
+  }
 
   // Starts a record; `what` (and, for data records, "i of n") names it for "unexpected
   // end of file" messages. The message is built only on failure: this runs per line.
@@ -101,8 +105,8 @@ struct NodeFile {
 };
 
 NodeFile read_node(const std::string& path, Mesh& m, ReadNotes& notes) {
-  const std::string text = io::load_file(path);
-  Records r(text, path);
+  io::FileBytes file(path);
+  Records r(file, path);
   r.begin("the .node header");
   // Shortest node line: "0 0 0 0\n".
   const int64_t n = r.count("node count", r.max_items(8));
@@ -162,8 +166,8 @@ int32_t vertex_ref(Records& r, const NodeFile& nf, const char* what) {
 }
 
 void read_ele(const std::string& path, const NodeFile& nf, Mesh& m, ReadNotes& notes) {
-  const std::string text = io::load_file(path);
-  Records r(text, path);
+  io::FileBytes file(path);
+  Records r(file, path);
   r.begin("the .ele header");
   const int64_t n = r.count("element count", r.max_items(10));
   const int64_t per = r.more() ? r.integer("nodes per tetrahedron") : 4;
@@ -206,8 +210,8 @@ void read_ele(const std::string& path, const NodeFile& nf, Mesh& m, ReadNotes& n
 }
 
 void read_face(const std::string& path, const NodeFile& nf, Mesh& m) {
-  const std::string text = io::load_file(path);
-  Records r(text, path);
+  io::FileBytes file(path);
+  Records r(file, path);
   r.begin("the .face header");
   const int64_t n = r.count("face count", r.max_items(8));
   const int64_t nbmarker = r.more() ? r.integer("boundary marker flag") : 0;
