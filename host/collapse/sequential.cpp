@@ -7,6 +7,7 @@
 
 #include "collapse/sequential_run.hpp"
 #include "collapse/stages.hpp"  // collapse_detail::Reason
+#include "collapse/upload.hpp"  // collapse_detail::remap_elements
 #include "collapse_predicate.h"
 #include "tetcollapse/collapse.hpp"
 
@@ -49,31 +50,6 @@ SeqParams checked_params(const Mesh& mesh, const CollapseOptions& o) {
   // With a bound, a smoothly curved face's vertices are face vertices: the bound decides.
   if (o.bounds_boundary_error()) p.eps_f = 2;
   return p;
-}
-
-// Input triangles / edges through the vertex map; degenerate ones (and bad indices) dropped,
-// tags kept with their element (as collapse() does for the device result).
-void remap_elements(std::vector<int32_t>& elems, std::vector<int32_t>& tags, int arity,
-                    const std::vector<int32_t>& origin) {
-  const size_t n = elems.size() / arity;
-  size_t m = 0, kt = 0;  // elements and tags kept (in place: m <= i)
-  for (size_t i = 0; i < n; ++i) {
-    int32_t v[3];
-    bool ok = true;
-    for (int k = 0; k < arity && ok; ++k) {
-      const int32_t x = elems[i * arity + k];
-      ok = x >= 0 && size_t(x) < origin.size();
-      if (!ok) break;
-      v[k] = origin[x];
-      for (int j = 0; j < k; ++j) ok = ok && v[j] != v[k];
-    }
-    if (!ok) continue;
-    std::copy(v, v + arity, elems.begin() + m * arity);
-    if (i < tags.size()) tags[kt++] = tags[i];
-    ++m;
-  }
-  elems.resize(m * arity);
-  tags.resize(kt);
 }
 
 // The greedy mode's set of queued edges is keyed by a << 32 | b.
@@ -429,8 +405,8 @@ void SequentialRun::keep_origin() {
 
 CollapseReport SequentialRun::finish() {
   if (!origin_.empty()) {
-    remap_elements(mesh_.tris, mesh_.tri_tags, 3, origin_);
-    remap_elements(mesh_.edges, mesh_.edge_tags, 2, origin_);
+    collapse_detail::remap_elements(mesh_.tris, mesh_.tri_tags, 3, origin_);
+    collapse_detail::remap_elements(mesh_.edges, mesh_.edge_tags, 2, origin_);
   }
   report_.target_length = target_;
   report_.boundary_error_bound = bound_;

@@ -207,35 +207,28 @@ DeviceBuffer<int32_t> upload_with_origin(Context& ctx, const Mesh& mesh, const C
   return DeviceBuffer<int32_t>(ctx, origin);
 }
 
-namespace {
-
-// The elements (triangles or edges) through the vertex map `origin`; degenerate ones dropped.
 void remap_elements(std::vector<int32_t>& elems, std::vector<int32_t>& tags, int arity,
                     const std::vector<int32_t>& origin) {
   const size_t n = elems.size() / arity;
-  std::vector<int32_t> out, out_tags;
-  out.reserve(elems.size());
+  size_t m = 0, kt = 0;  // elements and tags kept (in place: m <= i)
   for (size_t i = 0; i < n; ++i) {
     int32_t v[3];
     bool ok = true;
-    for (int k = 0; k < arity; ++k) {
-      int32_t x = elems[i * arity + k];
-      if (x < 0 || size_t(x) >= origin.size()) {
-        ok = false;
-        break;
-      }
+    for (int k = 0; k < arity && ok; ++k) {
+      const int32_t x = elems[i * arity + k];
+      ok = x >= 0 && size_t(x) < origin.size();
+      if (!ok) break;
       v[k] = origin[x];
       for (int j = 0; j < k; ++j) ok = ok && v[j] != v[k];
     }
     if (!ok) continue;
-    out.insert(out.end(), v, v + arity);
-    if (i < tags.size()) out_tags.push_back(tags[i]);
+    std::copy(v, v + arity, elems.begin() + m * arity);
+    if (i < tags.size()) tags[kt++] = tags[i];
+    ++m;
   }
-  elems.swap(out);
-  if (!tags.empty()) tags.swap(out_tags);
+  elems.resize(m * arity);
+  tags.resize(kt);
 }
-
-}  // namespace
 
 void download_result(const DeviceMesh& dm, const DeviceBuffer<int32_t>& origin, Mesh& mesh) {
   download_mesh(dm, mesh);

@@ -53,6 +53,11 @@ void download_mesh(const DeviceMesh& dm, Mesh& mesh);
 // upload_mesh, in spatial order with CollapseTuning::spatial_order; returns the map input
 // vertex -> device vertex, which collapse_and_compact keeps current.
 DeviceBuffer<int32_t> upload_with_origin(Context& ctx, const Mesh& mesh, const CollapseOptions& o, DeviceMesh& dm);
+// Triangles or edges (`arity` vertices each) through the vertex map `origin`, in place;
+// degenerate ones and those with an index outside the map dropped, tags kept with their element.
+// (The device's result, the sequential method's and the improvement's star mesh spliced back.)
+void remap_elements(std::vector<int32_t>& elems, std::vector<int32_t>& tags, int arity,
+                    const std::vector<int32_t>& origin);
 // download_mesh, and the input's triangles and edges remapped through origin (degenerate ones
 // dropped).
 void download_result(const DeviceMesh& dm, const DeviceBuffer<int32_t>& origin, Mesh& mesh);

@@ -1,6 +1,8 @@
 // The improvement's collapse step on the stars of its vertices (star_mesh.hpp).
 #include "improve/star_mesh.hpp"
 
+#include "collapse/upload.hpp"
+
 namespace tc::improve_detail {
 
 StarMesh star_mesh(const Mesh& whole, const std::vector<uint8_t>& mask) {
@@ -49,12 +51,6 @@ void splice(Mesh& whole, const StarMesh& s, const sequential_detail::SequentialR
   int32_t n = 0;
   for (size_t v = 0; v < to.size(); ++v)
     if (alive[v]) to[v] = n++;
-  // a whole vertex -> its survivor's new index
-  auto survivor = [&](int32_t v) {
-    const int32_t i = star_of[size_t(v)];
-    return i < 0 ? to[size_t(v)] : to[size_t(from[size_t(origin[size_t(i)])])];
-  };
-  // (the star mesh's vertex of an alive whole vertex v in it: origin[star_of[v]])
   Mesh out;
   for (size_t v = 0; v < to.size(); ++v) {
     if (!alive[v]) continue;
@@ -97,27 +93,14 @@ void splice(Mesh& whole, const StarMesh& s, const sequential_detail::SequentialR
       out.tet_fields.back().values.insert(out.tet_fields.back().values.end(), &f.values[size_t(t) * c],
                                           &f.values[size_t(t) * c + c]);
   }
-  // the input's triangles and edges through the survivors, degenerate ones dropped (as
-  // SequentialRun::finish remaps them)
-  auto remap = [&](const std::vector<int32_t>& elems, const std::vector<int32_t>& tags, size_t arity,
-                   std::vector<int32_t>& out_elems, std::vector<int32_t>& out_tags) {
-    for (size_t i = 0; i < elems.size() / arity; ++i) {
-      int32_t v[3];
-      bool ok = true;
-      for (size_t k = 0; k < arity && ok; ++k) {
-        const int32_t x = elems[i * arity + k];
-        ok = x >= 0 && x < whole.num_vertices();
-        if (!ok) break;
-        v[k] = survivor(x);
-        for (size_t j = 0; j < k; ++j) ok = ok && v[j] != v[k];
-      }
-      if (!ok) continue;
-      out_elems.insert(out_elems.end(), v, v + arity);
-      if (i < tags.size()) out_tags.push_back(tags[i]);
-    }
-  };
-  remap(whole.tris, whole.tri_tags, 3, out.tris, out.tri_tags);
-  remap(whole.edges, whole.edge_tags, 2, out.edges, out.edge_tags);
+  // the input's triangles and edges through each whole vertex's survivor, as the run remaps them
+  std::vector<int32_t> survivor(to.size());
+  for (size_t v = 0; v < to.size(); ++v)
+    survivor[v] = star_of[v] < 0 ? to[v] : to[size_t(from[size_t(origin[size_t(star_of[v])])])];
+  out.tris = std::move(whole.tris), out.tri_tags = std::move(whole.tri_tags);
+  out.edges = std::move(whole.edges), out.edge_tags = std::move(whole.edge_tags);
+  collapse_detail::remap_elements(out.tris, out.tri_tags, 3, survivor);
+  collapse_detail::remap_elements(out.edges, out.edge_tags, 2, survivor);
   whole = std::move(out);
 }
 
