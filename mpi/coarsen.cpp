@@ -71,8 +71,8 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context* ctx
     // scale it so that the bound is the whole mesh's.
     const double d = bbox_diagonal(m);
     if (d > 0) io.max_boundary_move *= s.whole_diagonal / d;
-    // under a bound: a third each to the passes, the collapse step and the passes after it, as
-    // tc::improve shares its own
+    // under a bound: a third each to the passes, the collapse step and the passes after it (three
+    // calls, each bounded from where it starts)
     const bool step = masked && io.collapse;
     if (s.boundary_bound > 0) {
       io.max_boundary_error_abs = step ? s.boundary_bound / 3 : s.boundary_bound;

@@ -123,9 +123,10 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
     io.eps_r = co.eps_r;
     io.use_labels = co.use_labels;
     // what the collapse left of the boundary error bound (DBL_MIN: only exact changes)
-    if (bound > 0)
-      io.max_boundary_error_abs =
-          std::max(bound - r.collapse.boundary_error, std::numeric_limits<double>::min());
+    if (bound > 0) {
+      io.max_boundary_error_abs = bound;
+      io.vertex_boundary_error = r.collapse.vertex_boundary_error;
+    }
     if (options.improve_mask) io.vertex_mask = options.improve_mask(mesh);
     r.improvement = ctx ? improve(mesh, io, *ctx) : improve(mesh, io);
     r.improved = true;

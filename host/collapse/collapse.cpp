@@ -99,6 +99,7 @@ CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Cont
   report.seconds_total += tail.seconds_total;
   report.boundary_error_bound = bound;
   report.boundary_error = tail.boundary_error;
+  report.vertex_boundary_error = tail.vertex_boundary_error;
   return report;
 }
 

@@ -395,6 +395,15 @@ bool SequentialRun::step() {
   return !done_;
 }
 
+void SequentialRun::seed_boundary_error(std::vector<double> eps) {
+  if (it_ > 0) throw std::logic_error("SequentialRun::seed_boundary_error: after the first step");
+  if (!(bound_ > 0)) throw std::logic_error("SequentialRun::seed_boundary_error: no bound");
+  if (eps.size() != eps_.size())
+    throw std::invalid_argument("seed_boundary_error: " + std::to_string(eps.size()) + " values for " +
+                                std::to_string(eps_.size()) + " vertices");
+  eps_ = std::move(eps);
+}
+
 void SequentialRun::keep_origin() {
   if (it_ > 0) throw std::logic_error("SequentialRun::keep_origin: after the first step");
   const size_t n = size_t(mesh_.num_vertices());
@@ -412,6 +421,7 @@ CollapseReport SequentialRun::finish() {
   report_.boundary_error_bound = bound_;
   for (size_t v = 0; v < eps_.size(); ++v)
     if (sm_.alive(int32_t(v))) report_.boundary_error = std::max(report_.boundary_error, eps_[v]);
+  if (bound_ > 0) report_.vertex_boundary_error = eps_;
   if (field_) report_.field_error = field_->max_error(sm_, mesh_);
   report_.vertices_out = mesh_.num_vertices();
   report_.tets_out = mesh_.num_tets();

@@ -105,6 +105,12 @@ class SequentialRun {
   void keep_origin();
   const std::vector<int32_t>& origin() const { return origin_; }
   const std::vector<int32_t>& source() const { return source_; }
+  // Under a boundary error bound: per vertex, the bound on how far the S triangles at it are
+  // from the input's S (each S triangle is within the largest of its corners'). Zero at the
+  // start unless seeded (before the first step: what earlier changes of S left, per vertex of
+  // the mesh given); after finish(), per vertex of the result.
+  void seed_boundary_error(std::vector<double> eps);
+  const std::vector<double>& boundary_errors() const { return eps_; }
 
  private:
   // The edge's cost: its length, or CollapseOptions::field_difference_cost's |f0 - f1| (the

@@ -85,8 +85,8 @@ namespace {
 
 // Passes of flips and relocation on `mesh` until they stall; appends them to the report.
 // With a context, the vertices are relocated on its device, and on a GPU the flips found there.
-void passes(Mesh& mesh, const ImproveOptions& options, Context* ctx, int max_passes, ImproveReport& report,
-            bool first) {
+// Under a boundary error bound, options.vertex_boundary_error goes on from what the passes spent.
+void passes(Mesh& mesh, ImproveOptions& options, Context* ctx, int max_passes, ImproveReport& report, bool first) {
   const Stopwatch setup;
   ImpMesh m(mesh, options);
   report.seconds_setup += setup.peek();
@@ -128,6 +128,7 @@ void passes(Mesh& mesh, const ImproveOptions& options, Context* ctx, int max_pas
   report.pinned_below_13_after = pinned_below_13(m);
   const Stopwatch write;
   m.write_back();
+  if (m.bounded()) options.vertex_boundary_error = m.boundary_errors();
   report.seconds_setup += write.peek();
 }
 
@@ -136,7 +137,7 @@ void passes(Mesh& mesh, const ImproveOptions& options, Context* ctx, int max_pas
 // device: a few hundred edges, where the parallel method takes as long (it uploads and connects
 // the whole mesh) and its order of collapses left more bad tets on W1. On the star mesh of
 // those vertices (star_mesh), spliced back: the same collapses as on the whole mesh.
-int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options, bool harmonic) {
+int64_t collapse_bad(Mesh& mesh, ImproveOptions& options, bool harmonic) {
   std::vector<uint8_t> mask(size_t(mesh.num_vertices()), 0);
   int64_t bad = 0;
   for (int64_t t = 0; t < mesh.num_tets(); ++t) {
@@ -164,17 +165,31 @@ int64_t collapse_bad(Mesh& mesh, const ImproveOptions& options, bool harmonic) {
                     : harmonic                  ? 1.0
                                                 : 1.5 * median_edge_length(mesh);
   o.harmonic_cost = harmonic;
-  if (options.boundary == CollapseOptions::Features) o.max_boundary_error_abs = options.max_boundary_error_abs;
+  // Under a bound the step goes on from what was spent at each vertex, which reaches the star
+  // mesh and comes back through the splice as a last vertex field.
+  const bool bounded = options.boundary == CollapseOptions::Features && options.max_boundary_error_abs > 0;
+  if (bounded) {
+    o.max_boundary_error_abs = options.max_boundary_error_abs;
+    std::vector<double> spent = options.vertex_boundary_error;
+    spent.resize(size_t(mesh.num_vertices()), 0.0);
+    mesh.vertex_fields.push_back({"tetcollapse:boundary_error", 1, std::move(spent)});
+  }
   StarMesh star = star_mesh(mesh, mask);
   o.vertex_mask.resize(star.verts.size());
   for (size_t i = 0; i < star.verts.size(); ++i) o.vertex_mask[i] = mask[size_t(star.verts[i])];
   sequential_detail::SequentialRun run(star.mesh, o);
   run.keep_origin();
+  if (bounded) run.seed_boundary_error(star.mesh.vertex_fields.back().values);
   while (run.step()) {
   }
   int64_t collapsed = 0;
   for (const IterationStats& it : run.finish().iterations) collapsed += it.collapsed;
+  if (bounded) star.mesh.vertex_fields.back().values = run.boundary_errors();
   if (collapsed > 0) splice(mesh, star, run);
+  if (bounded) {
+    options.vertex_boundary_error = std::move(mesh.vertex_fields.back().values);
+    mesh.vertex_fields.pop_back();
+  }
   return collapsed;
 }
 
@@ -183,16 +198,14 @@ ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) 
   if (ctx) prefetch_programs(*ctx);
   ImproveReport report;
   report.before = quality_summary(mesh);
-  // A boundary error bound is shared by the three stages that may move S: the passes, the
-  // collapse step and the passes after it (each measures from where it starts).
+  // Under a boundary error bound, options.vertex_boundary_error follows each stage's changes.
   ImproveOptions options = given;
-  if (given.max_boundary_error_abs > 0) options.max_boundary_error_abs = given.max_boundary_error_abs / 3;
   passes(mesh, options, ctx, options.max_iterations, report, true);
   // Rounds of the collapse step and the passes after it, while a round raises the smallest angle
   // or removes a tenth of the tets below 10 or 13 degrees left (a collapse frees its neighbours for the next passes, which free
-  // edges for the next step). Under a boundary error bound one round: the bound is shared by the
-  // three stages. (With a vertex mask the step does not run: the collapse renumbers the vertices.)
-  const int rounds = given.max_boundary_error_abs > 0 ? std::min(1, options.collapse_rounds) : options.collapse_rounds;
+  // edges for the next step). (With a vertex mask the step does not run: the collapse renumbers
+  // the vertices.)
+  const int rounds = options.collapse_rounds;
   for (int round = 0; round < rounds; ++round) {
     if (!options.collapse || !options.vertex_mask.empty() || int(report.passes.size()) >= options.max_iterations) break;
     const ImprovePassStats before = report.passes.back();
@@ -210,11 +223,13 @@ ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) 
     for (bool harmonic : {true, false}) {
       if (harmonic && !options.harmonic_collapse) continue;
       Mesh kept = mesh;
+      std::vector<double> spent = options.vertex_boundary_error;
       const int64_t n = collapse_bad(mesh, options, harmonic);
       const QualitySummary qa = quality_summary(mesh);
       if (n == 0 || qa.min_dihedral_deg < q0.min_dihedral_deg || qa.below_10_deg > q0.below_10_deg ||
           qa.below_13_deg > q0.below_13_deg) {
         mesh = std::move(kept);
+        options.vertex_boundary_error = std::move(spent);
         continue;
       }
       stats.collapsed += n;

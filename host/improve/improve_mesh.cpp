@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "collapse_guard_geometry.h"
+#include "collapse_surface_error.h"
 #include "tetcollapse/error.hpp"
 #include "tetcollapse/topology.hpp"
 
@@ -82,6 +83,12 @@ ImpMesh::ImpMesh(Mesh& mesh, const ImproveOptions& options) : mesh_(mesh), point
     // stays within the bound when no vertex gets further than it from where it started.
     bounded_ = true;
     max_boundary_move_ = options.max_boundary_error_abs;
+    err_ = options.vertex_boundary_error;
+    if (err_.empty()) err_.assign(size_t(nv), 0.0);
+    if (err_.size() != size_t(nv))
+      throw std::invalid_argument("vertex_boundary_error has " + std::to_string(err_.size()) + " entries for " +
+                                  std::to_string(nv) + " vertices");
+    err_start_ = err_;
   } else if (options.boundary != CollapseOptions::Strict && options.max_boundary_move > 0 && nv > 0) {
     max_boundary_move_ = options.max_boundary_move * bbox_diagonal(mesh);
   }
@@ -218,6 +225,80 @@ bool ImpMesh::surface_stays_clear(int32_t v, tc_d3 p) {
   return true;
 }
 
+namespace {
+
+// The fan test's fallback for fans it cannot bound because of a triangle with no area (common
+// on coarsened flat patches): when neither fan folds seen along the vertex's normal n (no
+// triangle turned over, the same area covered), every point of one lies straight above or
+// below a point of the other, within the slab of both fans' points along n.
+double slab_distance(const tc_d3* olds, const tc_d3* news, int n, tc_d3 o, tc_d3 nz) {
+  double sum_old = 0, sum_new = 0, lo = 0, hi = 0, scale = 0;
+  for (int i = 0; i < 3 * n; ++i) scale = std::max({scale, geo::length(olds[i] - o), geo::length(news[i] - o)});
+  const double tiny = 1e-12 * scale * scale;
+  double sign = 0;
+  for (int i = 0; i < n; ++i) sign += geo::dot(geo::cross(olds[3 * i + 1] - olds[3 * i], olds[3 * i + 2] - olds[3 * i]), nz);
+  sign = sign < 0 ? -1 : 1;
+  for (int side = 0; side < 2; ++side)
+    for (int i = 0; i < n; ++i) {
+      const tc_d3* t = (side == 0 ? olds : news) + 3 * i;
+      const double a = sign * geo::dot(geo::cross(t[1] - t[0], t[2] - t[0]), nz);
+      if (!(a >= -tiny)) return std::numeric_limits<double>::infinity();
+      (side == 0 ? sum_old : sum_new) += a;
+      for (int k = 0; k < 3; ++k) {
+        const double h = geo::dot(t[k] - o, nz);
+        lo = std::min(lo, h);
+        hi = std::max(hi, h);
+      }
+    }
+  if (!(std::fabs(sum_old - sum_new) <= 1e-9 * (sum_old + sum_new))) return std::numeric_limits<double>::infinity();
+  return hi - lo + 1e-12 * scale;
+}
+
+}  // namespace
+
+double ImpMesh::boundary_error_at(int32_t v, tc_d3 p) const {
+  const tc_d3 here = point(v);
+  // two bounds: the fan's largest plus the distance between the fan before and after; the fan's
+  // largest at the start plus how far a vertex of it got since (every point of a triangle moves
+  // by at most what its corners do)
+  double base = err_[size_t(v)], base_start = err_start_[size_t(v)], shift = geo::length(p - start_[size_t(v)]);
+  tc_d3 olds[3 * TCC_MAX_FAN], news[3 * TCC_MAX_FAN];
+  int n = 0;
+  bool fits = true;
+  // v's surface triangles, each once: from the tet on the owner's side (outside, or the smaller
+  // label), in that tet's orientation, so that the fan is oriented one way
+  for (int32_t t : vtets_[size_t(v)]) {
+    const Tet& q = tets_[size_t(t)];
+    for (int f = 0; f < 4; ++f) {
+      if (q[size_t(f)] == v) continue;  // the face opposite v
+      const auto& F = geo::TC_TET_FACES[f];
+      const int32_t c[3] = {q[size_t(F[0])], q[size_t(F[1])], q[size_t(F[2])]};
+      const int32_t o = across(t, c[0], c[1], c[2]);
+      if (!(o < 0 || label_[size_t(t)] < label_[size_t(o)])) continue;
+      for (int k = 0; k < 3; ++k) {
+        base = std::max(base, err_[size_t(c[k])]);
+        base_start = std::max(base_start, err_start_[size_t(c[k])]);
+        if (c[k] != v) shift = std::max(shift, geo::length(point(c[k]) - start_[size_t(c[k])]));
+      }
+      if (n == TCC_MAX_FAN) {
+        fits = false;
+        continue;
+      }
+      for (int k = 0; k < 3; ++k) {
+        olds[3 * n + k] = point(c[k]);
+        news[3 * n + k] = c[k] == v ? p : point(c[k]);
+      }
+      ++n;
+    }
+  }
+  // A move along a line (its fan is two sheets) or of a fan the test cannot bound: every point
+  // of the fan moves by at most what v does.
+  const double moved = geo::length(p - here);
+  double fan = fits && motion(v) == kInPlane ? geo::tcc_fan_distance(olds, n, news, n) : moved;
+  if (fits && motion(v) == kInPlane && !(fan < moved)) fan = std::min(fan, slab_distance(olds, news, n, here, normal_[size_t(v)]));
+  return std::min(base + std::min(fan, moved), base_start + shift);
+}
+
 void ImpMesh::surface_moved(int32_t v) {
   if (sfaces_.empty()) return;
   std::vector<FaceKey> fan;
@@ -281,6 +362,23 @@ bool ImpMesh::replace_on_boundary(const std::vector<int32_t>& old, const std::ve
   if (!flat)
     for (int32_t t : old)
       for (int32_t v : tets_[size_t(t)]) motion_[size_t(v)] = kFixed;
+  // Under the bound: the new triangles cover what the old ones did, whose corners' bounds they
+  // take (their own corners are three of the quad's four).
+  if (bounded_) {
+    double e = 0;
+    for (const auto& g : gone)
+      for (int32_t v : g) e = std::max(e, err_[size_t(v)]);
+    // and the bound by displacement starts again from here: what the quad's corners reached
+    double s = 0;
+    for (const auto& g : gone)
+      for (int32_t v : g) s = std::max(s, err_start_[size_t(v)] + geo::length(point(v) - start_[size_t(v)]));
+    for (const auto& g : gone)
+      for (int32_t v : g) {
+        err_[size_t(v)] = e;
+        err_start_[size_t(v)] = s;
+        start_[size_t(v)] = point(v);
+      }
+  }
   replace(old, added, old[0]);
   if (!sfaces_.empty()) {
     for (const auto& g : gone) {
@@ -354,7 +452,11 @@ void ImpMesh::mark_motion(const ImproveOptions& options) {
     }
     if (bend > kStraight) {
       if (!may_bend) continue;
-      max_offset_[size_t(v)] = bounded_ ? max_boundary_move_ : max_boundary_move_ / bend;
+      max_offset_[size_t(v)] = bounded_ && lines != 0 ? max_boundary_move_ : max_boundary_move_ / bend;
+    } else if (bounded_ && lines == 0) {
+      // Under the bound a flat patch's vertex is accounted as a curved one's: once a neighbour
+      // has moved, its fan is no longer flat.
+      max_offset_[size_t(v)] = max_boundary_move_ / kStraight;
     }
     motion_[size_t(v)] = lines == 0 ? kInPlane : kAlongLine;
     normal_[size_t(v)] = dir;

@@ -80,6 +80,12 @@ class ImpMesh {
   // within it and flips of flat quads change the boundary.
   bool bounded() const { return bounded_; }
   double max_boundary_move() const { return max_boundary_move_; }
+  // Under the bound, each vertex carries a bound on how far the surface triangles at it are
+  // from the surface the bound measures from (ImproveOptions::max_boundary_error_abs). The
+  // bound v would get at p; a move is admissible while it is at most max_boundary_move().
+  double boundary_error_at(int32_t v, tc_d3 p) const;
+  void set_boundary_error(int32_t v, double e) { err_[size_t(v)] = e; }
+  const std::vector<double>& boundary_errors() const { return err_; }
   // Replaces the tets `old` by `added` where that changes the boundary: its faces `gone` (two)
   // give way to `exposed` (two), which take over the input's tags of `gone`. False (nothing
   // done) if the tags do not allow it, if an exposed face would touch the rest of the surface,
@@ -178,6 +184,7 @@ class ImpMesh {
   std::unordered_map<FaceKey, int64_t, FaceHash> tris_;  // the input's tagged triangles -> index
   double max_boundary_move_ = 0;
   bool bounded_ = false;
+  std::vector<double> err_, err_start_;  // per vertex, under the bound: now, and at start_
 };
 
 // One topological pass over the bad tets (worst first); returns the counts in `stats`.

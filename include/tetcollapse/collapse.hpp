@@ -102,6 +102,10 @@ struct CollapseReport {
   // With a boundary error bound: the bound in mesh units, and the largest bound the run's
   // changes of S reached (the result's S is within it of the input's, both ways).
   double boundary_error_bound = 0, boundary_error = 0;
+  // With a boundary error bound, per vertex of the result: a bound on how far the S triangles
+  // at it are from the input's S (each S triangle is within the largest of its corners'); the
+  // improvement phase goes on from it (ImproveOptions::vertex_boundary_error).
+  std::vector<double> vertex_boundary_error;
   // With a field error bound: the bound (a share of the field's range), and the largest
   // difference, as a share of the range, between an input vertex's value and the result's
   // piecewise linear field at it (over the bounded field's components).

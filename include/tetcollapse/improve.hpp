@@ -99,13 +99,18 @@ struct ImproveOptions {
   // boundary moves by at most this share of the bounding-box diagonal; 0: never.
   double max_boundary_move = 0.001;
   // With > 0 (mesh units): the boundary changes stay within this two-sided distance of the
-  // surface as it was. A third each goes to the passes, the collapse step (which carries it as
-  // CollapseOptions::max_boundary_error_abs) and the passes after it: in a series of passes no
-  // boundary vertex off a flat patch or straight line gets further than its third from where
-  // it started (every point of S then moves no further), and no thin boundary tet is removed
-  // (max_boundary_move is not used). The coarsening command passes what its own bound left
-  // (CollapseReport::boundary_error).
+  // surface as it was (or of the surface that vertex_boundary_error measures from). Each vertex
+  // carries a bound on how far the S triangles at it are from there, the collapse step's as
+  // the sequential method's (CollapseOptions::max_boundary_error_abs), a relocation's the
+  // smaller of two: the largest bound of its fan plus the distance between the fan before and
+  // after (cl/collapse_surface_error.h; along a line, how far the vertex moved), or the fan's
+  // largest bound at the start of its series of passes plus how far a vertex of the fan got
+  // from where that series started. No thin boundary tet is removed (max_boundary_move is not
+  // used).
   double max_boundary_error_abs = 0;
+  // With max_boundary_error_abs: per vertex, what earlier changes of S already spent of it
+  // (CollapseReport::vertex_boundary_error, which the coarsening command passes); empty: none.
+  std::vector<double> vertex_boundary_error;
   // Collapse of the short edges of the tets below 13 degrees that flips and relocation left
   // (the paper's improvement by collapse), through the sequential method's checks, with the
   // quality guard at 0.3 (no collapse lowers the worst mean ratio of what it reshapes below
@@ -120,8 +125,7 @@ struct ImproveOptions {
   // angle (CollapseOptions::harmonic_cost); then the shortest edges as above on what is left.
   bool harmonic_collapse = true;
   // At most this many rounds of the collapse step and the passes after it, each only after one
-  // that raised the smallest angle or removed a tenth of the tets below 10 or 13 degrees (one
-  // under a boundary error bound, which the stages share).
+  // that raised the smallest angle or removed a tenth of the tets below 10 or 13 degrees.
   int collapse_rounds = 4;
   // With a non-empty mask (one byte per vertex, non-zero = selected), only selected vertices
   // move, and only tets whose vertices are all selected are flipped; the collapse step does not

@@ -66,22 +66,6 @@ TEST(BoundaryErrorFan, FoldedFanGetsNoBound) {
   EXPECT_TRUE(std::isinf(geo::tcc_fan_distance(olds.data(), 6, half.data(), 2)));
 }
 
-// cube_tets(n) in [-1, 1]^3, pushed out to the unit ball (x -> x |x|_inf / |x|_2).
-Mesh ball(int n) {
-  Mesh m = cube_tets(n);
-  for (size_t i = 0; i < m.points.size(); i += 3) {
-    double p[3], inf = 0, two = 0;
-    for (int c = 0; c < 3; ++c) {
-      p[c] = 2 * m.points[i + size_t(c)] - 1;
-      inf = std::max(inf, std::fabs(p[c]));
-      two += p[c] * p[c];
-    }
-    two = std::sqrt(two);
-    for (int c = 0; c < 3; ++c) m.points[i + size_t(c)] = two > 0 ? p[c] * inf / two : 0;
-  }
-  return m;
-}
-
 double hausdorff_rel(const Mesh& out, const Mesh& in) {
   CheckOptions co;
   co.hausdorff = true;

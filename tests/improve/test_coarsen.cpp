@@ -8,6 +8,9 @@
 #include "tetcollapse/coarsen.hpp"
 #include "tetcollapse/device.hpp"
 #include "tetcollapse/fields.hpp"
+#include "tetcollapse/check.hpp"
+#include "tetcollapse/collapse.hpp"
+#include "tetcollapse/improve.hpp"
 
 namespace tc {
 namespace {
@@ -59,6 +62,52 @@ TEST(Coarsen, SharesABoundaryErrorBoundWithTheImprovement) {
   EXPECT_TRUE(r.improved);
   EXPECT_EQ(r.collapse.boundary_error_bound, bound);
   EXPECT_LE(r.collapse.boundary_error, kCollapseShareOfBound * bound * (1 + 1e-12));
+}
+
+// The improvement goes on from what the collapse spent at each vertex: on a ball it moves
+// vertices of the curved surface, and the checker's two-sided distance of the result stays
+// within the bound. With every vertex seeded as spent, no vertex of the curved surface moves.
+TEST(Coarsen, TheImprovementKeepsTheBoundVertexByVertex) {
+  Context ctx;
+  const Mesh in = test::ball(8);
+  CoarsenOptions co;
+  co.collapse.target_factor = 2;
+  co.collapse.max_boundary_error = 0.002;
+  Mesh m = in;
+  const CoarsenReport r = coarsen(m, co, &ctx);
+  ASSERT_TRUE(r.improved);
+  ASSERT_EQ(r.collapse.vertex_boundary_error.size(), size_t(m.num_vertices()));
+  CheckOptions check;
+  check.hausdorff = true;
+  const CheckReport cr = check_mesh(m, check, &in);
+  EXPECT_TRUE(cr.valid) << check_report_text(cr);
+  EXPECT_LE(cr.reference.hausdorff_rel, 0.002) << "the checker's two-sided distance within the bound";
+
+  // the collapse alone, then the improvement with and without the collapse's spending
+  Mesh collapsed = in;
+  CollapseOptions cc = co.collapse;
+  cc.max_boundary_error = 0;
+  cc.max_boundary_error_abs = kCollapseShareOfBound * boundary_error_bound(in, co.collapse);
+  const CollapseReport c = collapse(collapsed, cc, ctx);
+  const auto surface_moves = [&](const std::vector<double>& spent) {
+    Mesh x = collapsed;
+    ImproveOptions io;
+    io.max_boundary_error_abs = boundary_error_bound(in, co.collapse);
+    io.vertex_boundary_error = spent;
+    io.collapse = false;  // (the collapse step renumbers the vertices)
+    improve(x, io, ctx);
+    int64_t moved = 0;
+    for (int64_t v = 0; v < x.num_vertices(); ++v) {
+      const double* p = &collapsed.points[3 * size_t(v)];
+      const double* q = &x.points[3 * size_t(v)];
+      const bool on_sphere = std::fabs(std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) - 1) < 1e-9;
+      moved += on_sphere && (p[0] != q[0] || p[1] != q[1] || p[2] != q[2]);
+    }
+    return moved;
+  };
+  EXPECT_GT(surface_moves(c.vertex_boundary_error), 0) << "the improvement moves vertices of the sphere";
+  EXPECT_EQ(surface_moves(std::vector<double>(size_t(collapsed.num_vertices()), boundary_error_bound(in, co.collapse))), 0)
+      << "nothing is left to spend";
 }
 
 // No improvement phase under the field error bound (its moves are not checked against it) or a

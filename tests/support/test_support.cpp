@@ -158,6 +158,21 @@ Mesh slab(int n) {
   });
 }
 
+Mesh ball(int n) {
+  Mesh m = cube_tets(n);
+  for (size_t i = 0; i < m.points.size(); i += 3) {
+    double p[3], inf = 0, two = 0;
+    for (int c = 0; c < 3; ++c) {
+      p[c] = 2 * m.points[i + size_t(c)] - 1;
+      inf = std::max(inf, std::fabs(p[c]));
+      two += p[c] * p[c];
+    }
+    two = std::sqrt(two);
+    for (int c = 0; c < 3; ++c) m.points[i + size_t(c)] = two > 0 ? p[c] * inf / two : 0;
+  }
+  return m;
+}
+
 Mesh cone_boundary(const Mesh& m, double x, double y, double z) {
   TopologyOptions no_labels;
   no_labels.use_labels = false;  // the boundary faces only, not material interfaces

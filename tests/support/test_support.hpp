@@ -63,6 +63,7 @@ Mesh single_tet();             // the unit right-corner tet, positively oriented
 Mesh cube_tets(int n);         // [0,1]^3 split into n^3 cubes of 6 tets each (Kuhn), labels none
 Mesh slab(int n);              // the bottom layer of cube_tets(n): one tet thick, every vertex on the boundary
 Mesh two_materials(int n);     // cube_tets(n) with labels 1 below z = 0.5 and 2 above (an interface plane)
+Mesh ball(int n);              // cube_tets(n) in [-1, 1]^3, pushed out to the unit ball (x -> x |x|_inf / |x|_2)
 // cube_tets(n) labelled ("material") by the side of the plane coordinate `axis` = 0.5 each tet's
 // centroid lies on: `below` or `above`
 Mesh split_materials(int n, int axis, int32_t below, int32_t above);
