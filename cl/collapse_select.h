@@ -59,6 +59,9 @@
 
 /* Predicate Q (tcc_predicate_q): shared with the sequential CPU method. */
 #include "collapse_predicate.h"
+#ifdef TCC_BOUND
+#include "collapse_bound.h"
+#endif
 
 /* The volume test (and the quality guard) of the edge (a, b), a < b, which passed Q with the
  * direction bits dir: TCC_OK, TCC_REFUSED_VOLUME or TCC_REFUSED_QUALITY. Live (see the top):
@@ -224,11 +227,12 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
       int use_labels, __global const double *pts, __global const double *vfield, uint vfield_stride,                \
       __global const uchar *vflags, __global const uchar *vclass, __global const uchar *eflags, int mode,           \
       int paper_rule, double eps_v, double q_min, double field_eps, __global const double *tets2quality,            \
-      __global uchar *edges2dir, __global uchar *edges2reason, __global uint *counters, __global uchar *edges2verdict
+      __global uchar *edges2dir, __global uchar *edges2reason, __global uint *counters, __global uchar *edges2verdict, \
+      double bound, uint eps_col
 #define TCC_TEST_ARGS                                                                                             \
   tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vfield, vfield_stride, vflags, vclass, \
       eflags, mode, paper_rule, eps_v, q_min, field_eps, tets2quality, edges2dir, edges2reason, counters,         \
-      edges2verdict
+      edges2verdict, bound, eps_col
 
 /* Q's direction bits of the candidate e = (a, b), with the user's placement (tcc_user_dir). */
 inline int tcc_lazy_dir(int e, int a, int b, TCC_TEST_PARAMS) {
@@ -270,6 +274,16 @@ inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* edg
   int a = edges[2 * e], b = edges[2 * e + 1];
   int dir = tcc_lazy_dir(e, a, b, TCC_TEST_ARGS);
   uchar r = tcc_lazy_verdict(e, a, b, dir, TCC_TEST_ARGS);
+#ifdef TCC_BOUND
+  /* the boundary error bound (collapse_bound.h), after the tests: not carried as a pass, since
+   * the bounds of the fan's vertices may grow while the rings stay (a refusal stays one) */
+  if (r == TCC_OK && !tcc_bound_holds(a, b, dir, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, vfield,
+                                      vfield_stride, vflags, bound, eps_col)) {
+    r = TCC_REFUSED_SURFACE;
+    edges2verdict[e] = r;
+    atomic_inc(&counters[6]);
+  }
+#endif
   edges2reason[e] = r;
   if (r == TCC_OK) {
     edges2dir[e] = (uchar)dir;

@@ -135,8 +135,8 @@ void register_collapse(CLI::App& app, int& exit_code) {
                  "Features mode: keep the boundary and the material interfaces within E x the input's\n"
                  "bounding-box diagonal of where they were, both ways (a conservative bound on the two-sided\n"
                  "Hausdorff distance, carried per vertex); smoothly curved faces then coarsen (--eps-f is not\n"
-                 "used). The parallel method coarsens the interior on the device with the boundary frozen,\n"
-                 "then the boundary on the host within the bound. 0 (default): no bound")
+                 "used). Tested on the device; the parallel method then selects by --conflicts greedy.\n"
+                 "0 (default): no bound")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_option("--max-boundary-error-abs", c->opt.max_boundary_error_abs,

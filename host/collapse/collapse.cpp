@@ -36,70 +36,47 @@ CollapseReport report_for(const Mesh& mesh, const Context& ctx) {
 
 namespace {
 
-// The boundary error bound on the parallel method: the device coarsens with S frozen (strict:
-// no change of S, so nothing to bound), then the sequential method, which carries the bound,
-// coarsens S and what its changes free. Why two phases: the bound's fan test and the per-vertex
-// bound are host code so far; the interior, most of the work, still runs on the device.
+// The hidden vertex field that carries the boundary error bound per vertex through the run
+// (collapse/bound.hpp).
+constexpr const char* kBoundField = "tetcollapse:boundary_error";
+
+CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Context& ctx);
+
+// The bound's column in the packed vertex fields: the last component (of kBoundField, last).
+uint32_t dm_bound_column(const Mesh& mesh) {
+  uint32_t n = 0;
+  for (const Field& f : mesh.vertex_fields) n += uint32_t(f.components);
+  return n - 1;
+}
+
+// The boundary error bound on the parallel method: the device tests each chosen collapse that
+// changes S against the bound (cl/collapse_bound.cl) with the bound per vertex in a last vertex
+// field, which the compaction carries and the host tail continues. The selection is the greedy
+// one: the matching selection applies its collapses before the tests, which read the mesh
+// before them.
 CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
-  if (options.has_user_functions())
+  if (options.boundary != CollapseOptions::Features)
     throw std::invalid_argument(
-        "the boundary error bound on the parallel method takes no user cost, placement or predicate yet: use the "
-        "sequential method");
+        "max_boundary_error applies to the features boundary mode (strict keeps the boundary exactly, free does not "
+        "bound it)");
   const double bound = boundary_error_bound(mesh, options);
-  CollapseOptions inner = options;
-  inner.boundary = CollapseOptions::Strict;
-  inner.max_boundary_error = inner.max_boundary_error_abs = 0;
-  // A vertex mask reaches the second phase through a vertex field, which the device's
-  // compaction and renumbering carry to the survivors (a collapse averages it at a midpoint:
-  // 1 stays 1 where both ends must be selected; with either end, a survivor of a selected end
-  // stays selected).
-  const bool masked = !options.vertex_mask.empty();
-  if (masked) {
-    Field f{"tetcollapse:vertex_mask", 1, {}};
-    f.values.assign(options.vertex_mask.begin(), options.vertex_mask.end());
-    for (double& x : f.values) x = x != 0 ? 1.0 : 0.0;
-    mesh.vertex_fields.push_back(std::move(f));
-  }
+  CollapseOptions o = options;
+  o.max_boundary_error = 0;
+  o.max_boundary_error_abs = bound;
+  o.conflicts = CollapseOptions::Greedy;
+  mesh.vertex_fields.push_back({kBoundField, 1, std::vector<double>(size_t(mesh.num_vertices()), 0.0)});
   CollapseReport report;
   try {
-    report = collapse(mesh, inner, ctx);
+    report = collapse_on_device(mesh, o, ctx);
   } catch (...) {
-    if (masked) mesh.vertex_fields.pop_back();
+    if (!mesh.vertex_fields.empty() && mesh.vertex_fields.back().name == kBoundField) mesh.vertex_fields.pop_back();
     throw;
   }
-  CollapseOptions outer = options;
-  if (masked) {
-    const std::vector<double>& v = mesh.vertex_fields.back().values;
-    outer.vertex_mask.resize(v.size());
-    for (size_t i = 0; i < v.size(); ++i)
-      outer.vertex_mask[i] = options.mask_either ? v[i] > 0 : v[i] > 1 - 1e-9;
-    mesh.vertex_fields.pop_back();
-  }
-  outer.method = CollapseOptions::Sequential;
-  outer.target_length = report.target_length;  // the input's, not the coarse mesh's median
-  outer.max_boundary_error = 0;
-  outer.max_boundary_error_abs = bound;
-  outer.max_iterations = std::max(0, options.max_iterations - int(report.iterations.size()));
-  const int offset = int(report.iterations.size());
-  if (options.progress)
-    outer.progress = [&options, offset](const IterationStats& it) {
-      IterationStats c = it;
-      c.iteration += offset;
-      c.on_host = true;
-      options.progress(c);
-    };
-  const CollapseReport tail = collapse_sequential(mesh, outer);
-  for (IterationStats it : tail.iterations) {
-    it.iteration += offset;
-    it.on_host = true;
-    report.iterations.push_back(it);
-  }
-  report.vertices_out = tail.vertices_out;
-  report.tets_out = tail.tets_out;
-  report.seconds_total += tail.seconds_total;
+  report.vertex_boundary_error = std::move(mesh.vertex_fields.back().values);
+  mesh.vertex_fields.pop_back();
   report.boundary_error_bound = bound;
-  report.boundary_error = tail.boundary_error;
-  report.vertex_boundary_error = tail.vertex_boundary_error;
+  report.boundary_error = 0;
+  for (double e : report.vertex_boundary_error) report.boundary_error = std::max(report.boundary_error, e);
   return report;
 }
 
@@ -114,6 +91,7 @@ void prefetch_programs(Context& ctx, const CollapseOptions& o) {
   if (o.conflicts == CollapseOptions::AtomicMin) ctx.prefetch("collapse_atomic_min.cl");
   if (o.conflicts == CollapseOptions::TwoPass) ctx.prefetch("collapse_conflict.cl");
   ctx.prefetch("collapse_admissible.cl");
+  if (o.bounds_boundary_error()) ctx.prefetch("collapse_bound.cl");
   if (o.boundary != CollapseOptions::Strict) {  // the surface guard
     ctx.prefetch("collapse_guard_applied.cl");
     ctx.prefetch("collapse_guard.cl");
@@ -130,12 +108,24 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   if (options.method == CollapseOptions::Sequential || options.max_field_error > 0)
     return collapse_sequential(mesh, options);
   if (options.bounds_boundary_error()) return collapse_bounded(mesh, options, ctx);
+  return collapse_on_device(mesh, options, ctx);
+}
+
+namespace {
+
+CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
   check_options(options, ctx);
   check_device_memory(ctx, mesh, options);
   prefetch_programs(ctx, options);
   CollapseReport report = report_for(mesh, ctx);
   StageParams p = params_from(options);
   p.eps_v = report.eps_v = volume_threshold(mesh, options);
+  if (options.max_boundary_error_abs > 0) {  // (collapse_bounded)
+    p.bound = options.max_boundary_error_abs;
+    p.eps_col = dm_bound_column(mesh);
+    p.eps_f = 2;  // as the sequential method: a smoothly curved face's vertices are face vertices
+    p.user_defines += " -DTCC_BOUND";  // the selection's test (cl/collapse_select.h)
+  }
   const bool carry = options.tuning.reuse_across_iterations;  // verdicts and connectivity carried
   Stopwatch clock;
   DeviceMesh dm, next;
@@ -198,5 +188,7 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
   report.tets_out = mesh.num_tets();
   return report;
 }
+
+}  // namespace
 
 }  // namespace tc

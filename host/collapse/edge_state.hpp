@@ -24,4 +24,13 @@ struct EdgeState {
   CompactState compact;    // compact.hpp
 };
 
+// Before the selection runs again (after refusals of the surface guard or the boundary error
+// bound): its counters start from zero, but counters[0], marked, stays.
+inline void restart_selection_counters(EdgeState& s) {
+  uint32_t marked = 0;
+  s.cost.counters.download(&marked, 1, 0);
+  s.cost.counters.fill(0u);
+  s.cost.counters.upload(&marked, 1, 0);
+}
+
 }  // namespace tc::collapse_detail

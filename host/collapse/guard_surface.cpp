@@ -272,13 +272,7 @@ uint32_t SurfaceGuard::test_queries(Context& ctx, DeviceMesh& dm, Connectivity& 
         std::fprintf(stderr, "\n");
       }
   }
-  if (refused > 0) {
-    // the selection runs again: its counters start from zero (counters[0], marked, stays)
-    uint32_t marked = 0;
-    s.cost.counters.download(&marked, 1, 0);
-    s.cost.counters.fill(0u);
-    s.cost.counters.upload(&marked, 1, 0);
-  }
+  if (refused > 0) restart_selection_counters(s);
   return refused;
 }
 

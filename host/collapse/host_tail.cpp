@@ -90,9 +90,12 @@ void HostTail::finish(Mesh& mesh, const StageParams& p, CollapseReport& report) 
   };
   sequential_detail::SequentialRun run(mesh, o, seed_.vflags.empty() ? nullptr : &seed_);
   run.set_greedy(true);
+  // the boundary error bound per vertex, in the last vertex field (collapse_bounded)
+  if (p.bound > 0) run.seed_boundary_error(mesh.vertex_fields.back().values);
   while (run.step()) {
   }
   const CollapseReport r = run.finish();
+  if (p.bound > 0) mesh.vertex_fields.back().values = run.boundary_errors();
   for (const IterationStats& t : r.iterations) report.iterations.push_back(continued(t));
   report.seconds_total += r.seconds_total;
 }

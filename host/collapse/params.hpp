@@ -60,6 +60,10 @@ struct StageParams : CheckParams {
   bool waiting_lists = true;
   // Matching selection: a waiting edge's early volume test (cl/collapse_matching.cl; MatchingState::edges_early_tested).
   bool match_early_tests = true;
+  // The boundary error bound in mesh units (0: none; bound.hpp) and the vertex field component
+  // that carries the bound per vertex.
+  double bound = 0;
+  uint32_t eps_col = 0;
 };
 StageParams params_from(const CollapseOptions& o);
 // The options the parallel method refuses (std::invalid_argument), or this device cannot run

@@ -58,7 +58,8 @@ void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, con
            arg("vfield_stride", dm.vfield_comps), arg("vflags", c.vflags), arg("vclass", c.vclass),
            arg("eflags", c.eflags), arg("mode", mode), arg("paper_rule", paper_rule), arg("eps_v", p.eps_v),
            arg("q_min", p.min_quality), arg("field_eps", p.field_eps), arg("tets2quality", quality), arg("edges2dir", s.result.edges2dir), arg("edges2reason", s.result.edges2reason),
-           arg("counters", s.cost.counters), arg("edges2verdict", s.carry.edges2verdict));
+           arg("counters", s.cost.counters), arg("edges2verdict", s.carry.edges2verdict), arg("bound", p.bound),
+           arg("eps_col", p.eps_col));
 }
 
 // The priority of the greedy and matching selections: greedy_priority with levels > 0, else the

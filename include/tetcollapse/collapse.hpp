@@ -212,9 +212,10 @@ struct CollapseOptions {
   // > 0). The bound is carried per vertex and grows by each change of S near it
   // (cl/collapse_surface_error.h); it is conservative, so the measured distance is smaller. With
   // a bound, eps_f is not used: a vertex of a smoothly curved face is a face vertex (ridges and
-  // corners as eps_r says), so curved faces coarsen within the bound. The parallel method
-  // coarsens with S frozen on the device, then S with the sequential method's checks (a vertex
-  // mask applies to both); not with user functions (std::invalid_argument). 0 (both): no bound.
+  // corners as eps_r says), so curved faces coarsen within the bound. The parallel method tests
+  // it on the device (cl/collapse_bound.cl) with the greedy selection whatever `conflicts` says
+  // (the matching selection applies its collapses before the test could read the mesh as it
+  // was); its host tail goes on from the device's bounds. 0 (both): no bound.
   double max_boundary_error = 0;
   double max_boundary_error_abs = 0;
   bool bounds_boundary_error() const { return max_boundary_error > 0 || max_boundary_error_abs > 0; }

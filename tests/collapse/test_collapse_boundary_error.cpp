@@ -146,46 +146,71 @@ TEST(BoundaryErrorRun, TheInterfaceOfTwoMaterialsKeepsItsShapeAndLabels) {
   EXPECT_LT(m.num_tets(), in.num_tets() / 2);
 }
 
-// The parallel method: the device with S frozen, then the host within the bound.
+// The parallel method tests the bound on the device (cl/collapse_bound.cl): the ball within it,
+// refusals counted, the bound per vertex reported, about the sequential method's tet count; the
+// host tail (when it runs) goes on from the device's bounds; with a mask only the selected half
+// coarsens; a user cost keeps the bound too.
 TEST(BoundaryErrorRun, TheParallelMethodKeepsTheBoundToo) {
   const Mesh in = ball(10);
   CollapseOptions o;
   o.target_factor = 2;
   o.max_boundary_error = 0.002;
   Context ctx;
-  Mesh m = in;
-  const CollapseReport r = collapse(m, o, ctx);
-  EXPECT_LE(r.boundary_error, r.boundary_error_bound);
-  EXPECT_GT(r.boundary_error, 0);
-  EXPECT_LE(hausdorff_rel(m, in), 0.002);
-  bool host = false, device = false;
-  for (const auto& it : r.iterations) (it.on_host ? host : device) = true;
-  EXPECT_TRUE(host && device) << "both phases ran";
-  for (size_t i = 0; i < r.iterations.size(); ++i) EXPECT_EQ(r.iterations[i].iteration, int(i)) << "numbered on";
-  EXPECT_LT(m.num_tets(), in.num_tets() / 3);
-  // with a mask: only the selected half (x < 0.5) coarsens, in both phases, within the bound
+  for (double tail : {-1.0, 0.0}) {  // the host tail as the device chooses, or none
+    o.tuning.host_tail = tail;
+    Mesh m = in;
+    const CollapseReport r = collapse(m, o, ctx);
+    const std::string what = tail == 0 ? "device alone" : "with the host tail";
+    EXPECT_LE(r.boundary_error, r.boundary_error_bound) << what;
+    EXPECT_GT(r.boundary_error, 0) << what;
+    EXPECT_LE(hausdorff_rel(m, in), 0.002) << what;
+    ASSERT_EQ(r.vertex_boundary_error.size(), size_t(m.num_vertices())) << what;
+    EXPECT_EQ(m.vertex_fields.size(), in.vertex_fields.size()) << what << ": the bound's field is gone";
+    int64_t refused = 0, on_device = 0;
+    for (const auto& it : r.iterations) {
+      refused += it.refused_by_bound;
+      on_device += !it.on_host;
+    }
+    EXPECT_GT(refused, 0) << what << ": the bound refused some collapses";
+    EXPECT_GT(on_device, 1) << what;
+    for (size_t i = 0; i < r.iterations.size(); ++i) EXPECT_EQ(r.iterations[i].iteration, int(i)) << "numbered on";
+    Mesh seq = in;
+    CollapseOptions so = o;
+    so.method = CollapseOptions::Sequential;
+    collapse_sequential(seq, so);
+    EXPECT_LT(m.num_tets(), in.num_tets() / 3) << what;
+    EXPECT_NEAR(double(m.num_tets()), double(seq.num_tets()), 0.15 * double(seq.num_tets())) << what;
+  }
+  o.tuning.host_tail = -1;
+  // with a mask: only the selected half (x < 0) coarsens, within the bound
   Mesh masked = in;
   o.vertex_mask.assign(size_t(in.num_vertices()), 0);
-  int64_t right = 0;
+  int64_t right = 0, left_on_sphere = 0;
+  const auto on_sphere = [](const double* p) { return std::fabs(std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) - 1) < 1e-9; };
   for (int64_t v = 0; v < in.num_vertices(); ++v) {
     o.vertex_mask[size_t(v)] = in.points[3 * size_t(v)] < 0.0;
     right += !o.vertex_mask[size_t(v)];
+    left_on_sphere += o.vertex_mask[size_t(v)] && on_sphere(&in.points[3 * size_t(v)]);
   }
-  const size_t fields = masked.vertex_fields.size();
   const CollapseReport rm = collapse(masked, o, ctx);
-  EXPECT_EQ(masked.vertex_fields.size(), fields) << "the mask's field is gone";
   EXPECT_LE(hausdorff_rel(masked, in), 0.002);
   EXPECT_LE(rm.boundary_error, rm.boundary_error_bound);
-  int64_t right_after = 0;
-  for (int64_t v = 0; v < masked.num_vertices(); ++v) right_after += masked.points[3 * size_t(v)] >= 0.0;
+  int64_t right_after = 0, left_on_sphere_after = 0;
+  for (int64_t v = 0; v < masked.num_vertices(); ++v) {
+    right_after += masked.points[3 * size_t(v)] >= 0.0;
+    left_on_sphere_after += masked.points[3 * size_t(v)] < 0.0 && on_sphere(&masked.points[3 * size_t(v)]);
+  }
   EXPECT_GE(right_after, right) << "no unselected vertex went (survivors of the left may cross)";
-  EXPECT_LT(masked.num_vertices(), in.num_vertices());
-  bool host_masked = false;
-  for (const auto& it : rm.iterations) host_masked |= it.on_host && it.collapsed > 0;
-  EXPECT_TRUE(host_masked) << "the second phase coarsened the selected part's surface";
-  o.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return 0.0; }";
-  o.target_length = 1;
-  EXPECT_THROW(collapse(masked, o, ctx), std::invalid_argument) << "no user functions with the bound on the device yet";
+  EXPECT_LT(left_on_sphere_after, left_on_sphere) << "the selected part's surface coarsened";
+  // a user cost: the device's test is the same
+  o.vertex_mask.clear();
+  o.cost_cl_source = "double tc_user_cost(double3 p0, double3 p1, double f0, double f1) { return length(p1 - p0); }";
+  o.target_length = 0.4;
+  Mesh user = in;
+  const CollapseReport ru = collapse(user, o, ctx);
+  EXPECT_LE(ru.boundary_error, ru.boundary_error_bound);
+  EXPECT_LE(hausdorff_rel(user, in), 0.002);
+  EXPECT_LT(user.num_tets(), in.num_tets() / 2);
 }
 
 TEST(BoundaryErrorRun, RefusedWhereItCannotHold) {
