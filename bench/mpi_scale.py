@@ -158,7 +158,8 @@ def main():
     configs = []
     with tempfile.TemporaryDirectory() as tmp:
         f = str(a.factor)
-        single = measure("tetcollapse", 1, lambda out, st: [tool, a.mesh, out, "--target-factor", f, "-q", "--stats", st],
+        single = measure("tetcollapse", 1, lambda out, st: [tool, a.mesh, out, "--target-factor", f, "--max-boundary-error", "0",
+                                                            "-q", "--stats", st],
                          tool, a.runs, tmp)
         configs.append(single)
         for n in [int(x) for x in a.ranks.split(",") if x]:

@@ -8,7 +8,8 @@
 Runs, on mesh M with the uniform target edge length L, in this order:
   tetcollapse           tetcollapse M OUT --target-length L            (default options, quality guard 0.1)
   tetcollapse_noimprove ... --no-improve                             (the collapse alone)
-  tetcollapse_bounded   ... --max-boundary-error 0.001
+  tetcollapse_bounded   ... --max-boundary-error 0.001 (the default's bound, given)
+  tetcollapse_unbounded ... --max-boundary-error 0     (no bound: the paper's method)
                                                                        (the boundary error bound, as MMG's -hausd
                                                                         below: 0.001 x the bounding-box diagonal)
   tetcollapse_q0        ... --min-quality 0 --no-improve               (the paper: no quality guard, no
@@ -57,7 +58,7 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-ALL_PEERS = ["tetcollapse", "tetcollapse_noimprove", "tetcollapse_bounded", "tetcollapse_q0", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "mmg3d_hmin", "mmg3d_hmin_nosurf", "mmg3d_hmin_hausd",
+ALL_PEERS = ["tetcollapse", "tetcollapse_noimprove", "tetcollapse_bounded", "tetcollapse_unbounded", "tetcollapse_q0", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "mmg3d_hmin", "mmg3d_hmin_nosurf", "mmg3d_hmin_hausd",
              "cgal_remesh", "tetgen_rR", "tetgen_rR_keepbnd"]
 
 
@@ -265,6 +266,8 @@ def main():
                 cmd += ["--no-improve"]
             if peer == "tetcollapse_bounded":
                 cmd += ["--max-boundary-error", "0.001"]
+            if peer == "tetcollapse_unbounded":
+                cmd += ["--max-boundary-error", "0"]
 
             def alg(stdout, stderr):  # the collapse and the improvement, without I/O
                 with open(stats) as f:

@@ -8,7 +8,8 @@ For each mesh of ../shared/meshes (top level), L = F x the input's median edge l
 bench/peers.py runs, in one process each and one after the other on the same machine:
   tetcollapse            tetcollapse M OUT --target-length L         (defaults: collapse + improvement)
   tetcollapse_noimprove  ... --no-improve                            (the collapse alone)
-  tetcollapse_bounded    ... --max-boundary-error 0.001               (the bound, as -hausd)
+  tetcollapse_bounded    ... --max-boundary-error 0.001               (the default's bound, given)
+  tetcollapse_unbounded  ... --max-boundary-error 0                   (no bound: the paper's method)
   mmg3d_hmin             mmg3d_O3 M.mesh -hmin L                     (MMG3D, coarsening only)
   mmg3d_hmin_hausd       ... -hausd 0.001 x the bounding-box diagonal (MMG's default -hausd 0.01 is
                                                                       in mesh units)
@@ -31,7 +32,8 @@ sys.path.insert(0, HERE)
 import peers  # noqa: E402
 
 SHARED = os.path.join(os.path.dirname(ROOT), "shared", "meshes")
-PEERS = ["tetcollapse", "tetcollapse_noimprove", "tetcollapse_bounded", "mmg3d_hmin", "mmg3d_hmin_hausd"]
+PEERS = ["tetcollapse", "tetcollapse_noimprove", "tetcollapse_bounded", "tetcollapse_unbounded", "mmg3d_hmin",
+         "mmg3d_hmin_hausd"]
 
 
 def fmt(x, spec):

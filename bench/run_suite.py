@@ -201,7 +201,8 @@ class Suite:
         ext = ".meshb"  # output only; the binary Medit writer is the fastest (bench/README.md, I/O)
         cmd = [self.cli, self.mesh_path(mesh), os.path.join(self.work, "out" + ext)]
         cmd += threshold
-        cmd += ["--eps-c", str(eps_c), "--min-quality", repr(self.args.min_quality), "--quiet"]
+        # the paper's method: no boundary error bound (the command's default in features mode)
+        cmd += ["--eps-c", str(eps_c), "--min-quality", repr(self.args.min_quality), "--max-boundary-error", "0", "--quiet"]
         cmd += METHODS[method]
         if device is not None:
             cmd += ["--device", str(device["index"])]

@@ -8,7 +8,7 @@ For every volume mesh in DIR (default ../shared/meshes; every extension the CLI 
 .msh .mesh .meshb .vtk .vtu .node; the sub-folders cad/ and surfaces/ hold STEP files and
 surface meshes only and are not read) and every mode, runs
 
-    tetcollapse IN OUT.vtu --target-factor 1 --boundary MODE --check --stats S.json --quiet
+    tetcollapse IN OUT.vtu --target-factor 1 --boundary MODE --max-boundary-error 0 --check --stats S.json --quiet
 
 and then, on the output when one was written, `tetcollapse check OUT.vtu --reference IN --json`
 for the numbers --check does not put in the statistics (boundary Hausdorff distance, topology,
@@ -57,9 +57,10 @@ def run_one(tc, path, mode, work, timeout):
     for f in (out, stats):
         if os.path.exists(f):
             os.remove(f)
-    cmd = [tc, path, out, "--target-factor", "1", "--boundary", mode, "--check", "--stats", stats, "--quiet"]
+    cmd = [tc, path, out, "--target-factor", "1", "--boundary", mode, "--max-boundary-error", "0", "--check", "--stats", stats,
+           "--quiet"]
     row = {"mesh": name, "mode": mode,
-           "command": f"tetcollapse {name} OUT.vtu --target-factor 1 --boundary {mode} --check --stats S.json",
+           "command": f"tetcollapse {name} OUT.vtu --target-factor 1 --boundary {mode} --max-boundary-error 0 --check --stats S.json",
            "load_avg_before": round(os.getloadavg()[0], 2)}
     t0 = time.perf_counter()
     try:

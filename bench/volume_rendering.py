@@ -10,7 +10,7 @@ Marschner-Lobb signal, the standard volume-rendering test, with its 6 cycles, wh
 this size does not resolve), and the shared `vtkdata_post_pressure.vtk` with its own field.
 Each is coarsened by
 
-    tetcollapse IN OUT --preserve-field F [--field-tolerance T] --boundary B --no-improve
+    tetcollapse IN OUT --preserve-field F [--field-tolerance T] --boundary B --max-boundary-error 0 --no-improve
 
 at T = 0.02 (the paper) in `features` and `free` modes, with `--field-check 0` (the paper's cost
 alone: "paper cost" rows) and `--average-fields` (the survivor's value the average of the edge's
@@ -155,7 +155,7 @@ def main():
         for mesh, field, vtu, mode, t, variant in runs:
             out = os.path.join(work, "out.vtu")
             stats = os.path.join(work, "s.json")
-            cmd = [tc, vtu, out, "--preserve-field", field, "--boundary", mode, "--no-improve", "--stats", stats,
+            cmd = [tc, vtu, out, "--preserve-field", field, "--boundary", mode, "--max-boundary-error", "0", "--no-improve", "--stats", stats,
                    "-q"] + {"": [], "paper cost": ["--field-check", "0"], "averaged": ["--average-fields"]}[variant]
             cmd += ["--field-tolerance", str(t)] if t is not None else ["--max-field-error", str(BOUND)]
             p = subprocess.run(cmd, capture_output=True, text=True)
@@ -192,8 +192,10 @@ def main():
             out, stats = os.path.join(work, "out.vtu"), os.path.join(work, "s.json")
             times = {"preserve_field": [], "w1": []}
             for _ in range(3):
-                for key, cmd in (("preserve_field", [tc, vtu, out, "--preserve-field", "gauss", "--no-improve"]),
-                                 ("w1", [tc, robot, out, "--target-factor", "2", "--eps-c", "0", "--no-improve"])):
+                for key, cmd in (("preserve_field", [tc, vtu, out, "--preserve-field", "gauss", "--max-boundary-error", "0",
+                                                     "--no-improve"]),
+                                 ("w1", [tc, robot, out, "--target-factor", "2", "--eps-c", "0", "--max-boundary-error", "0",
+                                         "--no-improve"])):
                     subprocess.run(cmd + ["--stats", stats, "-q"], check=True)
                     with open(stats) as f:
                         st = json.load(f)

@@ -129,7 +129,7 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
                      py::array_t<int32_t, py::array::c_style | py::array::forcecast> tets, double target_factor,
                      py::object target_length, const std::string& boundary, py::object labels,
                      py::object vertex_fields, py::object device, const std::string& method, bool improve_phase,
-                     double min_quality, double max_boundary_error, bool average_fields,
+                     double min_quality, py::object max_boundary_error, bool average_fields,
                      const std::string& preserve_field, double field_tolerance, double field_check,
                      double max_field_error,
                      const std::string& sizing_field) {
@@ -140,7 +140,10 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
   if (!target_length.is_none()) o.target_length = target_length.cast<double>();
   o.boundary = boundary_of(boundary);
   o.min_quality = min_quality;
-  o.max_boundary_error = max_boundary_error;
+  // the command line's default: a bound in features mode unless one is given (None)
+  o.max_boundary_error = !max_boundary_error.is_none()                ? max_boundary_error.cast<double>()
+                         : o.boundary == CollapseOptions::Features ? kDefaultMaxBoundaryError
+                                                                    : 0.0;
   o.max_field_error = max_field_error;
   co.improve = improve_phase;
   co.resample_fields = !average_fields;
@@ -245,7 +248,7 @@ PYBIND11_MODULE(_core, mod) {
   mod.def("collapse", &collapse_py, py::arg("points"), py::arg("tets"), py::kw_only(), py::arg("target_factor") = 1.0,
           py::arg("target_length") = py::none(), py::arg("boundary") = "features", py::arg("labels") = py::none(),
           py::arg("vertex_fields") = py::none(), py::arg("device") = py::none(), py::arg("method") = "parallel",
-          py::arg("improve") = true, py::arg("min_quality") = 0.1, py::arg("max_boundary_error") = 0.0,
+          py::arg("improve") = true, py::arg("min_quality") = 0.1, py::arg("max_boundary_error") = py::none(),
           py::arg("average_fields") = false, py::arg("preserve_field") = "", py::arg("field_tolerance") = 0.02,
           py::arg("field_check") = CoarsenOptions{}.field_check, py::arg("max_field_error") = 0.0, py::arg("sizing_field") = "",
           "Coarsens a tet mesh; returns a dict: points, tets, labels (if given), vertex_fields, stats.");

@@ -35,6 +35,7 @@ struct CollapseCli {
   CLI::Option* field_tolerance_option = nullptr;
   double field_check = CoarsenOptions{}.field_check;
   CLI::Option* field_check_option = nullptr;
+  CLI::Option* bound_options[2] = {nullptr, nullptr};  // --max-boundary-error(-abs)
   ImproveCli improve;
 };
 
@@ -120,28 +121,33 @@ void register_collapse(CLI::App& app, int& exit_code) {
       ->check(CLI::PositiveNumber);
   app.add_option("--boundary", c->boundary,
                  "strict: boundary vertices never move; features (default): the paper's protection,\n"
-                 "face vertices move along faces, ridge vertices along ridges, corners never;\n"
+                 "face vertices move along faces, ridge vertices along ridges, corners never, within\n"
+                 "--max-boundary-error (default 0.001) of the input's boundary;\n"
                  "free: no protection (e.g. volume-rendering data)")
       ->check(CLI::IsMember({"strict", "features", "free"}));
   app.add_flag("--paper-boundary-rule", c->opt.paper_boundary_rule,
                "Refuse every non-boundary edge that touches the boundary, as the paper does\n"
                "(default: an interior vertex may collapse onto a boundary vertex, which stays put)");
   app.add_flag("--no-labels", c->no_labels, "Do not protect material interfaces between labels");
-  app.add_option("--eps-f", c->opt.eps_f, "Face-vertex threshold on 1 - dot of normals (paper: 0.01)")
+  app.add_option("--eps-f", c->opt.eps_f,
+                 "Face-vertex threshold on 1 - dot of normals (paper: 0.01; not used under a boundary error\n"
+                 "bound, the default in features mode)")
       ->capture_default_str();
   app.add_option("--eps-r", c->opt.eps_r, "Ridge-edge threshold on 1 - dot of normals (paper: 0.1)")
       ->capture_default_str();
-  app.add_option("--max-boundary-error", c->opt.max_boundary_error,
-                 "Features mode: keep the boundary and the material interfaces within E x the input's\n"
-                 "bounding-box diagonal of where they were, both ways (a conservative bound on the two-sided\n"
-                 "Hausdorff distance, carried per vertex); smoothly curved faces then coarsen (--eps-f is not\n"
-                 "used). Tested on the device; the parallel method then selects by --conflicts greedy.\n"
-                 "0 (default): no bound")
-      ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
-  app.add_option("--max-boundary-error-abs", c->opt.max_boundary_error_abs,
-                 "The same bound in mesh units (used instead of --max-boundary-error when > 0)")
-      ->check(CLI::NonNegativeNumber);
+  c->bound_options[0] =
+      app.add_option("--max-boundary-error", c->opt.max_boundary_error,
+                     "Features mode: keep the boundary and the material interfaces within E x the input's\n"
+                     "bounding-box diagonal of where they were, both ways (a conservative bound on the two-sided\n"
+                     "Hausdorff distance, carried per vertex); smoothly curved faces then coarsen (--eps-f is not\n"
+                     "used). Tested on the device; the parallel method then selects by --conflicts greedy.\n"
+                     "Default 0.001 in features mode; 0: no bound (the paper's method: curved faces stay as\n"
+                     "--eps-f says, what moves is not bounded)")
+          ->check(CLI::NonNegativeNumber);
+  c->bound_options[1] =
+      app.add_option("--max-boundary-error-abs", c->opt.max_boundary_error_abs,
+                     "The same bound in mesh units (used instead of --max-boundary-error when > 0)")
+          ->check(CLI::NonNegativeNumber);
   app.add_option("--eps-v", c->opt.eps_v, "Refuse collapses leaving a tet with volume below this (paper: 2e-12)")
       ->capture_default_str();
   app.add_option("--min-quality", c->opt.min_quality,
@@ -204,7 +210,8 @@ void register_collapse(CLI::App& app, int& exit_code) {
                  "sharing an end point with one taken), greedy (one selection under both of the paper's\n"
                  "conflict rules: no two collapses share a tet; about a quarter of matching's collapses\n"
                  "per iteration), two-pass (the paper's pass 1 over edges, then pass 2 over tets) or\n"
-                 "atomic-min (Gautron and Kenzel 2023; needs 64-bit atomics on the device)")
+                 "atomic-min (Gautron and Kenzel 2023; needs 64-bit atomics on the device). Under a boundary\n"
+                 "error bound (the default in features mode) the selection is greedy whatever this says")
       ->check(CLI::IsMember({"greedy", "two-pass", "atomic-min", "matching"}));
   app.add_option("--priority-levels", c->priority_levels,
                  "Matching and greedy conflicts: edges are ordered by their cost in steps of target / N,\n"
@@ -265,6 +272,9 @@ void register_collapse(CLI::App& app, int& exit_code) {
                                    "applies to the greedy and matching conflict detections only (--conflicts greedy|matching)");
       opt.tuning.priority_levels = c->priority_levels;
     }
+    // the default bound, in features mode only (the other modes refuse one given)
+    if (c->bound_options[0]->count() == 0 && c->bound_options[1]->count() == 0)
+      opt.max_boundary_error = opt.boundary == CollapseOptions::Features ? kDefaultMaxBoundaryError : 0.0;
     if (opt.bounds_boundary_error()) {
       if (opt.boundary != CollapseOptions::Features)
         throw CLI::ValidationError("--max-boundary-error",

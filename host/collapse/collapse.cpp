@@ -87,11 +87,19 @@ void prefetch_programs(Context& ctx, const CollapseOptions& o) {
   ctx.prefetch("collapse_connectivity.cl");
   dev::prefetch_scan(ctx);
   ctx.prefetch("collapse_cost.cl");
-  if (o.conflicts == CollapseOptions::Matching) ctx.prefetch("collapse_matching.cl");
-  if (o.conflicts == CollapseOptions::AtomicMin) ctx.prefetch("collapse_atomic_min.cl");
-  if (o.conflicts == CollapseOptions::TwoPass) ctx.prefetch("collapse_conflict.cl");
+  // under a bound the selection is greedy, and the stages' kernels are built with kBoundDefines
+  // (their other kernels without: both variants are used)
+  const bool bounded = o.bounds_boundary_error() && o.method == CollapseOptions::Parallel &&
+                       !(o.max_field_error > 0) && o.placement_cl_source.empty() && o.predicate_cl_source.empty();
+  const CollapseOptions::Conflicts conflicts = o.bounds_boundary_error() ? CollapseOptions::Greedy : o.conflicts;
+  if (conflicts == CollapseOptions::Matching) ctx.prefetch("collapse_matching.cl");
+  if (conflicts == CollapseOptions::AtomicMin) ctx.prefetch("collapse_atomic_min.cl");
+  if (conflicts == CollapseOptions::TwoPass) ctx.prefetch("collapse_conflict.cl");
+  if (conflicts == CollapseOptions::Greedy) ctx.prefetch("collapse_select_greedy.cl");
   ctx.prefetch("collapse_admissible.cl");
-  if (o.bounds_boundary_error()) ctx.prefetch("collapse_bound.cl");
+  if (bounded)
+    for (const char* f : {"collapse_select_greedy.cl", "collapse_admissible.cl", "collapse_bound.cl"})
+      ctx.prefetch(f, kBoundDefines);
   if (o.boundary != CollapseOptions::Strict) {  // the surface guard
     ctx.prefetch("collapse_guard_applied.cl");
     ctx.prefetch("collapse_guard.cl");
@@ -124,7 +132,7 @@ CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Co
     p.bound = options.max_boundary_error_abs;
     p.eps_col = dm_bound_column(mesh);
     p.eps_f = 2;  // as the sequential method: a smoothly curved face's vertices are face vertices
-    p.user_defines += " -DTCC_BOUND";  // the selection's test (cl/collapse_select.h)
+    p.user_defines += kBoundDefines;  // the selection's test (cl/collapse_select.h)
   }
   const bool carry = options.tuning.reuse_across_iterations;  // verdicts and connectivity carried
   Stopwatch clock;

@@ -65,6 +65,8 @@ struct StageParams : CheckParams {
   double bound = 0;
   uint32_t eps_col = 0;
 };
+// The build option of the stages' programs under a boundary error bound (in user_defines).
+constexpr const char* kBoundDefines = " -DTCC_BOUND";
 StageParams params_from(const CollapseOptions& o);
 // The options the parallel method refuses (std::invalid_argument), or this device cannot run
 // (tc::DeviceError).

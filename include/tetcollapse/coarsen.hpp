@@ -55,6 +55,11 @@ struct CoarsenReport {
   int64_t outside = 0;        // vertices outside the input whose fields came from the nearest tet
 };
 
+// The boundary error bound (CollapseOptions::max_boundary_error, a share of the bounding-box
+// diagonal) that the command lines and the Python module apply in features mode unless told
+// otherwise (0 there: none, the paper's method). CollapseOptions itself keeps 0.
+constexpr double kDefaultMaxBoundaryError = 0.001;
+
 // The share of a boundary error bound the collapse may use when the improvement phase follows
 // (the rest is for the improvement's boundary moves, which remove the slivers at a curved
 // surface).

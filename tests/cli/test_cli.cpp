@@ -1,6 +1,7 @@
 // The command line as a user meets it: exit codes, messages, --help, --json keys.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <iterator>
@@ -286,15 +287,45 @@ TEST(Cli, AFirstRunShowsTheCompileProgress) {
   EXPECT_EQ(out.find("compil"), std::string::npos) << out;
 }
 
+// The boundary error bound by default in features mode (0.001 x the diagonal, 4.657 on the
+// bracket), none in strict mode or with 0; given with strict, refused.
+TEST(Cli, ABoundaryErrorBoundByDefaultInFeaturesMode) {
+  tc::test::TempDir dir;
+  std::string out;
+  const std::string stats = dir.file("s.json");
+  const auto bound = [&](const std::string& opts) {
+    EXPECT_EQ(run_command(cli() + " " + q(tc::test::project_mesh("bracket.msh")) + " " + q(dir.file("o.msh")) +
+                              " --target-factor 2 -q --stats " + q(stats) + " " + opts,
+                          &out),
+              0)
+        << opts << "\n" << out;
+    const std::string s = tc::test::read_text(stats);
+    const size_t at = s.find("\"boundary_error_bound\":");
+    return at == std::string::npos ? -1.0 : std::atof(s.c_str() + at + 23);
+  };
+  EXPECT_NEAR(bound(""), 0.001 * std::sqrt(4.0 * 4 + 2 * 2 + 1.3 * 1.3), 1e-12);
+  EXPECT_EQ(bound("--max-boundary-error 0"), 0.0);
+  EXPECT_EQ(bound("--boundary strict"), 0.0);
+  EXPECT_NEAR(bound("--max-boundary-error-abs 0.01"), 0.01, 1e-15);
+  EXPECT_EQ(run_command(cli() + " " + q(tc::test::project_mesh("bracket.msh")) + " " + q(dir.file("o.msh")) +
+                            " --boundary strict --max-boundary-error 0.001",
+                        &out),
+            2)
+      << out;
+}
+
 TEST(Cli, KernelProfileTableAndTheSameResult) {
   tc::test::TempDir dir;
   std::string out;
   const std::string in = q(tc::test::project_mesh("bracket.msh")), a = dir.file("a.vtu"), b = dir.file("b.vtu");
-  ASSERT_EQ(run_command("TETCOLLAPSE_PROFILE_KERNELS=1 " + cli() + " " + in + " " + q(a) + " -q", &out), 0) << out;
+  // (the matching selection's kernels: without the default boundary error bound, which selects greedily)
+  ASSERT_EQ(run_command("TETCOLLAPSE_PROFILE_KERNELS=1 " + cli() + " " + in + " " + q(a) + " -q --max-boundary-error 0", &out),
+            0)
+      << out;
   EXPECT_NE(out.find("kernel profile (TETCOLLAPSE_PROFILE_KERNELS)"), std::string::npos) << out;
   for (const char* k : {"match_decide", "match_apply", "conn_ring_sort_and_gather", "cost_and_mark", "sguard_surface"})
     EXPECT_NE(out.find(std::string("\n  ") + k + " "), std::string::npos) << k << " not in " << out;
-  ASSERT_EQ(run_command(cli() + " " + in + " " + q(b) + " -q", &out), 0) << out;
+  ASSERT_EQ(run_command(cli() + " " + in + " " + q(b) + " -q --max-boundary-error 0", &out), 0) << out;
   EXPECT_TRUE(out.empty()) << out;  // off by default: quiet stays quiet
   EXPECT_EQ(tc::test::read_text(a), tc::test::read_text(b));
 }

@@ -59,6 +59,18 @@ class Module(unittest.TestCase):
             self.assertEqual(out["stats"]["tets_out"], out["tets"].shape[0])
             self.assertTrue(tetcollapse.check(out["points"], out["tets"])["valid"])
 
+    def test_the_command_lines_boundary_error_bound_by_default(self):
+        # features mode: 0.001 of the diagonal unless given; none in the other modes or with 0
+        points, tets = cube(4)
+        diagonal = np.sqrt(3.0)
+        bound = lambda **kw: tetcollapse.collapse(points, tets, target_factor=2, **kw)["stats"]["boundary_error_bound"]  # noqa: E731
+        self.assertAlmostEqual(bound(), 0.001 * diagonal, places=12)
+        self.assertAlmostEqual(bound(max_boundary_error=0.01), 0.01 * diagonal, places=12)
+        self.assertEqual(bound(max_boundary_error=0.0), 0.0)
+        self.assertEqual(bound(boundary="strict"), 0.0)
+        with self.assertRaises(ValueError):
+            bound(boundary="strict", max_boundary_error=0.01)
+
     def test_field_options_of_the_command_line(self):
         points, tets = cube(8)
         rng = np.random.default_rng(5)
