@@ -22,7 +22,6 @@ results files:
     quality_peers   bench/results/quality_peers.json                    (bench/quality_peers.py; its table)
     improve_slivers bench/results/improve_slivers.json                  (bench/improve_slivers.py; its table)
     improve_paths   bench/results/improve_paths.json                    (bench/improve_paths.py; its tables)
-    boundary_error  bench/results/boundary_error.json                   (bench/quality_peers.py; its table)
     volume_rendering bench/results/volume_rendering.json               (bench/volume_rendering.py; its table)
     cold_start      bench/results/cold_start.json                       (bench/cold_start.py; its table)
     mpi_scale       bench/results/mpi_scale.json                        (bench/mpi_scale.py; its table)
@@ -374,7 +373,6 @@ BLOCKS = {
     "quality_peers": lambda: recorded_block("quality_peers", "quality_peers"),
     "improve_slivers": lambda: recorded_block("improve_slivers", "improve_slivers"),
     "improve_paths": lambda: recorded_block("improve_paths", "improve_paths"),
-    "boundary_error": lambda: recorded_block("boundary_error", "quality_peers"),
     "volume_rendering": lambda: recorded_block("volume_rendering", "volume_rendering"),
     "cold_start": lambda: recorded_block("cold_start", "cold_start"),
     "python_overhead": lambda: recorded_block("python_overhead", "python_overhead"),
