@@ -1,6 +1,7 @@
 // The parallel method: the paper's Algorithm 1 over the stages of host/collapse/, one file each
 // (the header tetcollapse/collapse.hpp gives the algorithm in pseudocode).
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <memory>
 
@@ -59,21 +60,33 @@ CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Cont
     throw std::invalid_argument(
         "max_boundary_error applies to the features boundary mode (strict keeps the boundary exactly, free does not "
         "bound it)");
+  if (!(options.max_boundary_error >= 0) || !(options.max_boundary_error_abs >= 0) ||
+      std::isinf(options.max_boundary_error) || std::isinf(options.max_boundary_error_abs))
+    throw std::invalid_argument("max_boundary_error and max_boundary_error_abs must be finite and >= 0");
+  if (options.field_difference_cost && mesh.vertex_fields.empty())
+    throw std::invalid_argument("field_difference_cost needs an explicit target_length > 0 and a vertex field");
   const double bound = boundary_error_bound(mesh, options);
   CollapseOptions o = options;
   o.max_boundary_error = 0;
   o.max_boundary_error_abs = bound;
   o.conflicts = CollapseOptions::Greedy;
-  mesh.vertex_fields.push_back({kBoundField, 1, std::vector<double>(size_t(mesh.num_vertices()), 0.0)});
+  o.selection_rounds = 1;  // (a two-pass option)
+  // The user's functions read the first vertex field as f0 (0 when there is none): a field of
+  // zeros keeps the bound's field from being the first.
+  const size_t added = mesh.vertex_fields.empty() && options.has_user_functions() ? 2 : 1;
+  const size_t nv = size_t(mesh.num_vertices());
+  if (added == 2) mesh.vertex_fields.push_back({"tetcollapse:none", 1, std::vector<double>(nv, 0.0)});
+  mesh.vertex_fields.push_back({kBoundField, 1, std::vector<double>(nv, 0.0)});
+  const auto drop_added = [&] { mesh.vertex_fields.resize(mesh.vertex_fields.size() - added); };
   CollapseReport report;
   try {
     report = collapse_on_device(mesh, o, ctx);
   } catch (...) {
-    if (!mesh.vertex_fields.empty() && mesh.vertex_fields.back().name == kBoundField) mesh.vertex_fields.pop_back();
+    drop_added();
     throw;
   }
   report.vertex_boundary_error = std::move(mesh.vertex_fields.back().values);
-  mesh.vertex_fields.pop_back();
+  drop_added();
   report.boundary_error_bound = bound;
   report.boundary_error = 0;
   for (double e : report.vertex_boundary_error) report.boundary_error = std::max(report.boundary_error, e);

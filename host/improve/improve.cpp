@@ -174,18 +174,23 @@ int64_t collapse_bad(Mesh& mesh, ImproveOptions& options, bool harmonic) {
     spent.resize(size_t(mesh.num_vertices()), 0.0);
     mesh.vertex_fields.push_back({"tetcollapse:boundary_error", 1, std::move(spent)});
   }
-  StarMesh star = star_mesh(mesh, mask);
-  o.vertex_mask.resize(star.verts.size());
-  for (size_t i = 0; i < star.verts.size(); ++i) o.vertex_mask[i] = mask[size_t(star.verts[i])];
-  sequential_detail::SequentialRun run(star.mesh, o);
-  run.keep_origin();
-  if (bounded) run.seed_boundary_error(star.mesh.vertex_fields.back().values);
-  while (run.step()) {
-  }
   int64_t collapsed = 0;
-  for (const IterationStats& it : run.finish().iterations) collapsed += it.collapsed;
-  if (bounded) star.mesh.vertex_fields.back().values = run.boundary_errors();
-  if (collapsed > 0) splice(mesh, star, run);
+  try {
+    StarMesh star = star_mesh(mesh, mask);
+    o.vertex_mask.resize(star.verts.size());
+    for (size_t i = 0; i < star.verts.size(); ++i) o.vertex_mask[i] = mask[size_t(star.verts[i])];
+    sequential_detail::SequentialRun run(star.mesh, o);
+    run.keep_origin();
+    if (bounded) run.seed_boundary_error(star.mesh.vertex_fields.back().values);
+    while (run.step()) {
+    }
+    for (const IterationStats& it : run.finish().iterations) collapsed += it.collapsed;
+    if (bounded) star.mesh.vertex_fields.back().values = run.boundary_errors();
+    if (collapsed > 0) splice(mesh, star, run);
+  } catch (...) {
+    if (bounded) mesh.vertex_fields.pop_back();  // (the bound's field, last)
+    throw;
+  }
   if (bounded) {
     options.vertex_boundary_error = std::move(mesh.vertex_fields.back().values);
     mesh.vertex_fields.pop_back();
@@ -199,6 +204,10 @@ ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) 
   ImproveReport report;
   report.before = quality_summary(mesh);
   // Under a boundary error bound, options.vertex_boundary_error follows each stage's changes.
+  if (given.max_boundary_error_abs > 0 && given.boundary != CollapseOptions::Features)
+    throw std::invalid_argument(
+        "max_boundary_error_abs applies to the features boundary mode (strict keeps the boundary exactly, free does "
+        "not bound it)");
   ImproveOptions options = given;
   passes(mesh, options, ctx, options.max_iterations, report, true);
   // Rounds of the collapse step and the passes after it, while a round raises the smallest angle

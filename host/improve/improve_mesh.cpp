@@ -254,6 +254,23 @@ double slab_distance(const tc_d3* olds, const tc_d3* news, int n, tc_d3 o, tc_d3
   return hi - lo + 1e-12 * scale;
 }
 
+// A move by `moved` along a line of direction `dir` (its fan two sheets meeting there): when
+// every triangle's plane holds the direction, two triangles of a sheet sharing an edge off the
+// line lie in one plane (their planes meet in that edge, which would otherwise be parallel to
+// the line), so each sheet is planar and the move re-triangulates it in place; the triangles'
+// tilt against the direction bounds what is left.
+double line_distance(const tc_d3* olds, int n, double moved, tc_d3 dir) {
+  double tilt = 0;
+  for (int i = 0; i < n; ++i) {
+    const tc_d3* t = olds + 3 * i;
+    const tc_d3 c = geo::cross(t[1] - t[0], t[2] - t[0]);
+    const double l = geo::length(c);
+    if (!(l > 0)) return std::numeric_limits<double>::infinity();
+    tilt = std::max(tilt, std::fabs(geo::dot(c, dir)) / l);
+  }
+  return tilt <= 1e-9 ? moved * tilt : std::numeric_limits<double>::infinity();
+}
+
 }  // namespace
 
 double ImpMesh::boundary_error_at(int32_t v, tc_d3 p) const {
@@ -291,11 +308,15 @@ double ImpMesh::boundary_error_at(int32_t v, tc_d3 p) const {
       ++n;
     }
   }
-  // A move along a line (its fan is two sheets) or of a fan the test cannot bound: every point
-  // of the fan moves by at most what v does.
+  // A fan the test cannot bound: every point of the fan moves by at most what v does.
   const double moved = geo::length(p - here);
-  double fan = fits && motion(v) == kInPlane ? geo::tcc_fan_distance(olds, n, news, n) : moved;
-  if (fits && motion(v) == kInPlane && !(fan < moved)) fan = std::min(fan, slab_distance(olds, news, n, here, normal_[size_t(v)]));
+  double fan = moved;
+  if (fits && motion(v) == kInPlane) {
+    fan = geo::tcc_fan_distance(olds, n, news, n);
+    if (!(fan < moved)) fan = std::min(fan, slab_distance(olds, news, n, here, normal_[size_t(v)]));
+  } else if (fits && motion(v) == kAlongLine) {
+    fan = std::min(moved, line_distance(olds, n, moved, normal_[size_t(v)]));
+  }
   return std::min(base + std::min(fan, moved), base_start + shift);
 }
 
@@ -368,15 +389,19 @@ bool ImpMesh::replace_on_boundary(const std::vector<int32_t>& old, const std::ve
     double e = 0;
     for (const auto& g : gone)
       for (int32_t v : g) e = std::max(e, err_[size_t(v)]);
-    // and the bound by displacement starts again from here: what the quad's corners reached
-    double s = 0;
+    // and the bound by displacement: the old triangles were within max A + max D (A their
+    // corners' start bounds, D their displacements), and a corner's move since is at most its
+    // displacement now plus max D, so the corners' start bounds become max A + 2 max D
+    double a = 0, d = 0;
     for (const auto& g : gone)
-      for (int32_t v : g) s = std::max(s, err_start_[size_t(v)] + geo::length(point(v) - start_[size_t(v)]));
+      for (int32_t v : g) {
+        a = std::max(a, err_start_[size_t(v)]);
+        d = std::max(d, geo::length(point(v) - start_[size_t(v)]));
+      }
     for (const auto& g : gone)
       for (int32_t v : g) {
         err_[size_t(v)] = e;
-        err_start_[size_t(v)] = s;
-        start_[size_t(v)] = point(v);
+        err_start_[size_t(v)] = std::max(err_start_[size_t(v)], a + 2 * d);
       }
   }
   replace(old, added, old[0]);
@@ -453,9 +478,9 @@ void ImpMesh::mark_motion(const ImproveOptions& options) {
     if (bend > kStraight) {
       if (!may_bend) continue;
       max_offset_[size_t(v)] = bounded_ && lines != 0 ? max_boundary_move_ : max_boundary_move_ / bend;
-    } else if (bounded_ && lines == 0) {
-      // Under the bound a flat patch's vertex is accounted as a curved one's: once a neighbour
-      // has moved, its fan is no longer flat.
+    } else if (bounded_) {
+      // Under the bound a flat patch's or a straight line's vertex is accounted as a curved
+      // one's: once a neighbour has moved, its fan is no longer flat.
       max_offset_[size_t(v)] = max_boundary_move_ / kStraight;
     }
     motion_[size_t(v)] = lines == 0 ? kInPlane : kAlongLine;

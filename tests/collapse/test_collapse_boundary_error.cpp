@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <stdexcept>
 
@@ -211,6 +212,22 @@ TEST(BoundaryErrorRun, TheParallelMethodKeepsTheBoundToo) {
   EXPECT_LE(ru.boundary_error, ru.boundary_error_bound);
   EXPECT_LE(hausdorff_rel(user, in), 0.002);
   EXPECT_LT(user.num_tets(), in.num_tets() / 2);
+  // the user's f0 and f1 stay 0 on a mesh without fields (the bound's field is not the first)
+  o.cost_cl_source.clear();
+  o.target_length = 0;
+  o.predicate_cl_source = "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) { return 1; }";
+  Mesh any = in;
+  collapse(any, o, ctx);
+  o.predicate_cl_source =
+      "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) { return f0 == 0.0 && f1 == 0.0; }";
+  Mesh zero = in;
+  collapse(zero, o, ctx);
+  EXPECT_EQ(zero.tets, any.tets) << "f0 and f1 are 0 without fields";
+  EXPECT_TRUE(zero.vertex_fields.empty());
+  o.predicate_cl_source.clear();
+  o.max_boundary_error = std::numeric_limits<double>::infinity();
+  Mesh inf = in;
+  EXPECT_THROW(collapse(inf, o, ctx), std::invalid_argument) << "an infinite bound";
 }
 
 TEST(BoundaryErrorRun, RefusedWhereItCannotHold) {

@@ -108,6 +108,11 @@ TEST(Coarsen, TheImprovementKeepsTheBoundVertexByVertex) {
   EXPECT_GT(surface_moves(c.vertex_boundary_error), 0) << "the improvement moves vertices of the sphere";
   EXPECT_EQ(surface_moves(std::vector<double>(size_t(collapsed.num_vertices()), boundary_error_bound(in, co.collapse))), 0)
       << "nothing is left to spend";
+  ImproveOptions free_mode;
+  free_mode.boundary = CollapseOptions::Free;
+  free_mode.max_boundary_error_abs = 0.01;
+  Mesh x = collapsed;
+  EXPECT_THROW(improve(x, free_mode, ctx), std::invalid_argument) << "the bound is the features mode's";
 }
 
 // No improvement phase under the field error bound (its moves are not checked against it) or a
