@@ -1,7 +1,6 @@
 // The parallel method: the paper's Algorithm 1 over the stages of host/collapse/, one file each
 // (the header tetcollapse/collapse.hpp gives the algorithm in pseudocode).
 #include <algorithm>
-#include <cmath>
 #include <stdexcept>
 #include <memory>
 
@@ -37,10 +36,6 @@ CollapseReport report_for(const Mesh& mesh, const Context& ctx) {
 
 namespace {
 
-// The hidden vertex field that carries the boundary error bound per vertex through the run
-// (collapse/bound.hpp).
-constexpr const char* kBoundField = "tetcollapse:boundary_error";
-
 CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Context& ctx);
 
 // The bound's column in the packed vertex fields: the last component (of kBoundField, last).
@@ -56,13 +51,7 @@ uint32_t dm_bound_column(const Mesh& mesh) {
 // one: the matching selection applies its collapses before the tests, which read the mesh
 // before them.
 CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
-  if (options.boundary != CollapseOptions::Features)
-    throw std::invalid_argument(
-        "max_boundary_error applies to the features boundary mode (strict keeps the boundary exactly, free does not "
-        "bound it)");
-  if (!(options.max_boundary_error >= 0) || !(options.max_boundary_error_abs >= 0) ||
-      std::isinf(options.max_boundary_error) || std::isinf(options.max_boundary_error_abs))
-    throw std::invalid_argument("max_boundary_error and max_boundary_error_abs must be finite and >= 0");
+  check_boundary_error_options(options);
   if (options.field_difference_cost && mesh.vertex_fields.empty())
     throw std::invalid_argument("field_difference_cost needs an explicit target_length > 0 and a vertex field");
   const double bound = boundary_error_bound(mesh, options);

@@ -8,6 +8,16 @@
 
 namespace tc::collapse_detail {
 
+void check_boundary_error_options(const CollapseOptions& o) {
+  if (!(o.max_boundary_error >= 0) || !(o.max_boundary_error_abs >= 0) || std::isinf(o.max_boundary_error) ||
+      std::isinf(o.max_boundary_error_abs))
+    throw std::invalid_argument("max_boundary_error and max_boundary_error_abs must be finite and >= 0");
+  if (o.bounds_boundary_error() && o.boundary != CollapseOptions::Features)
+    throw std::invalid_argument(
+        "max_boundary_error applies to the features boundary mode (strict keeps the boundary exactly, free "
+        "does not bound it)");
+}
+
 CheckParams check_params_from(const CollapseOptions& o) {
   CheckParams p;
   p.mode = o.boundary == CollapseOptions::Strict ? 0 : o.boundary == CollapseOptions::Features ? 1 : 2;

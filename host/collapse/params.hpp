@@ -67,6 +67,12 @@ struct StageParams : CheckParams {
 };
 // The build option of the stages' programs under a boundary error bound (in user_defines).
 constexpr const char* kBoundDefines = " -DTCC_BOUND";
+// The hidden last vertex field that carries the boundary error bound per vertex through a run
+// on the device or through the improvement's collapse step (popped before the caller sees it).
+constexpr const char* kBoundField = "tetcollapse:boundary_error";
+// The boundary error bound's options, for both methods (std::invalid_argument): finite, >= 0,
+// and only in the features mode.
+void check_boundary_error_options(const CollapseOptions& o);
 StageParams params_from(const CollapseOptions& o);
 // The options the parallel method refuses (std::invalid_argument), or this device cannot run
 // (tc::DeviceError).

@@ -34,13 +34,7 @@ SeqParams checked_params(const Mesh& mesh, const CollapseOptions& o) {
   if (!o.vertex_mask.empty() && o.vertex_mask.size() != size_t(mesh.num_vertices()))
     throw std::invalid_argument("vertex_mask has " + std::to_string(o.vertex_mask.size()) + " entries for " +
                                 std::to_string(mesh.num_vertices()) + " vertices");
-  if (!(o.max_boundary_error >= 0) || !(o.max_boundary_error_abs >= 0) || std::isinf(o.max_boundary_error) ||
-      std::isinf(o.max_boundary_error_abs))
-    throw std::invalid_argument("max_boundary_error and max_boundary_error_abs must be finite and >= 0");
-  if (o.bounds_boundary_error() && o.boundary != CollapseOptions::Features)
-    throw std::invalid_argument(
-        "max_boundary_error applies to the features boundary mode (strict keeps the boundary exactly, free "
-        "does not bound it)");
+  collapse_detail::check_boundary_error_options(o);
   if (!(o.max_field_error >= 0) || std::isinf(o.max_field_error))
     throw std::invalid_argument("max_field_error must be finite and >= 0");
   if (o.field_difference_cost && (!(o.target_length > 0) || mesh.vertex_fields.empty()))

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "collapse/params.hpp"
 #include "collapse/programs.hpp"
 #include "collapse/sequential_run.hpp"
 #include "improve/improve_mesh.hpp"
@@ -172,7 +173,7 @@ int64_t collapse_bad(Mesh& mesh, ImproveOptions& options, bool harmonic) {
     o.max_boundary_error_abs = options.max_boundary_error_abs;
     std::vector<double> spent = options.vertex_boundary_error;
     spent.resize(size_t(mesh.num_vertices()), 0.0);
-    mesh.vertex_fields.push_back({"tetcollapse:boundary_error", 1, std::move(spent)});
+    mesh.vertex_fields.push_back({collapse_detail::kBoundField, 1, std::move(spent)});
   }
   int64_t collapsed = 0;
   try {

@@ -79,8 +79,8 @@ ImpMesh::ImpMesh(Mesh& mesh, const ImproveOptions& options) : mesh_(mesh), point
                                 std::to_string(nv) + " vertices");
   mask_ = options.vertex_mask;
   if (options.max_boundary_error_abs > 0 && options.boundary != CollapseOptions::Strict) {
-    // A boundary error bound: every point of S moves by at most what its vertices do, so S
-    // stays within the bound when no vertex gets further than it from where it started.
+    // A boundary error bound, carried per vertex (boundary_error_at), from what earlier changes
+    // of S spent.
     bounded_ = true;
     max_boundary_move_ = options.max_boundary_error_abs;
     err_ = options.vertex_boundary_error;
@@ -385,16 +385,14 @@ bool ImpMesh::replace_on_boundary(const std::vector<int32_t>& old, const std::ve
       for (int32_t v : tets_[size_t(t)]) motion_[size_t(v)] = kFixed;
   // Under the bound: the new triangles cover what the old ones did, whose corners' bounds they
   // take (their own corners are three of the quad's four).
+  // And the bound by displacement: the old triangles were within max A + max D (A their
+  // corners' start bounds, D their displacements), and a corner's move since is at most its
+  // displacement now plus max D, so the corners' start bounds become max A + 2 max D.
   if (bounded_) {
-    double e = 0;
-    for (const auto& g : gone)
-      for (int32_t v : g) e = std::max(e, err_[size_t(v)]);
-    // and the bound by displacement: the old triangles were within max A + max D (A their
-    // corners' start bounds, D their displacements), and a corner's move since is at most its
-    // displacement now plus max D, so the corners' start bounds become max A + 2 max D
-    double a = 0, d = 0;
+    double e = 0, a = 0, d = 0;
     for (const auto& g : gone)
       for (int32_t v : g) {
+        e = std::max(e, err_[size_t(v)]);
         a = std::max(a, err_start_[size_t(v)]);
         d = std::max(d, geo::length(point(v) - start_[size_t(v)]));
       }
