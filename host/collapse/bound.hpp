@@ -1,5 +1,5 @@
 // The boundary error bound on the device (cl/collapse_bound.cl): the selection's test refuses
-// what exceeds it (kernels built with -DTCC_BOUND, StageParams::user_defines); after it, the
+// what exceeds it (programs built with kBoundDefines for the run); after it, the
 // chosen collapses that change S get their new bounds (and, as a safeguard, any over the bound
 // is refused), written on the survivors once the selection is final. The bound per vertex is the last vertex field component
 // (StageParams::eps_col), which collapse() adds for the run.

@@ -86,22 +86,19 @@ CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Cont
 
 namespace collapse_detail {
 void prefetch_programs(Context& ctx, const CollapseOptions& o) {
+  // under a bound the selection is greedy, and every program is built with kBoundDefines
+  const bool bounded = o.bounds_boundary_error() && o.method == CollapseOptions::Parallel && !(o.max_field_error > 0);
+  const Context::ProgramOptions variant(ctx, bounded ? kBoundDefines : "");
   ctx.prefetch("collapse_connectivity.cl");
   dev::prefetch_scan(ctx);
   ctx.prefetch("collapse_cost.cl");
-  // under a bound the selection is greedy, and the stages' kernels are built with kBoundDefines
-  // (their other kernels without: both variants are used)
-  const bool bounded = o.bounds_boundary_error() && o.method == CollapseOptions::Parallel &&
-                       !(o.max_field_error > 0) && o.placement_cl_source.empty() && o.predicate_cl_source.empty();
   const CollapseOptions::Conflicts conflicts = o.bounds_boundary_error() ? CollapseOptions::Greedy : o.conflicts;
   if (conflicts == CollapseOptions::Matching) ctx.prefetch("collapse_matching.cl");
   if (conflicts == CollapseOptions::AtomicMin) ctx.prefetch("collapse_atomic_min.cl");
   if (conflicts == CollapseOptions::TwoPass) ctx.prefetch("collapse_conflict.cl");
   if (conflicts == CollapseOptions::Greedy) ctx.prefetch("collapse_select_greedy.cl");
   ctx.prefetch("collapse_admissible.cl");
-  if (bounded)
-    for (const char* f : {"collapse_select_greedy.cl", "collapse_admissible.cl", "collapse_bound.cl"})
-      ctx.prefetch(f, kBoundDefines);
+  if (bounded) ctx.prefetch("collapse_bound.cl");
   if (o.boundary != CollapseOptions::Strict) {  // the surface guard
     ctx.prefetch("collapse_guard_applied.cl");
     ctx.prefetch("collapse_guard.cl");
@@ -126,6 +123,7 @@ namespace {
 CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
   check_options(options, ctx);
   check_device_memory(ctx, mesh, options);
+  const Context::ProgramOptions variant(ctx, options.max_boundary_error_abs > 0 ? kBoundDefines : "");
   prefetch_programs(ctx, options);
   CollapseReport report = report_for(mesh, ctx);
   StageParams p = params_from(options);
@@ -134,7 +132,6 @@ CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Co
     p.bound = options.max_boundary_error_abs;
     p.eps_col = dm_bound_column(mesh);
     p.eps_f = 2;  // as the sequential method: a smoothly curved face's vertices are face vertices
-    p.user_defines += kBoundDefines;  // the selection's test (cl/collapse_select.h)
   }
   const bool carry = options.tuning.reuse_across_iterations;  // verdicts and connectivity carried
   Stopwatch clock;

@@ -65,8 +65,9 @@ struct StageParams : CheckParams {
   double bound = 0;
   uint32_t eps_col = 0;
 };
-// The build option of the stages' programs under a boundary error bound (in user_defines).
-constexpr const char* kBoundDefines = " -DTCC_BOUND";
+// The build option of every program of a run under a boundary error bound
+// (Context::ProgramOptions: each program is built in one variant per run).
+constexpr const char* kBoundDefines = "-DTCC_BOUND";
 // The hidden last vertex field that carries the boundary error bound per vertex through a run
 // on the device or through the improvement's collapse step (popped before the caller sees it).
 constexpr const char* kBoundField = "tetcollapse:boundary_error";

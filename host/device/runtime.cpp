@@ -510,6 +510,7 @@ std::string Context::options_as_built(const std::string& options) const {
   // (host/collapse/launch.hpp)
   opts += " -cl-kernel-arg-info";
   if (!options.empty()) opts += " " + options;
+  if (!run_options_.empty()) opts += " " + run_options_;
   if (const char* extra = std::getenv("TETCOLLAPSE_CL_OPTIONS"); extra && *extra) opts += std::string(" ") + extra;
   return opts;
 }

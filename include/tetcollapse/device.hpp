@@ -126,6 +126,23 @@ class Context {
   // nor the disk cache, so that a first run compiles the programs it will use on every core
   // while it waits for the first of them; program() then takes the result.
   void prefetch(const std::string& file, const std::string& options = "");
+  // Build options added to every program built or prefetched while it lives, after the call's
+  // own: the variant a whole run needs (the collapse under a boundary error bound compiles every
+  // program with -DTCC_BOUND), set once for the run so that each program is built once and not in
+  // two variants. Scopes nest; the innermost applies.
+  class ProgramOptions {
+   public:
+    ProgramOptions(Context& ctx, std::string options) : ctx_(ctx), saved_(std::move(ctx.run_options_)) {
+      ctx.run_options_ = std::move(options);
+    }
+    ~ProgramOptions() { ctx_.run_options_ = std::move(saved_); }
+    ProgramOptions(const ProgramOptions&) = delete;
+    ProgramOptions& operator=(const ProgramOptions&) = delete;
+
+   private:
+    Context& ctx_;
+    std::string saved_;
+  };
 
   // Enqueues a 1-D launch of n work items: the global size is n rounded up to a multiple of the
   // work-group size, so kernels must check their global id against n. `what` names the kernel
@@ -173,6 +190,7 @@ class Context {
   BuildSource last_build_source_ = BuildSource::Memory;
   std::function<void(const std::string&, int, int)> compile_notice_;
   int compiles_done_ = 0, compiles_total_ = 0;
+  std::string run_options_;  // (ProgramOptions)
   std::unique_ptr<device_detail::CompilePool> pool_;  // made at the first compile from source
 };
 

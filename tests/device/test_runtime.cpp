@@ -397,6 +397,27 @@ TEST_F(RuntimeCtx, FilesOfAGroupShareOneProgram) {
   EXPECT_NE(&ctx_->program("scan.cl"), &cost) << "a file of no group is a program of its own";
 }
 
+// Options set for a scope reach every program built in it, after the call's own; the scope
+// ends, the programs without them come back; the innermost scope applies.
+TEST_F(RuntimeCtx, ProgramOptionsApplyToEveryProgramOfTheirScope) {
+  const auto options = [&](cl::Program& p) { return p.getBuildInfo<CL_PROGRAM_BUILD_OPTIONS>(ctx_->device()); };
+  cl::Program& plain = ctx_->program("scan.cl");
+  EXPECT_EQ(options(plain).find("-DTCC_VARIANT"), std::string::npos);
+  {
+    const tc::Context::ProgramOptions variant(*ctx_, "-DTCC_VARIANT");
+    cl::Program& scan = ctx_->program("scan.cl");
+    EXPECT_NE(&scan, &plain);
+    EXPECT_NE(options(scan).find("-DTCC_VARIANT"), std::string::npos) << options(scan);
+    EXPECT_NE(options(ctx_->program("scan.cl", "-DTCC_OWN")).find("-DTCC_OWN -DTCC_VARIANT"), std::string::npos);
+    {
+      const tc::Context::ProgramOptions none(*ctx_, "");
+      EXPECT_EQ(&ctx_->program("scan.cl"), &plain);
+    }
+    EXPECT_EQ(&ctx_->program("scan.cl"), &scan);
+  }
+  EXPECT_EQ(&ctx_->program("scan.cl"), &plain);
+}
+
 TEST(Runtime, CacheDirFollowsTheEnvironment) {
   EnvVar a("TETCOLLAPSE_CACHE_DIR", "/tmp/tc-a");
   EXPECT_EQ(tc::Context::cache_dir(), "/tmp/tc-a");
