@@ -89,7 +89,10 @@ void prefetch_programs(Context& ctx, const CollapseOptions& o) {
   // under a bound the selection is greedy, and every program is built with kBoundDefines
   const bool bounded = o.bounds_boundary_error() && o.method == CollapseOptions::Parallel && !(o.max_field_error > 0);
   const Context::ProgramOptions variant(ctx, bounded ? kBoundDefines : "");
+  // the first needed, then the largest (the group of collapse_admissible.cl), so that the
+  // compiles of a first run end together
   ctx.prefetch("collapse_connectivity.cl");
+  ctx.prefetch("collapse_admissible.cl");
   dev::prefetch_scan(ctx);
   ctx.prefetch("collapse_cost.cl");
   const CollapseOptions::Conflicts conflicts = o.bounds_boundary_error() ? CollapseOptions::Greedy : o.conflicts;
@@ -97,7 +100,6 @@ void prefetch_programs(Context& ctx, const CollapseOptions& o) {
   if (conflicts == CollapseOptions::AtomicMin) ctx.prefetch("collapse_atomic_min.cl");
   if (conflicts == CollapseOptions::TwoPass) ctx.prefetch("collapse_conflict.cl");
   if (conflicts == CollapseOptions::Greedy) ctx.prefetch("collapse_select_greedy.cl");
-  ctx.prefetch("collapse_admissible.cl");
   if (bounded) ctx.prefetch("collapse_bound.cl");
   if (o.boundary != CollapseOptions::Strict) {  // the surface guard
     ctx.prefetch("collapse_guard_applied.cl");

@@ -387,8 +387,9 @@ TEST_F(RuntimeCtx, PrefetchedProgramsCompileInHelperProcesses) {
 // a group gives its group's program, which holds every kernel of the group's files.
 TEST_F(RuntimeCtx, FilesOfAGroupShareOneProgram) {
   cl::Program& cost = ctx_->program("collapse_cost.cl");
-  EXPECT_EQ(&ctx_->program("collapse_matching.cl"), &cost);
+  EXPECT_EQ(&ctx_->program("collapse_verdicts.cl"), &cost);
   EXPECT_EQ(ctx_->last_build_source(), tc::Context::BuildSource::Memory);
+  EXPECT_NE(&ctx_->program("collapse_matching.cl"), &cost) << "a selection is a program of its own";
   ctx_->kernel("collapse_connectivity.cl", "conn_count");
   ctx_->kernel("collapse_cost.cl", "cost_and_mark");
   cl::Program& guard = ctx_->program("collapse_guard.cl");
