@@ -16,6 +16,19 @@ void check_boundary_error_options(const CollapseOptions& o) {
     throw std::invalid_argument(
         "max_boundary_error applies to the features boundary mode (strict keeps the boundary exactly, free "
         "does not bound it)");
+  if (!o.vertex_boundary_error.empty() && !o.bounds_boundary_error())
+    throw std::invalid_argument("vertex_boundary_error needs a boundary error bound (max_boundary_error)");
+}
+
+std::vector<double> initial_boundary_error(const Mesh& mesh, const CollapseOptions& o) {
+  const size_t nv = size_t(mesh.num_vertices());
+  if (o.vertex_boundary_error.empty()) return std::vector<double>(nv, 0.0);
+  if (o.vertex_boundary_error.size() != nv)
+    throw std::invalid_argument("vertex_boundary_error has " + std::to_string(o.vertex_boundary_error.size()) +
+                                " values for " + std::to_string(nv) + " vertices");
+  for (double e : o.vertex_boundary_error)
+    if (!(e >= 0) || std::isinf(e)) throw std::invalid_argument("vertex_boundary_error: values must be finite and >= 0");
+  return o.vertex_boundary_error;
 }
 
 CheckParams check_params_from(const CollapseOptions& o) {
@@ -54,6 +67,7 @@ StageParams params_from(const CollapseOptions& o) {
 }
 
 void check_options(const CollapseOptions& o, const Context& ctx) {
+  check_boundary_error_options(o);
   if (o.max_iterations < 0) throw std::invalid_argument("max_iterations must be >= 0");
   if (o.selection_rounds < 1) throw std::invalid_argument("selection_rounds must be >= 1");
   if (o.selection_rounds > 1 && o.conflicts != CollapseOptions::TwoPass)

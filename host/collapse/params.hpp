@@ -74,6 +74,9 @@ constexpr const char* kBoundField = "tetcollapse:boundary_error";
 // The boundary error bound's options, for both methods (std::invalid_argument): finite, >= 0,
 // and only in the features mode.
 void check_boundary_error_options(const CollapseOptions& o);
+// The bound per vertex at the start of a run: CollapseOptions::vertex_boundary_error, checked
+// against the mesh (std::invalid_argument), or zeros.
+std::vector<double> initial_boundary_error(const Mesh& mesh, const CollapseOptions& o);
 StageParams params_from(const CollapseOptions& o);
 // The options the parallel method refuses (std::invalid_argument), or this device cannot run
 // (tc::DeviceError).

@@ -72,7 +72,7 @@ SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const T
   report_.eps_v = params_.eps_v;
   mask_ = options.vertex_mask;
   bound_ = boundary_error_bound(mesh, options);
-  if (bound_ > 0) eps_.assign(size_t(sm_.num_vertices()), 0.0);
+  if (bound_ > 0) eps_ = collapse_detail::initial_boundary_error(mesh, options);
   if (options.max_field_error > 0) {
     field_ = std::make_unique<FieldBound>(mesh, options, sm_);
     report_.field_error_bound = field_->bound();

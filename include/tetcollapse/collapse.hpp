@@ -218,6 +218,10 @@ struct CollapseOptions {
   // was); its host tail goes on from the device's bounds. 0 (both): no bound.
   double max_boundary_error = 0;
   double max_boundary_error_abs = 0;
+  // With a bound: per vertex of the mesh given, what earlier changes of S already spent of it,
+  // in mesh units (as CollapseReport::vertex_boundary_error reports it: a run goes on from
+  // where one before it ended, as the MPI tool's rounds do); empty: none.
+  std::vector<double> vertex_boundary_error;
   bool bounds_boundary_error() const { return max_boundary_error > 0 || max_boundary_error_abs > 0; }
   // Field error bound (beyond the paper, after Cignoni et al. 2000): a collapse is made only
   // while every input vertex keeps, in the result's piecewise linear vertex field

@@ -230,6 +230,52 @@ TEST(BoundaryErrorRun, TheParallelMethodKeepsTheBoundToo) {
   EXPECT_THROW(collapse(inf, o, ctx), std::invalid_argument) << "an infinite bound";
 }
 
+// A run goes on from the bounds a run before it spent (CollapseOptions::vertex_boundary_error):
+// zeros are no seed at all; every vertex at the full bound leaves the sphere's vertices where
+// they are; the seed's bounds come back in the report, at least as large; on both methods.
+TEST(BoundaryErrorRun, ARunGoesOnFromTheBoundsGiven) {
+  const Mesh in = ball(10);
+  const auto on_sphere = [](const double* p) { return std::fabs(std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) - 1) < 1e-9; };
+  const auto sphere_points = [&](const Mesh& m) {
+    std::vector<std::array<double, 3>> out;
+    for (int64_t v = 0; v < m.num_vertices(); ++v)
+      if (on_sphere(&m.points[3 * size_t(v)])) out.push_back({m.points[3 * size_t(v)], m.points[3 * size_t(v) + 1], m.points[3 * size_t(v) + 2]});
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  Context ctx;
+  for (auto method : {CollapseOptions::Sequential, CollapseOptions::Parallel}) {
+    const std::string what = method == CollapseOptions::Sequential ? "sequential" : "parallel";
+    CollapseOptions o;
+    o.method = method;
+    o.target_factor = 2;
+    o.max_boundary_error = 0.002;
+    const double bound = boundary_error_bound(in, o);
+    const auto run = [&](Mesh& m, const CollapseOptions& opt) {
+      return method == CollapseOptions::Sequential ? collapse_sequential(m, opt) : collapse(m, opt, ctx);
+    };
+    Mesh plain = in, zeros = in, spent = in;
+    const CollapseReport rp = run(plain, o);
+    o.vertex_boundary_error.assign(size_t(in.num_vertices()), 0.0);
+    run(zeros, o);
+    EXPECT_EQ(zeros.tets, plain.tets) << what;
+    EXPECT_EQ(zeros.points, plain.points) << what;
+    o.vertex_boundary_error.assign(size_t(in.num_vertices()), bound);
+    const CollapseReport rs = run(spent, o);
+    EXPECT_LT(spent.num_tets(), in.num_tets()) << what << ": the interior still coarsens";
+    EXPECT_EQ(sphere_points(spent), sphere_points(in)) << what << ": no sphere vertex moved or went";
+    ASSERT_EQ(rs.vertex_boundary_error.size(), size_t(spent.num_vertices())) << what;
+    EXPECT_EQ(*std::min_element(rs.vertex_boundary_error.begin(), rs.vertex_boundary_error.end()), bound) << what;
+    EXPECT_GT(rp.boundary_error, 0) << what << ": without the seed the sphere moves";
+    o.vertex_boundary_error.pop_back();
+    Mesh wrong = in;
+    EXPECT_THROW(run(wrong, o), std::invalid_argument) << what << ": one value short";
+    o.vertex_boundary_error.assign(size_t(in.num_vertices()), 0.0);
+    o.max_boundary_error = 0;
+    EXPECT_THROW(run(wrong, o), std::invalid_argument) << what << ": a seed without a bound";
+  }
+}
+
 TEST(BoundaryErrorRun, RefusedWhereItCannotHold) {
   Mesh m = ball(4);
   CollapseOptions o;
