@@ -264,6 +264,7 @@ ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) 
       break;
   }
   report.after = quality_summary(mesh);
+  if (options.max_boundary_error_abs > 0) report.vertex_boundary_error = std::move(options.vertex_boundary_error);
   report.seconds_total = clock.peek();
   return report;
 }

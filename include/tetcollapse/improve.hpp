@@ -83,6 +83,9 @@ struct ImproveReport {
   double seconds_total = 0;
   // Building the improvement's mesh (the vertex classes, the surface grid) and writing it back.
   double seconds_setup = 0;
+  // Under a boundary error bound (ImproveOptions::max_boundary_error_abs): per vertex of the
+  // output, the bound it reached (ImproveOptions::vertex_boundary_error for a run after it).
+  std::vector<double> vertex_boundary_error;
 };
 
 struct ImproveOptions {

@@ -1,6 +1,7 @@
 // tc::coarsen: the command line's sequence as one call (tetcollapse/coarsen.hpp).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -108,6 +109,26 @@ TEST(Coarsen, TheImprovementKeepsTheBoundVertexByVertex) {
   EXPECT_GT(surface_moves(c.vertex_boundary_error), 0) << "the improvement moves vertices of the sphere";
   EXPECT_EQ(surface_moves(std::vector<double>(size_t(collapsed.num_vertices()), boundary_error_bound(in, co.collapse))), 0)
       << "nothing is left to spend";
+  // the bounds reached come back per vertex: each at least where it began, within the bound,
+  // some higher (the sphere's vertices moved); with the collapse step, per output vertex
+  for (bool step : {false, true}) {
+    Mesh x = collapsed;
+    ImproveOptions io;
+    io.max_boundary_error_abs = boundary_error_bound(in, co.collapse);
+    io.vertex_boundary_error = c.vertex_boundary_error;
+    io.collapse = step;
+    const ImproveReport ir = improve(x, io, ctx);
+    ASSERT_EQ(ir.vertex_boundary_error.size(), size_t(x.num_vertices())) << step;
+    EXPECT_LE(*std::max_element(ir.vertex_boundary_error.begin(), ir.vertex_boundary_error.end()),
+              io.max_boundary_error_abs) << step;
+    if (step) continue;
+    int64_t higher = 0;
+    for (size_t v = 0; v < ir.vertex_boundary_error.size(); ++v) {
+      EXPECT_GE(ir.vertex_boundary_error[v], c.vertex_boundary_error[v]) << v;
+      higher += ir.vertex_boundary_error[v] > c.vertex_boundary_error[v];
+    }
+    EXPECT_GT(higher, 0);
+  }
   ImproveOptions free_mode;
   free_mode.boundary = CollapseOptions::Free;
   free_mode.max_boundary_error_abs = 0.01;
