@@ -25,6 +25,8 @@ constexpr double kMinCountGain = 0.05;  // share of the tets below 10 or 13 degr
 constexpr double kMinRoundGain = 0.1;
 // A tet is below 10 (13) degrees when the cosine of its smallest angle is above these.
 const double kCos10 = std::cos(10 / kDeg), kCos13 = std::cos(13 / kDeg);
+// The vertex mask through the collapse step (collapse_bad).
+const char* const kMaskField = "tetcollapse:improve-mask";
 
 // The live tets below the threshold, worst first (ties by index: deterministic).
 std::vector<int32_t> bad_tets(const ImpMesh& m, double threshold) {
@@ -139,17 +141,21 @@ void passes(Mesh& mesh, ImproveOptions& options, Context* ctx, int max_passes, I
 // the whole mesh) and its order of collapses left more bad tets on W1. On the star mesh of
 // those vertices (star_mesh), spliced back: the same collapses as on the whole mesh.
 int64_t collapse_bad(Mesh& mesh, ImproveOptions& options, bool harmonic) {
+  const std::vector<uint8_t>& selected = options.vertex_mask;  // (empty: all)
   std::vector<uint8_t> mask(size_t(mesh.num_vertices()), 0);
-  int64_t bad = 0;
+  bool any = false;
   for (int64_t t = 0; t < mesh.num_tets(); ++t) {
     geo::tc_d3 p[4];
     for (int k = 0; k < 4; ++k) p[k] = geo::tc_point(mesh.points.data(), mesh.tets[size_t(4 * t + k)]);
     if (geo::tc_tet_max_dihedral_cos(p[0], p[1], p[2], p[3]) <= kCos13) continue;
-    ++bad;
-    for (int k = 0; k < 4; ++k) mask[size_t(mesh.tets[size_t(4 * t + k)])] = 1;
+    for (int k = 0; k < 4; ++k) {
+      const size_t v = size_t(mesh.tets[size_t(4 * t + k)]);
+      mask[v] = selected.empty() || selected[v];
+      any = any || mask[v];
+    }
   }
 
-  if (bad == 0) return 0;
+  if (!any) return 0;
   CollapseOptions o;
   o.method = CollapseOptions::Sequential;
   o.boundary = options.boundary;
@@ -166,8 +172,11 @@ int64_t collapse_bad(Mesh& mesh, ImproveOptions& options, bool harmonic) {
                     : harmonic                  ? 1.0
                                                 : 1.5 * median_edge_length(mesh);
   o.harmonic_cost = harmonic;
-  // Under a bound the step goes on from what was spent at each vertex, which reaches the star
-  // mesh and comes back through the splice as a last vertex field.
+  // A vertex mask follows the renumbering as a vertex field (a survivor of two selected vertices
+  // is selected: the mean of two ones); under a bound the step goes on from what was spent at
+  // each vertex, which reaches the star mesh and comes back through the splice as the last field.
+  const bool masked = !selected.empty();
+  if (masked) mesh.vertex_fields.push_back({kMaskField, 1, std::vector<double>(selected.begin(), selected.end())});
   const bool bounded = options.boundary == CollapseOptions::Features && options.max_boundary_error_abs > 0;
   if (bounded) {
     o.max_boundary_error_abs = options.max_boundary_error_abs;
@@ -190,10 +199,17 @@ int64_t collapse_bad(Mesh& mesh, ImproveOptions& options, bool harmonic) {
     if (collapsed > 0) splice(mesh, star, run);
   } catch (...) {
     if (bounded) mesh.vertex_fields.pop_back();  // (the bound's field, last)
+    if (masked) mesh.vertex_fields.pop_back();
     throw;
   }
   if (bounded) {
     options.vertex_boundary_error = std::move(mesh.vertex_fields.back().values);
+    mesh.vertex_fields.pop_back();
+  }
+  if (masked) {
+    const std::vector<double>& m = mesh.vertex_fields.back().values;
+    options.vertex_mask.assign(m.size(), 0);
+    for (size_t v = 0; v < m.size(); ++v) options.vertex_mask[v] = m[v] == 1.0;
     mesh.vertex_fields.pop_back();
   }
   return collapsed;
@@ -212,12 +228,11 @@ ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) 
   ImproveOptions options = given;
   passes(mesh, options, ctx, options.max_iterations, report, true);
   // Rounds of the collapse step and the passes after it, while a round raises the smallest angle
-  // or removes a tenth of the tets below 10 or 13 degrees left (a collapse frees its neighbours for the next passes, which free
-  // edges for the next step). (With a vertex mask the step does not run: the collapse renumbers
-  // the vertices.)
+  // or removes a tenth of the tets below 10 or 13 degrees left (a collapse frees its neighbours
+  // for the next passes, which free edges for the next step).
   const int rounds = options.collapse_rounds;
   for (int round = 0; round < rounds; ++round) {
-    if (!options.collapse || !options.vertex_mask.empty() || int(report.passes.size()) >= options.max_iterations) break;
+    if (!options.collapse || int(report.passes.size()) >= options.max_iterations) break;
     const ImprovePassStats before = report.passes.back();
     const Stopwatch step;
     ImprovePassStats stats;
@@ -234,12 +249,14 @@ ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) 
       if (harmonic && !options.harmonic_collapse) continue;
       Mesh kept = mesh;
       std::vector<double> spent = options.vertex_boundary_error;
+      std::vector<uint8_t> selected = options.vertex_mask;
       const int64_t n = collapse_bad(mesh, options, harmonic);
       const QualitySummary qa = quality_summary(mesh);
       if (n == 0 || qa.min_dihedral_deg < q0.min_dihedral_deg || qa.below_10_deg > q0.below_10_deg ||
           qa.below_13_deg > q0.below_13_deg) {
         mesh = std::move(kept);
         options.vertex_boundary_error = std::move(spent);
+        options.vertex_mask = std::move(selected);
         continue;
       }
       stats.collapsed += n;

@@ -131,8 +131,8 @@ struct ImproveOptions {
   // that raised the smallest angle or removed a tenth of the tets below 10 or 13 degrees.
   int collapse_rounds = 4;
   // With a non-empty mask (one byte per vertex, non-zero = selected), only selected vertices
-  // move, and only tets whose vertices are all selected are flipped; the collapse step does not
-  // run (it renumbers the vertices).
+  // move, only tets whose vertices are all selected are flipped, and the collapse step collapses
+  // only edges between two selected vertices (the mask follows its renumbering).
   std::vector<uint8_t> vertex_mask;
   std::function<void(const ImprovePassStats&)> progress;
 };

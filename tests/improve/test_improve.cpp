@@ -2,6 +2,7 @@
 // on coarsened meshes (validity by the checker, the boundary kept, determinism).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -205,6 +206,24 @@ TEST(ImproveOps, ASliverOnlyACollapseRemoves) {
   EXPECT_GT(r.after.min_dihedral_deg, 25) << "the collapse took the short edge and its slivers";
   EXPECT_EQ(r.after.below_13_deg, 0);
   EXPECT_TRUE(check_mesh(m, {}, nullptr).valid);
+  // under a vertex mask the step collapses between selected vertices only (the mask follows
+  // its renumbering into the passes after it)
+  Mesh all = without;
+  o.vertex_mask.assign(size_t(all.num_vertices()), 1);
+  const ImproveReport ra = improve(all, o);
+  EXPECT_EQ(all.tets, m.tets) << "a mask of every vertex is none";
+  EXPECT_EQ(ra.after.below_13_deg, 0);
+  Mesh pinned = without;
+  o.vertex_mask[size_t(u)] = o.vertex_mask[size_t(v)] = 0;
+  const ImproveReport rp = improve(pinned, o);
+  EXPECT_LT(rp.after.min_dihedral_deg, 5) << "the short edge's ends are not selected";
+  for (int32_t w : {u, v}) {
+    bool kept = false;
+    for (int64_t i = 0; i < pinned.num_vertices(); ++i)
+      kept = kept || std::equal(&pinned.points[3 * size_t(i)], &pinned.points[3 * size_t(i)] + 3, &without.points[3 * size_t(w)]);
+    EXPECT_TRUE(kept) << "an unselected vertex stays where it was";
+  }
+  o.vertex_mask.clear();
   // no rounds: no collapse step
   Mesh no_rounds = without;
   o.collapse_rounds = 0;
@@ -395,6 +414,7 @@ TEST(ImprovePhase, OnlyTheMaskedVerticesMove) {
   o.threshold_deg = 40;
   o.vertex_mask.resize(size_t(m.num_vertices()));
   for (int64_t v = 0; v < m.num_vertices(); ++v) o.vertex_mask[size_t(v)] = m.points[3 * v] < 0.5;
+  o.collapse = false;  // (its collapse step renumbers the vertices)
   const Mesh before = m;
   improve(m, o);
   int64_t moved = 0;
