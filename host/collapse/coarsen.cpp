@@ -73,10 +73,12 @@ size_t apply_field_options(const Mesh& mesh, const CoarsenOptions& options, Coll
 
 bool improvement_follows(const CoarsenOptions& options) {
   // A user's predicate or placement states rules the improvement cannot know; the improvement's
-  // moves are not checked against a field error bound.
+  // moves are not checked against a field error bound; with its every operation off it would
+  // change nothing (and the collapse may then have all of a boundary error bound).
   const CollapseOptions& co = options.collapse;
+  const ImproveOptions& io = options.improvement;
   return options.improve && co.predicate_cl_source.empty() && co.placement_cl_source.empty() &&
-         !(co.max_field_error > 0);
+         !(co.max_field_error > 0) && (io.flips || io.smoothing || io.collapse);
 }
 
 CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, const Mesh* original) {

@@ -77,7 +77,8 @@ size_t apply_field_options(const Mesh& mesh, const CoarsenOptions& options, Coll
 // field's mean at its ends, target 1), for callers that set it on parts of a mesh.
 std::string sizing_cost_source();
 // Whether the improvement phase follows the collapse: options.improve, unless a user placement
-// or predicate, or a field error bound, states rules the improvement cannot know.
+// or predicate, or a field error bound, states rules the improvement cannot know, or its flips,
+// relocation and collapse step are all off.
 bool improvement_follows(const CoarsenOptions& options);
 
 // Coarsens `mesh` in place as described above. With ctx null, the collapse must use the

@@ -50,6 +50,27 @@ TEST(Coarsen, IsTheCollapseThenTheImprovementThenTheFields) {
   EXPECT_EQ(r.collapse.tets_out, a.num_tets());
 }
 
+// With its flips, relocation and collapse step all off the improvement would change nothing: no
+// improvement phase, and the collapse has all of the boundary error bound (as without the phase).
+TEST(Coarsen, NoImprovementPhaseWithEveryOperationOff) {
+  Context ctx;
+  const Mesh in = test::ball(8);
+  CoarsenOptions co;
+  co.collapse.target_factor = 2;
+  co.collapse.max_boundary_error = 0.002;
+  co.improvement.flips = co.improvement.smoothing = co.improvement.collapse = false;
+  Mesh off = in, none = in;
+  const CoarsenReport r = coarsen(off, co, &ctx);
+  EXPECT_FALSE(r.improved);
+  co.improve = false;
+  coarsen(none, co, &ctx);
+  EXPECT_EQ(off.tets, none.tets);
+  EXPECT_EQ(off.points, none.points);
+  co.improve = true;
+  co.improvement.collapse = true;
+  EXPECT_TRUE(improvement_follows(co));
+}
+
 // A boundary error bound: the collapse uses its share, the improvement the rest, and the result
 // stays within the whole.
 TEST(Coarsen, SharesABoundaryErrorBoundWithTheImprovement) {
