@@ -2,12 +2,13 @@
 """tetcollapse-mpi against tetcollapse on W1: wall time, tets, validity and peak memory per rank.
 
     bench/mpi_scale.py [--build DIR] [--mesh M] [--ranks 2,3] [--runs 3] [--factor 2]
-                       [--out bench/results/mpi_scale.json]
+                       [--max-boundary-error 0.001] [--out bench/results/mpi_scale.json]
     bench/mpi_scale.py --table bench/results/mpi_scale.json    prints the markdown table
 
 Runs, one after the other, `runs` times each (the median is reported):
-  tetcollapse M OUT --target-factor F --stats S                 (one process, one device)
-  mpirun -n N tetcollapse-mpi M OUT --target-factor F --stats S  (N ranks, a device context each)
+  tetcollapse M OUT --target-factor F --max-boundary-error E --stats S     (one process, one device)
+  mpirun -n N tetcollapse-mpi M OUT --target-factor F --max-boundary-error E --stats S
+                                                                   (N ranks, a device context each)
 and `tetcollapse check OUT` once per configuration. Wall time is the whole command (reading,
 writing and, under mpirun, starting the ranks); the peak memory of tetcollapse is its maximum
 resident set (wait4), that of each rank the VmHWM tetcollapse-mpi reports in --stats. The goals
@@ -114,7 +115,8 @@ def below_10(c):
 def table(path):
     with open(path) as f:
         res = json.load(f)
-    print(f"`{os.path.basename(res['mesh'])}`, --target-factor {res['target_factor']}, median of {res['runs']} runs, "
+    print(f"`{os.path.basename(res['mesh'])}`, --target-factor {res['target_factor']} "
+          f"--max-boundary-error {res.get('max_boundary_error', 0):g}, median of {res['runs']} runs, "
           f"{res['machine']}, commit {res['commit'][:10]}\n")
     print(f"A process's fixed cost (tetcollapse-mpi -n 1 on two tets): {res['fixed_cost_rss_kb'] / 1024:.0f} MB.\n")
     print("| command | ranks | wall s (median) | tets | vs tetcollapse | valid | tets below 10 deg "
@@ -140,6 +142,8 @@ def main():
     ap.add_argument("--ranks", default="2,3")
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--factor", type=float, default=2.0)
+    ap.add_argument("--max-boundary-error", default="0.001",
+                    help="passed to both tools (default: their default in features mode; 0: the paper's method)")
     ap.add_argument("--mpirun", default="mpirun")
     ap.add_argument("--out", default=os.path.join(HERE, "results", "mpi_scale.json"))
     ap.add_argument("--table", metavar="JSON", help="print the markdown table of a results file and exit")
@@ -158,14 +162,15 @@ def main():
     configs = []
     with tempfile.TemporaryDirectory() as tmp:
         f = str(a.factor)
-        single = measure("tetcollapse", 1, lambda out, st: [tool, a.mesh, out, "--target-factor", f, "--max-boundary-error", "0",
+        bound = ["--max-boundary-error", a.max_boundary_error]
+        single = measure("tetcollapse", 1, lambda out, st: [tool, a.mesh, out, "--target-factor", f, *bound,
                                                             "-q", "--stats", st],
                          tool, a.runs, tmp)
         configs.append(single)
         for n in [int(x) for x in a.ranks.split(",") if x]:
             configs.append(measure(f"tetcollapse-mpi -n {n}", n,
                                    lambda out, st, n=n: [a.mpirun, "--oversubscribe", "-n", str(n), mpi_tool, a.mesh, out,
-                                                         "--target-factor", f, "-q", "--stats", st],
+                                                         "--target-factor", f, *bound, "-q", "--stats", st],
                                    tool, a.runs, tmp, mpi_env()))
         # What a process costs before any mesh: the OpenCL runtime (PoCL links LLVM), the kernels.
         tiny = os.path.join(ROOT, "meshes", "two_tets.mesh")
@@ -186,6 +191,7 @@ def main():
         "benchmark": "tetcollapse-mpi against tetcollapse, " + os.path.basename(a.mesh),
         "mesh": a.mesh,
         "target_factor": a.factor,
+        "max_boundary_error": float(a.max_boundary_error),
         "runs": a.runs,
         "commit": commit + (" (with uncommitted changes)" if dirty else ""),
         "machine": f"{cpu_model()}, {os.cpu_count()} cores",

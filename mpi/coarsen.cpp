@@ -1,5 +1,6 @@
 #include "coarsen.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <stdexcept>
@@ -7,7 +8,6 @@
 #include <unordered_map>
 
 #include "cli/masks.hpp"
-#include "improve_collapse.hpp"
 #include "stopwatch.hpp"
 
 namespace tc::mpi {
@@ -16,17 +16,18 @@ namespace {
 
 // The library renumbers vertices (spatial order, compaction) but carries vertex fields with
 // them, and leaves a vertex outside the mask untouched, fields included: the id travels as a
-// field and comes back exact (doubles hold integers to 2^53). The others carry kSelected or kLeft:
-// an edge collapses only between two selected vertices, whose survivor (the average of both)
-// stays kSelected, so the field also says where the round may still work after a collapse.
+// field and comes back exact (doubles hold integers to 2^53); the others carry kNone.
 const char* const kIdField = "tetcollapse-mpi:frozen-id";
-constexpr double kSelected = -1, kLeft = -2;
+constexpr double kNone = -1;
 
-std::vector<uint8_t> selected_by_field(const Mesh& m) {
-  const std::vector<double>& ids = m.vertex_fields.back().values;
-  std::vector<uint8_t> sel(ids.size());
-  for (size_t v = 0; v < ids.size(); ++v) sel[v] = ids[v] == kSelected;
-  return sel;
+// Takes the bound each vertex spent (kSpentField, the last vertex field) out of the mesh: the
+// library gets it as its options' seed.
+std::vector<double> take_spent(Mesh& m) {
+  if (m.vertex_fields.empty() || m.vertex_fields.back().name != kSpentField)
+    throw std::logic_error("a part without its boundary error field");
+  std::vector<double> spent = std::move(m.vertex_fields.back().values);
+  m.vertex_fields.pop_back();
+  return spent;
 }
 
 }  // namespace
@@ -37,9 +38,11 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context* ctx
   r.tets_in = m.num_tets();
   r.vertices_in = m.num_vertices();
   const size_t nv = size_t(m.num_vertices());
+  const bool bounded = s.boundary_bound > 0;
+  std::vector<double> spent = bounded ? take_spent(m) : std::vector<double>();
   // Where each frozen vertex is, to know it again by id and place.
   std::unordered_map<int64_t, size_t> frozen_at;
-  Field id{kIdField, 1, std::vector<double>(nv, kSelected)};
+  Field id{kIdField, 1, std::vector<double>(nv, kNone)};
   std::vector<uint8_t> mask(nv, 1);
   const std::vector<uint8_t> chosen = cli::region_and_label_mask(m, s.region, s.labels);
   for (size_t v = 0; v < nv; ++v)
@@ -49,20 +52,23 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context* ctx
       frozen_at.emplace(part.gid[v], v);
     } else if ((!part.select.empty() && !part.select[v]) || (!chosen.empty() && !chosen[v])) {
       mask[v] = 0;
-      id.values[v] = kLeft;
     }
   r.frozen = int64_t(frozen_at.size());
   const std::vector<double> points_in = m.points;  // only the frozen ones are read back
   m.vertex_fields.push_back(std::move(id));
 
-  // An all-ones mask would only stop the improvement's collapse step: no mask then.
+  // (an all-ones mask: none)
   const bool masked = !frozen_at.empty() || !part.select.empty() || !chosen.empty();
   Stopwatch clock;
   if (m.num_tets() > 0 && phase == Phase::Collapse) {
     CollapseOptions co = s.collapse;
     if (masked) co.vertex_mask = mask;
-    if (s.boundary_bound > 0) co.max_boundary_error = 0, co.max_boundary_error_abs = s.boundary_bound;
-    r.boundary_error = (ctx ? collapse(m, co, *ctx) : collapse_sequential(m, co)).boundary_error;
+    if (bounded) {
+      co.max_boundary_error = 0, co.max_boundary_error_abs = s.boundary_bound;
+      co.vertex_boundary_error = std::move(spent);
+    }
+    CollapseReport cr = ctx ? collapse(m, co, *ctx) : collapse_sequential(m, co);
+    if (bounded) spent = std::move(cr.vertex_boundary_error);
     r.seconds_collapse = clock.lap();
   } else if (m.num_tets() > 0) {
     ImproveOptions io = s.improve;
@@ -71,27 +77,14 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context* ctx
     // scale it so that the bound is the whole mesh's.
     const double d = bbox_diagonal(m);
     if (d > 0) io.max_boundary_move *= s.whole_diagonal / d;
-    // under a bound: a third each to the passes, the collapse step and the passes after it (three
-    // calls, each bounded from where it starts)
-    const bool step = masked && io.collapse;
-    if (s.boundary_bound > 0) {
-      io.max_boundary_error_abs = step ? s.boundary_bound / 3 : s.boundary_bound;
-      r.boundary_error = s.boundary_bound;  // not measured: all of it
+    // the collapse step reaches as far as tc::improve's default on the whole mesh
+    if (!(io.collapse_length > 0)) io.collapse_length = s.collapse_length;
+    if (bounded) {  // (from the bounds spent, which it raises)
+      io.max_boundary_error_abs = s.boundary_bound;
+      io.vertex_boundary_error = std::move(spent);
     }
-    ctx ? improve(m, io, *ctx) : improve(m, io);
-    // Under a mask the library leaves out its collapse step: run it here, then the passes again.
-    // The improvement keeps the numbering under a mask but gives a moved vertex the fields
-    // interpolated at its new place (-1 from -1s need not come out exact): mark the vertices
-    // again by the mask before the collapse.
-    if (step) {
-      std::vector<double>& marks = m.vertex_fields.back().values;
-      for (size_t v = 0; v < nv; ++v)
-        if (!part.frozen[v]) marks[v] = mask[v] ? kSelected : kLeft;
-      if (collapse_bad_tets(m, selected_by_field(m), io, s.collapse_length) > 0) {
-        io.vertex_mask = selected_by_field(m);
-        ctx ? improve(m, io, *ctx) : improve(m, io);
-      }
-    }
+    ImproveReport ir = ctx ? improve(m, io, *ctx) : improve(m, io);
+    if (bounded) spent = std::move(ir.vertex_boundary_error);
     r.seconds_improve = clock.lap();
   }
 
@@ -116,6 +109,11 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context* ctx
   if (found != frozen_at.size())
     throw std::runtime_error("a part lost " + std::to_string(frozen_at.size() - found) + " of its " +
                              std::to_string(frozen_at.size()) + " frozen vertices");
+  if (bounded) {
+    if (spent.size() != n_out) throw std::logic_error("a part's boundary error bounds lost their vertices");
+    for (double e : spent) r.boundary_error = std::max(r.boundary_error, e);
+    m.vertex_fields.push_back({kSpentField, 1, std::move(spent)});
+  }
   r.tets_out = m.num_tets();
   r.vertices_out = m.num_vertices();
   return r;

@@ -17,20 +17,25 @@ struct Settings {
   ImproveOptions improve;     // max_boundary_move relative to the whole mesh's diagonal
   double whole_diagonal = 0;  // bounding-box diagonal of the whole input
   double collapse_length = 0;  // the improvement's collapse step: 1.5 x the coarse mesh's median
-  // This round's share of the boundary error bound, in mesh units (0: no bound). Each round
-  // measures from the mesh it is given, so the shares of all rounds add up to at most the bound
-  // (the Hausdorff distance obeys the triangle inequality; the parts' boundaries are disjoint
-  // but for the frozen interfaces, which do not change).
+  // The phase's boundary error bound, in mesh units (0: no bound), as tc::coarsen shares it
+  // (kCollapseShareOfBound of it for the collapse). Each vertex carries what it spent of it
+  // (kSpentField) from round to round, so that every round goes on from there, as one run of
+  // the library would (the frozen interface vertices keep theirs: nothing at them changes).
   double boundary_bound = 0;
   // --region and --labels: only their vertices change (tetcollapse's masks, found on each part:
   // a vertex that is not frozen has its whole star in the part)
   std::string region, labels;
 };
 
+// Under a boundary error bound, the whole mesh's and each part's last vertex field between the
+// rounds: per vertex, the bound it reached (CollapseReport::vertex_boundary_error); the driver
+// adds it before the first round and drops it after the last.
+constexpr const char* kSpentField = "tetcollapse-mpi:boundary-error";
+
 struct RankReport {
   int64_t tets_in = 0, tets_out = 0, vertices_in = 0, vertices_out = 0, frozen = 0;
   double seconds_collapse = 0, seconds_improve = 0;
-  double boundary_error = 0;  // of the bound, what the round may have used (an upper bound)
+  double boundary_error = 0;  // the largest bound a vertex of the part reached
 };
 
 // What a round does to each part: the rounds of the collapse phase coarsen, then those of the

@@ -73,6 +73,7 @@ int run(Options& o, MPI_Comm comm) {
 
   // Rank 0 reads the input and turns every bound relative to the whole mesh into an absolute one.
   int code = guarded(rank, [&] {
+    resolve_defaults(o);
     validate(o);
     // the user's OpenCL C, read by every rank (a missing file is an input error on each)
     if (!o.cost_cl.empty()) s.collapse.cost_cl_source = cli::cl_file(o.cost_cl);
@@ -124,24 +125,30 @@ int run(Options& o, MPI_Comm comm) {
 
   // The collapse phase, then the improvement phase, each in rounds until nothing is left to do.
   // A boundary error bound is shared as tc::coarsen shares it: kCollapseShareOfBound of it for
-  // the collapse, what the collapse left for the improvement.
+  // the collapse, all of it for the improvement, which goes on from what each vertex spent (a
+  // vertex field from round to round).
   const double bound = o.max_boundary_error_abs > 0 ? o.max_boundary_error_abs : o.max_boundary_error * s.whole_diagonal;
   stats.boundary_error_bound = bound;
+  if (bound > 0 && rank == 0) whole.vertex_fields.push_back({kSpentField, 1, std::vector<double>(size_t(whole.num_vertices()), 0.0)});
   // (none after a user's placement or predicate, as tc::coarsen)
   CoarsenOptions as_coarsen;
-  as_coarsen.collapse = s.collapse, as_coarsen.improve = !o.no_improve;
+  as_coarsen.collapse = s.collapse, as_coarsen.improve = !o.no_improve, as_coarsen.improvement = s.improve;
   const bool improve_phase = improvement_follows(as_coarsen);
-  double bound_left = improve_phase ? kCollapseShareOfBound * bound : bound;
   Round state{whole, {}, 0};
-  code = run_phase(Phase::Collapse, state, s, o, device, stats, comm, bound_left);
+  s.boundary_bound = improve_phase ? kCollapseShareOfBound * bound : bound;
+  code = run_phase(Phase::Collapse, state, s, o, device, stats, comm);
   if (code == cli::kOk && improve_phase) {
     // the improvement's collapse step reaches as far as tc::improve's default on the whole mesh
     if (rank == 0) s.collapse_length = 1.5 * median_edge_length(whole);
     bcast(&s.collapse_length, 1, comm);
-    bound_left += (1 - kCollapseShareOfBound) * bound;
-    code = run_phase(Phase::Improve, state, s, o, device, stats, comm, bound_left);
+    s.boundary_bound = bound;
+    code = run_phase(Phase::Improve, state, s, o, device, stats, comm);
   }
   if (code) return code;
+  if (bound > 0 && rank == 0) {
+    for (double e : whole.vertex_fields.back().values) stats.boundary_error = std::max(stats.boundary_error, e);
+    whole.vertex_fields.pop_back();  // (kSpentField)
+  }
 
   // Peak memory per rank over the run, then rank 0 finishes: fields, check, write, stats.
   int64_t peak = peak_rss_kb();

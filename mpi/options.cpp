@@ -1,6 +1,7 @@
 #include "options.hpp"
 
 #include "cli/masks.hpp"
+#include "tetcollapse/coarsen.hpp"
 
 namespace tc::mpi {
 
@@ -30,19 +31,16 @@ void add_options(CLI::App& app, Options& o) {
       ->check(CLI::Range(0.0, 1.0));
   app.add_option("--max-boundary-error", o.max_boundary_error,
                  "Features mode: keep the boundary and the material interfaces within E x the whole input's\n"
-                 "bounding-box diagonal of where they were, both ways, as tetcollapse does. Each round has a\n"
-                 "share and measures from the mesh it is given (the shares add up to at most E); the\n"
-                 "partition interfaces are frozen. 0 (default here; tetcollapse's is 0.001 in features mode:\n"
-                 "the bound per vertex does not cross the ranks' rounds yet, and shares of it cost tets): no\n"
-                 "bound")
-      ->capture_default_str()
+                 "bounding-box diagonal of where they were, both ways, as tetcollapse does (each vertex carries\n"
+                 "the bound it reached from round to round; the partition interfaces are frozen). Default\n"
+                 "0.001 in features mode; 0: no bound (the paper's method)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--max-boundary-error-abs", o.max_boundary_error_abs,
                  "The same bound in mesh units (used instead of --max-boundary-error when > 0)")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--no-improve", o.no_improve,
                "Coarsen only (default: each rank improves its part after coarsening it, the interface\n"
-               "frozen; the improvement's collapse step does not run, as with any vertex mask)");
+               "frozen)");
   cli::add_improve_options(app, o.improve);
   app.add_option("--preserve-field", o.preserve_field,
                  "Direct volume rendering (the paper's Section 4.5), as tetcollapse: collapse the edges whose\n"
@@ -133,6 +131,11 @@ void add_options(CLI::App& app, Options& o) {
   app.add_flag("-q,--quiet", o.quiet, "No progress lines, only errors");
   cli::add_input_options(app, o.input);
   cli::add_output_options(app, o.output);
+}
+
+void resolve_defaults(Options& o) {
+  if (o.max_boundary_error < 0)
+    o.max_boundary_error = o.boundary == "features" && !(o.max_boundary_error_abs > 0) ? kDefaultMaxBoundaryError : 0;
 }
 
 void validate(const Options& o) {

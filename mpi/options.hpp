@@ -17,7 +17,8 @@ struct Options {
   std::string in, out, stats, device, boundary = "features";
   double target_length = 0, target_factor = 0;
   double eps_f = 0.01, eps_r = 0.1, eps_v = 2e-12, min_quality = 0.1;
-  double max_boundary_error = 0, max_boundary_error_abs = 0;  // features mode only: see validate()
+  // features mode only (see validate()); max_boundary_error < 0: not given (resolve_defaults)
+  double max_boundary_error = -1, max_boundary_error_abs = 0;
   int64_t eps_c = 0;
   int max_iterations = 1000;
   bool paper_boundary_rule = false, no_spatial_order = false;
@@ -42,5 +43,8 @@ struct Options {
 void add_options(CLI::App& app, Options& o);
 // What CLI11 cannot check alone; throws CLI::ValidationError.
 void validate(const Options& o);
+// The defaults that depend on other options, as tetcollapse's: the boundary error bound
+// (kDefaultMaxBoundaryError in features mode, none in the other modes).
+void resolve_defaults(Options& o);
 
 }  // namespace tc::mpi

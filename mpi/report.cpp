@@ -63,6 +63,8 @@ std::string stats_json(const RunStats& s) {
       .field("tets_out", s.tets_out)
       .field("median_edge_length", s.median_edge_length)
       .field("target_length", s.target_length)
+      .field("boundary_error_bound", s.boundary_error_bound)
+      .field("boundary_error", s.boundary_error)
       .field("seconds_total", s.seconds_total)
       .field("seconds_read", s.seconds_read)
       .field("seconds_write", s.seconds_write);

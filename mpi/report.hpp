@@ -16,7 +16,7 @@ struct RankStats {
   double tets_in = 0, tets_out = 0, frozen = 0;
   double seconds = 0, seconds_collapse = 0, seconds_improve = 0;
   double peak_rss_kb = 0;
-  double boundary_error = 0;  // what the rank's round may have used of the bound
+  double boundary_error = 0;  // the largest bound a vertex of the rank's part reached
   static constexpr int kCount = 8;
   void to(double* d) const;
   static RankStats from(const double* d);
@@ -29,7 +29,7 @@ struct RoundStats {
   int64_t interface_vertices = 0;  // frozen in this round
   int64_t refrozen_vertices = 0;   // of them, in the band the round was to coarsen
   double seconds_partition = 0, seconds_scatter = 0, seconds_coarsen = 0, seconds_gather = 0;
-  double boundary_bound = 0;  // the round's share of the boundary error bound (mesh units; 0: none)
+  double boundary_bound = 0;  // the phase's boundary error bound (mesh units; 0: none)
   std::vector<RankStats> ranks;
 };
 
@@ -39,6 +39,7 @@ struct RunStats {
   int64_t vertices_in = 0, tets_in = 0, vertices_out = 0, tets_out = 0;
   double median_edge_length = 0, target_length = 0;
   double boundary_error_bound = 0;  // mesh units; 0: none
+  double boundary_error = 0;        // the largest bound a vertex of the output reached
   double seconds_total = 0, seconds_read = 0, seconds_write = 0;
   std::string check;  // "valid" / "invalid" with --check
   std::vector<RoundStats> rounds;

@@ -105,26 +105,18 @@ int run_round(Phase phase, Round& st, const Settings& s, const Options& o, LazyD
 // collapsing, removed fewer than o.round_threshold of its tets), or after o.max_rounds (two
 // when improving).
 int run_phase(Phase phase, Round& st, const Settings& s, const Options& o, LazyDevice& device, RunStats& stats,
-              MPI_Comm comm, double& bound_left) {
+              MPI_Comm comm) {
   int rank = 0;
   MPI_Comm_rank(comm, &rank);
   st.band.clear();
-  // A boundary error bound: each round may use what is left of the phase's share (the improvement
-  // gets a half of its share per round, as it has at most two), and uses what its ranks report.
-  const double phase_bound = bound_left;
   for (int round = 1;; ++round) {
     RoundStats rs;
     rs.round = ++st.number;
     rs.phase = phase == Phase::Collapse ? "collapse" : "improve";
-    Settings rounds_settings = s;
-    const double share = phase == Phase::Collapse ? bound_left : std::min(bound_left, phase_bound / 2);
-    // (none left: only changes that move no point of the boundary, as tc::coarsen does)
-    rounds_settings.boundary_bound = rs.boundary_bound =
-        phase_bound > 0 ? std::max(share, std::numeric_limits<double>::min()) : 0;
-    if (int code = run_round(phase, st, rounds_settings, o, device, rs, comm)) return code;
-    double go = 0, used = 0;
+    rs.boundary_bound = s.boundary_bound;
+    if (int code = run_round(phase, st, s, o, device, rs, comm)) return code;
+    double go = 0;
     if (rank == 0) {
-      for (const RankStats& k : rs.ranks) used = std::max(used, k.boundary_error);
       const double removed = rs.tets_before ? double(rs.tets_before - rs.tets_after) / double(rs.tets_before) : 0;
       const bool pending = round == 1 ? rs.interface_vertices > 0 : rs.refrozen_vertices > 0;
       // (Improving the band again rarely changes more than a few tets: two improvement rounds.)
@@ -136,10 +128,8 @@ int run_phase(Phase phase, Round& st, const Settings& s, const Options& o, LazyD
       }
       stats.rounds.push_back(std::move(rs));
     }
-    double msg[2] = {go, used};
-    MPI_Bcast(msg, 2, MPI_DOUBLE, 0, comm);
-    if (bound_left > 0) bound_left = std::max(0.0, bound_left - msg[1]);
-    if (msg[0] == 0) return cli::kOk;
+    MPI_Bcast(&go, 1, MPI_DOUBLE, 0, comm);
+    if (go == 0) return cli::kOk;
   }
 }
 

@@ -40,9 +40,8 @@ class LazyDevice {
 };
 
 // Runs on every rank; returns the agreed exit code. Rank 0 appends each round to stats.rounds.
-// bound_left: what is left of the boundary error bound (mesh units; 0: no bound), less what the
-// phase's rounds used on return.
+// Under settings.boundary_bound, state.whole carries the bound each vertex spent (kSpentField).
 int run_phase(Phase phase, Round& state, const Settings& settings, const Options& options, LazyDevice& device,
-              RunStats& stats, MPI_Comm comm, double& bound_left);
+              RunStats& stats, MPI_Comm comm);
 
 }  // namespace tc::mpi
