@@ -173,6 +173,72 @@ Mesh ball(int n) {
   return m;
 }
 
+Mesh filleted_cylinder(int n, double fillet) {
+  // the signed distance to the surface: a cylinder of radius and half-height 1 - fillet, grown by
+  // the fillet
+  const double core = 1 - fillet;
+  const auto sdf = [&](const double* q) {
+    const double a = std::hypot(q[0], q[1]) - core, b = std::fabs(q[2]) - core;
+    return std::hypot(std::max(a, 0.0), std::max(b, 0.0)) + std::min(std::max(a, b), 0.0) - fillet;
+  };
+  Mesh m = cube_tets(n);
+  for (size_t i = 0; i < m.points.size(); i += 3) {
+    double p[3], inf = 0, two = 0;
+    for (int c = 0; c < 3; ++c) {
+      p[c] = 2 * m.points[i + size_t(c)] - 1;
+      inf = std::max(inf, std::fabs(p[c]));
+      two += p[c] * p[c];
+    }
+    two = std::sqrt(two);
+    if (two == 0) {
+      for (int c = 0; c < 3; ++c) m.points[i + size_t(c)] = 0;
+      continue;
+    }
+    // where the ray along p leaves the shape (convex, around the origin): bisection
+    double lo = 0, hi = 2;
+    for (int it = 0; it < 60; ++it) {
+      const double mid = (lo + hi) / 2, q[3] = {p[0] / two * mid, p[1] / two * mid, p[2] / two * mid};
+      (sdf(q) < 0 ? lo : hi) = mid;
+    }
+    for (int c = 0; c < 3; ++c) m.points[i + size_t(c)] = p[c] / two * inf * lo;
+  }
+  return m;
+}
+
+Mesh torus(int n, int ring) {
+  Mesh m;
+  const auto id = [&](int i, int j, int k) { return int32_t(((i % ring) * (n + 1) + j) * (n + 1) + k); };
+  for (int i = 0; i < ring; ++i)
+    for (int j = 0; j <= n; ++j)
+      for (int k = 0; k <= n; ++k) {
+        double x = 2.0 * j / n - 1, y = 2.0 * k / n - 1;
+        const double inf = std::max(std::fabs(x), std::fabs(y)), two = std::hypot(x, y);
+        if (two > 0) x *= inf / two, y *= inf / two;
+        const double theta = 2 * std::acos(-1.0) * i / ring, r = 2 + x;
+        m.points.insert(m.points.end(), {r * std::cos(theta), r * std::sin(theta), y});
+      }
+  // Kuhn: the six paths from corner 000 to 111 of each cell, one axis at a time (conforming
+  // across cells, and across the ring's seam)
+  const int order[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  for (int i = 0; i < ring; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k)
+        for (const auto& o : order) {
+          int c[3] = {i, j, k};
+          std::array<int32_t, 4> t;
+          t[0] = id(c[0], c[1], c[2]);
+          for (int s = 0; s < 3; ++s) {
+            ++c[o[s]];
+            t[size_t(s + 1)] = id(c[0], c[1], c[2]);
+          }
+          if (geo::tc_orient3d(geo::tc_point(m.points.data(), t[0]), geo::tc_point(m.points.data(), t[1]),
+                               geo::tc_point(m.points.data(), t[2]), geo::tc_point(m.points.data(), t[3])) < 0)
+            std::swap(t[0], t[1]);
+          m.tets.insert(m.tets.end(), t.begin(), t.end());
+        }
+  return m;
+}
+
 Mesh cone_boundary(const Mesh& m, double x, double y, double z) {
   TopologyOptions no_labels;
   no_labels.use_labels = false;  // the boundary faces only, not material interfaces

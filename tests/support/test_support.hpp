@@ -64,6 +64,13 @@ Mesh cube_tets(int n);         // [0,1]^3 split into n^3 cubes of 6 tets each (K
 Mesh slab(int n);              // the bottom layer of cube_tets(n): one tet thick, every vertex on the boundary
 Mesh two_materials(int n);     // cube_tets(n) with labels 1 below z = 0.5 and 2 above (an interface plane)
 Mesh ball(int n);              // cube_tets(n) in [-1, 1]^3, pushed out to the unit ball (x -> x |x|_inf / |x|_2)
+// cube_tets(n) in [-1, 1]^3 pushed out radially onto a cylinder of radius 1 and height 2 whose two
+// rims are rounded by fillets of radius `fillet` (a smooth surface: flat caps, a cylinder, two
+// toroidal bands).
+Mesh filleted_cylinder(int n, double fillet);
+// A solid torus of radii R = 2 (the ring) and 1 (the tube): a ring of `ring` x n x n cells of 6
+// tets each (Kuhn), closed around, its square cross-section pushed out onto the disc as ball()'s.
+Mesh torus(int n, int ring);
 // cube_tets(n) labelled ("material") by the side of the plane coordinate `axis` = 0.5 each tet's
 // centroid lies on: `below` or `above`
 Mesh split_materials(int n, int axis, int32_t below, int32_t above);
