@@ -26,12 +26,15 @@ bool try_smooth(ImpMesh& m, int32_t v) {
   // Under a boundary error bound, a move of the surface must keep it (ImpMesh::boundary_error_at).
   const bool bounded = m.bounded() && motion != kFree;
   const auto within = [&m](int u, tc_d3 x) { return m.boundary_error_at(u, x) <= m.max_boundary_move(); };
+  double error = bounded ? m.boundary_error_at(v, p) : 0;
   // On a curved surface the guard is the costly part: it is asked of the ascent's end only,
   // and of every step only when that end would cross the surface (or leave the bound).
-  if (m.bends_surface(v) && !((!bounded || within(v, p)) && m.surface_stays_clear(v, p)) &&
-      !relocate([&](int u, tc_d3 x) { return (!bounded || within(u, x)) && m.surface_stays_clear(u, x); }, &p))
-    return false;
-  if (bounded) m.set_boundary_error(v, m.boundary_error_at(v, p));
+  if (m.bends_surface(v) && !((!bounded || error <= m.max_boundary_move()) && m.surface_stays_clear(v, p))) {
+    if (!relocate([&](int u, tc_d3 x) { return (!bounded || within(u, x)) && m.surface_stays_clear(u, x); }, &p))
+      return false;
+    if (bounded) error = m.boundary_error_at(v, p);
+  }
+  if (bounded) m.set_boundary_error(v, error);
   m.move(v, p);
   if (motion != kFree) m.surface_moved(v);  // its surface triangles moved: re-list them
   return true;
