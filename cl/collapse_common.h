@@ -55,6 +55,11 @@ inline void tcc_group_count(uint flag, volatile __local uint* lc, __global uint*
 #define TCC_REFUSED_SURFACE 7 /* by the surface guard (collapse_guard.cl) */
 #define TCC_VOLUME_OK 8 /* verdict only: the volume test passed, the link condition is untested */
 
+/* The iteration's counters (host/collapse/cost.hpp, CostState::counters): 0-5 the stages' counts,
+ * then the refusals of the boundary error bound's test (collapse_select.h). */
+#define TCC_COUNTER_BOUND_REFUSED 6
+#define TCC_COUNTERS 7
+
 /* Per-edge states of the conflict passes and of the lazy admissible filter. */
 #define TCC_UNDECIDED 0
 #define TCC_IN 1

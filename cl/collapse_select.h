@@ -281,7 +281,7 @@ inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* edg
                                       vfield_stride, vflags, bound, eps_col)) {
     r = TCC_REFUSED_SURFACE;
     edges2verdict[e] = r;
-    atomic_inc(&counters[6]);
+    atomic_inc(&counters[TCC_COUNTER_BOUND_REFUSED]);
   }
 #endif
   edges2reason[e] = r;

@@ -6,7 +6,7 @@
 namespace tc::collapse_detail {
 
 uint32_t cost_and_mark(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, const StageParams& p) {
-  ensure(s.cost.counters, ctx, 7);
+  ensure(s.cost.counters, ctx, kCounters);
   s.cost.counters.fill(0);
   ensure(s.cost.edges2cost, ctx, c.ne);
   ensure(s.cost.edges_are_marked, ctx, c.ne);

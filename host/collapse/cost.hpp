@@ -14,8 +14,12 @@ namespace tc::collapse_detail {
 struct CostState {
   DeviceBuffer<double> edges2cost;
   DeviceBuffer<uint32_t> edges_are_marked;
-  DeviceBuffer<uint32_t> counters;  // marked, admissible, pass 1, pass 2, tested, passed Q
+  // marked, admissible, pass 1, pass 2, tested, passed Q; the boundary error bound's refusals
+  DeviceBuffer<uint32_t> counters;
 };
+// The counters' count and the bound's refusals' index (TCC_COUNTERS, TCC_COUNTER_BOUND_REFUSED in
+// cl/collapse_common.h).
+constexpr size_t kCounters = 7, kCounterBoundRefused = 6;
 
 // Counter i of counters (marked, admissible, pass1, pass2, tested, passed Q).
 inline uint32_t read_counter(CostState& s, int i) {

@@ -21,7 +21,7 @@ uint32_t Selection::select(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
     stats.tested += chosen.tested;
     if (p.bound > 0) {  // the selection's test refused these (TCC_BOUND, cl/collapse_select.h)
       uint32_t out = 0;
-      s.cost.counters.download(&out, 1, 6);
+      s.cost.counters.download(&out, 1, kCounterBoundRefused);
       stats.refused_by_bound += out;
     }
     stats.seconds_select += clock.lap();
