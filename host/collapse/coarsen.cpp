@@ -106,8 +106,7 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
     co.max_boundary_error = 0;
   }
 
-  if (ctx && co.method != CollapseOptions::Sequential && !(co.max_field_error > 0))
-    collapse_detail::prefetch_programs(*ctx, co);
+  if (ctx) collapse_detail::prefetch_programs(*ctx, co);
   if (ctx && improve_phase) improve_detail::prefetch_programs(*ctx);
   CoarsenReport r;
   {

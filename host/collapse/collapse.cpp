@@ -87,9 +87,16 @@ CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Cont
 }  // namespace
 
 namespace collapse_detail {
+CollapsePath collapse_path(const CollapseOptions& o) {
+  if (o.method == CollapseOptions::Sequential || o.max_field_error > 0) return CollapsePath::Host;
+  return o.bounds_boundary_error() ? CollapsePath::DeviceBounded : CollapsePath::Device;
+}
+
 void prefetch_programs(Context& ctx, const CollapseOptions& o) {
+  const CollapsePath path = collapse_path(o);
+  if (path == CollapsePath::Host) return;
   // under a bound the selection is greedy, and every program is built with kBoundDefines
-  const bool bounded = o.bounds_boundary_error() && o.method == CollapseOptions::Parallel && !(o.max_field_error > 0);
+  const bool bounded = path == CollapsePath::DeviceBounded;
   const Context::ProgramOptions variant(ctx, bounded ? kBoundDefines : "");
   // the first needed, then the largest (the group of collapse_admissible.cl), so that the
   // compiles of a first run end together
@@ -97,7 +104,7 @@ void prefetch_programs(Context& ctx, const CollapseOptions& o) {
   ctx.prefetch("collapse_admissible.cl");
   dev::prefetch_scan(ctx);
   ctx.prefetch("collapse_cost.cl");
-  const CollapseOptions::Conflicts conflicts = o.bounds_boundary_error() ? CollapseOptions::Greedy : o.conflicts;
+  const CollapseOptions::Conflicts conflicts = bounded ? CollapseOptions::Greedy : o.conflicts;
   if (conflicts == CollapseOptions::Matching) ctx.prefetch("collapse_matching.cl");
   if (conflicts == CollapseOptions::AtomicMin) ctx.prefetch("collapse_atomic_min.cl");
   if (conflicts == CollapseOptions::TwoPass) ctx.prefetch("collapse_conflict.cl");
@@ -114,11 +121,11 @@ void prefetch_programs(Context& ctx, const CollapseOptions& o) {
 }  // namespace collapse_detail
 
 CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
-  // The field error bound's check reads the input vertices of the region a collapse changes,
-  // which live on the host (CollapseOptions::max_field_error).
-  if (options.method == CollapseOptions::Sequential || options.max_field_error > 0)
-    return collapse_sequential(mesh, options);
-  if (options.bounds_boundary_error()) return collapse_bounded(mesh, options, ctx);
+  switch (collapse_path(options)) {
+    case CollapsePath::Host: return collapse_sequential(mesh, options);
+    case CollapsePath::DeviceBounded: return collapse_bounded(mesh, options, ctx);
+    case CollapsePath::Device: break;
+  }
   return collapse_on_device(mesh, options, ctx);
 }
 

@@ -7,6 +7,12 @@
 #include "tetcollapse/device.hpp"
 
 namespace tc::collapse_detail {
+// Which way collapse() goes: the sequential method on the host (asked for, or under a field
+// error bound, whose check reads the input on the host), the device under a boundary error
+// bound, or the device alone.
+enum class CollapsePath { Host, DeviceBounded, Device };
+CollapsePath collapse_path(const CollapseOptions& options);  // collapse.cpp
+// The programs of collapse()'s path on the device (none on the host's).
 void prefetch_programs(Context& ctx, const CollapseOptions& options);  // collapse.cpp
 }
 
