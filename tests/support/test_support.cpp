@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <random>
 #include <sstream>
 #include <sys/wait.h>
@@ -158,7 +159,11 @@ Mesh slab(int n) {
   });
 }
 
-Mesh ball(int n) {
+namespace {
+// cube_tets(n) moved to [-1, 1]^3 and pushed out radially: a point p goes to p / |p|_2 x |p|_inf x
+// radius(p / |p|_2), so the cube's shells become the shells of the star-shaped solid `radius`
+// gives the size of in each direction.
+Mesh pushed_out_cube(int n, const std::function<double(const double*)>& radius) {
   Mesh m = cube_tets(n);
   for (size_t i = 0; i < m.points.size(); i += 3) {
     double p[3], inf = 0, two = 0;
@@ -168,9 +173,16 @@ Mesh ball(int n) {
       two += p[c] * p[c];
     }
     two = std::sqrt(two);
-    for (int c = 0; c < 3; ++c) m.points[i + size_t(c)] = two > 0 ? p[c] * inf / two : 0;
+    const double d[3] = {two > 0 ? p[0] / two : 0, two > 0 ? p[1] / two : 0, two > 0 ? p[2] / two : 0};
+    const double r = two > 0 ? radius(d) : 0;
+    for (int c = 0; c < 3; ++c) m.points[i + size_t(c)] = d[c] * inf * r;
   }
   return m;
+}
+}  // namespace
+
+Mesh ball(int n) {
+  return pushed_out_cube(n, [](const double*) { return 1.0; });
 }
 
 Mesh filleted_cylinder(int n, double fillet) {
@@ -181,28 +193,15 @@ Mesh filleted_cylinder(int n, double fillet) {
     const double a = std::hypot(q[0], q[1]) - core, b = std::fabs(q[2]) - core;
     return std::hypot(std::max(a, 0.0), std::max(b, 0.0)) + std::min(std::max(a, b), 0.0) - fillet;
   };
-  Mesh m = cube_tets(n);
-  for (size_t i = 0; i < m.points.size(); i += 3) {
-    double p[3], inf = 0, two = 0;
-    for (int c = 0; c < 3; ++c) {
-      p[c] = 2 * m.points[i + size_t(c)] - 1;
-      inf = std::max(inf, std::fabs(p[c]));
-      two += p[c] * p[c];
-    }
-    two = std::sqrt(two);
-    if (two == 0) {
-      for (int c = 0; c < 3; ++c) m.points[i + size_t(c)] = 0;
-      continue;
-    }
-    // where the ray along p leaves the shape (convex, around the origin): bisection
+  // where the ray along d leaves the shape (convex, around the origin): bisection
+  return pushed_out_cube(n, [&](const double* d) {
     double lo = 0, hi = 2;
     for (int it = 0; it < 60; ++it) {
-      const double mid = (lo + hi) / 2, q[3] = {p[0] / two * mid, p[1] / two * mid, p[2] / two * mid};
+      const double mid = (lo + hi) / 2, q[3] = {d[0] * mid, d[1] * mid, d[2] * mid};
       (sdf(q) < 0 ? lo : hi) = mid;
     }
-    for (int c = 0; c < 3; ++c) m.points[i + size_t(c)] = p[c] / two * inf * lo;
-  }
-  return m;
+    return lo;
+  });
 }
 
 Mesh torus(int n, int ring) {
