@@ -95,9 +95,10 @@ CollapsePath collapse_path(const CollapseOptions& o) {
 void prefetch_programs(Context& ctx, const CollapseOptions& o) {
   const CollapsePath path = collapse_path(o);
   if (path == CollapsePath::Host) return;
-  // under a bound the selection is greedy, and every program is built with kBoundDefines
+  // under a bound the selection is greedy, and the programs with its test are built with
+  // kBoundDefines
   const bool bounded = path == CollapsePath::DeviceBounded;
-  const Context::ProgramOptions variant(ctx, bounded ? kBoundDefines : "");
+  const Context::ProgramOptions variant(ctx, bounded ? kBoundDefines : "", kBoundHeader);
   // the first needed, then the largest (the group of collapse_admissible.cl), so that the
   // compiles of a first run end together
   ctx.prefetch("collapse_connectivity.cl");
@@ -134,7 +135,7 @@ namespace {
 CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
   check_options(options, ctx);
   check_device_memory(ctx, mesh, options);
-  const Context::ProgramOptions variant(ctx, options.max_boundary_error_abs > 0 ? kBoundDefines : "");
+  const Context::ProgramOptions variant(ctx, options.max_boundary_error_abs > 0 ? kBoundDefines : "", kBoundHeader);
   prefetch_programs(ctx, options);
   CollapseReport report = report_for(mesh, ctx);
   StageParams p = params_from(options);

@@ -65,9 +65,11 @@ struct StageParams : CheckParams {
   double bound = 0;
   uint32_t eps_col = 0;
 };
-// The build option of every program of a run under a boundary error bound
-// (Context::ProgramOptions: each program is built in one variant per run).
+// The build option of the programs of a run under a boundary error bound that test it, those
+// with the selection's test (kBoundHeader): set for the run (Context::ProgramOptions), so each
+// program is built in one variant per run, and the others are the unbounded run's.
 constexpr const char* kBoundDefines = "-DTCC_BOUND";
+constexpr const char* kBoundHeader = "collapse_select.h";
 // The hidden last vertex field that carries the boundary error bound per vertex through a run
 // on the device or through the improvement's collapse step (popped before the caller sees it).
 constexpr const char* kBoundField = "tetcollapse:boundary_error";

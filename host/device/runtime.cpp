@@ -500,7 +500,8 @@ cl::Program& Context::program(const std::string& file, const std::string& option
   return build(name, text, options);
 }
 
-std::string Context::options_as_built(const std::string& options) const {
+std::string Context::options_as_built(const std::string& name, const std::string& text,
+                                      const std::string& options) const {
   std::string opts = "-cl-std=CL1.2";
   // CPU devices run a work-group's items one after another, so a kernel may prefetch for its
   // next items (the selections' decisions and match_apply: tcc_prefetch_test in
@@ -512,14 +513,28 @@ std::string Context::options_as_built(const std::string& options) const {
   // (host/collapse/launch.hpp)
   opts += " -cl-kernel-arg-info";
   if (!options.empty()) opts += " " + options;
-  if (!run_options_.empty()) opts += " " + run_options_;
+  if (!run_options_.empty()) {
+    bool applies = run_header_.empty();
+    if (!applies) {
+      const std::string key = name + '\n' + std::to_string(std::hash<std::string>{}(text));
+      auto it = includes_.find(key);
+      if (it == includes_.end()) {
+        std::set<std::string> seen{name};
+        std::string expanded;
+        expand_text(text, expanded, seen, 0);
+        it = includes_.emplace(key, std::move(seen)).first;
+      }
+      applies = it->second.count(run_header_) > 0;
+    }
+    if (applies) opts += " " + run_options_;
+  }
   if (const char* extra = std::getenv("TETCOLLAPSE_CL_OPTIONS"); extra && *extra) opts += std::string(" ") + extra;
   return opts;
 }
 
 Context::Unit Context::unit(const std::string& file, const std::string& text, const std::string& options) const {
   Unit u;
-  u.opts = options_as_built(options);
+  u.opts = options_as_built(file, text, options);
   std::set<std::string> seen{file};
   expand_text(text, u.source, seen, 0);
   u.cache_key = info_.name + '\n' + info_.vendor + '\n' + info_.driver_version + '\n' + info_.platform_version + '\n' +
@@ -537,7 +552,7 @@ device_detail::CompilePool& Context::pool() {
 
 void Context::prefetch(const std::string& file_in, const std::string& options) {
   const auto [file, text] = program_of(file_in);
-  if (programs_.count({file, options_as_built(options)})) return;
+  if (programs_.count({file, options_as_built(file, text, options)})) return;
   Unit u = unit(file, text, options);
   device_detail::ProgramCache cache(cache_dir(), u.cache_key);
   std::error_code ec;
@@ -552,7 +567,7 @@ void Context::prefetch(const std::string& file_in, const std::string& options) {
 cl::Program& Context::build(const std::string& file, const std::string& text, const std::string& options) {
   // in memory under the options as built: a change of cpu_tuning or of the environment's
   // options between two calls builds again
-  const std::string opts = options_as_built(options);
+  const std::string opts = options_as_built(file, text, options);
   auto key = std::make_pair(file, opts);
   if (auto it = programs_.find(key); it != programs_.end()) {
     last_build_source_ = BuildSource::Memory;

@@ -23,6 +23,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -126,22 +127,29 @@ class Context {
   // nor the disk cache, so that a first run compiles the programs it will use on every core
   // while it waits for the first of them; program() then takes the result.
   void prefetch(const std::string& file, const std::string& options = "");
-  // Build options added to every program built or prefetched while it lives, after the call's
-  // own: the variant a whole run needs (the collapse under a boundary error bound compiles every
-  // program with -DTCC_BOUND), set once for the run so that each program is built once and not in
-  // two variants. Scopes nest; the innermost applies.
+  // Build options added, after the call's own, to every program built or prefetched while it
+  // lives whose source includes the embedded file `header` (empty: every program): the variant
+  // a whole run needs of the programs that test it (the collapse under a boundary error bound:
+  // -DTCC_BOUND for those with collapse_select.h), set once for the run, so that each program is
+  // built once, and those that do not test it are the same program with or without. Scopes
+  // nest; the innermost applies.
   class ProgramOptions {
    public:
-    ProgramOptions(Context& ctx, std::string options) : ctx_(ctx), saved_(std::move(ctx.run_options_)) {
+    ProgramOptions(Context& ctx, std::string options, std::string header = "")
+        : ctx_(ctx), saved_(std::move(ctx.run_options_)), saved_header_(std::move(ctx.run_header_)) {
       ctx.run_options_ = std::move(options);
+      ctx.run_header_ = std::move(header);
     }
-    ~ProgramOptions() { ctx_.run_options_ = std::move(saved_); }
+    ~ProgramOptions() {
+      ctx_.run_options_ = std::move(saved_);
+      ctx_.run_header_ = std::move(saved_header_);
+    }
     ProgramOptions(const ProgramOptions&) = delete;
     ProgramOptions& operator=(const ProgramOptions&) = delete;
 
    private:
     Context& ctx_;
-    std::string saved_;
+    std::string saved_, saved_header_;
   };
 
   // Enqueues a 1-D launch of n work items: the global size is n rounded up to a multiple of the
@@ -177,7 +185,9 @@ class Context {
     std::string opts, source, cache_key;
   };
   Unit unit(const std::string& file, const std::string& text, const std::string& options) const;
-  std::string options_as_built(const std::string& options) const;
+  // The options a program is built with: the call's, cpu_tuning's, the run's (ProgramOptions,
+  // when `text`, the program `name`'s source, includes its header) and the environment's.
+  std::string options_as_built(const std::string& name, const std::string& text, const std::string& options) const;
   device_detail::CompilePool& pool();
   DeviceInfo info_;
   cl::Platform platform_;
@@ -190,7 +200,10 @@ class Context {
   BuildSource last_build_source_ = BuildSource::Memory;
   std::function<void(const std::string&, int, int)> compile_notice_;
   int compiles_done_ = 0, compiles_total_ = 0;
-  std::string run_options_;  // (ProgramOptions)
+  std::string run_options_, run_header_;  // (ProgramOptions)
+  // Per program (name and a hash of its text), the embedded files its source includes
+  // (ProgramOptions' header test).
+  mutable std::map<std::string, std::set<std::string>> includes_;
   std::unique_ptr<device_detail::CompilePool> pool_;  // made at the first compile from source
 };
 

@@ -398,8 +398,9 @@ TEST_F(RuntimeCtx, FilesOfAGroupShareOneProgram) {
   EXPECT_NE(&ctx_->program("scan.cl"), &cost) << "a file of no group is a program of its own";
 }
 
-// Options set for a scope reach every program built in it, after the call's own; the scope
-// ends, the programs without them come back; the innermost scope applies.
+// Options set for a scope reach every program built in it (or, given a header, those that
+// include it), after the call's own; the scope ends, the programs without them come back; the
+// innermost scope applies.
 TEST_F(RuntimeCtx, ProgramOptionsApplyToEveryProgramOfTheirScope) {
   const auto options = [&](cl::Program& p) { return p.getBuildInfo<CL_PROGRAM_BUILD_OPTIONS>(ctx_->device()); };
   cl::Program& plain = ctx_->program("scan.cl");
@@ -417,6 +418,16 @@ TEST_F(RuntimeCtx, ProgramOptionsApplyToEveryProgramOfTheirScope) {
     EXPECT_EQ(&ctx_->program("scan.cl"), &scan);
   }
   EXPECT_EQ(&ctx_->program("scan.cl"), &plain);
+  // with a header: only the programs that include it
+  cl::Program& select = ctx_->program("collapse_select_greedy.cl");
+  {
+    const tc::Context::ProgramOptions variant(*ctx_, "-DTCC_VARIANT", "collapse_select.h");
+    EXPECT_EQ(&ctx_->program("scan.cl"), &plain) << "scan.cl does not include collapse_select.h";
+    cl::Program& with = ctx_->program("collapse_select_greedy.cl");
+    EXPECT_NE(&with, &select);
+    EXPECT_NE(options(with).find("-DTCC_VARIANT"), std::string::npos) << options(with);
+  }
+  EXPECT_EQ(&ctx_->program("collapse_select_greedy.cl"), &select);
 }
 
 TEST(Runtime, CacheDirFollowsTheEnvironment) {
