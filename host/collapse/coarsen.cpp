@@ -108,6 +108,7 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
 
   if (ctx) collapse_detail::prefetch_programs(*ctx, co);
   if (ctx && improve_phase) improve_detail::prefetch_programs(*ctx);
+  if (ctx && resample) fields_detail::prefetch_programs(*ctx);
   CoarsenReport r;
   {
     const bool cost_by_field = by_field && !(co.max_field_error > 0);

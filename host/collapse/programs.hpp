@@ -19,3 +19,8 @@ void prefetch_programs(Context& ctx, const CollapseOptions& options);  // collap
 namespace tc::improve_detail {
 void prefetch_programs(Context& ctx);  // improve.cpp
 }
+
+namespace tc::fields_detail {
+// resample_vertex_fields' on the device: the BVH, its sort and scan (device/bvh.cpp).
+void prefetch_programs(Context& ctx);
+}

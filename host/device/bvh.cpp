@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "collapse/programs.hpp"
 #include "device/primitives.hpp"
 #include "fields_detail.hpp"
 #include "tetcollapse/fields.hpp"
@@ -32,6 +33,12 @@ void launch(Context& ctx, const char* name, size_t n, const A&... a) {
 cl_uint u32(int64_t v) { return static_cast<cl_uint>(v); }
 
 }  // namespace
+
+void fields_detail::prefetch_programs(Context& ctx) {
+  ctx.prefetch(kFile);
+  dev::prefetch_sort(ctx);
+  dev::prefetch_scan(ctx);
+}
 
 DeviceTetLocator::DeviceTetLocator(const Mesh& mesh, Context& ctx)
     : mesh_(mesh), ctx_(ctx), n_(mesh.num_tets()) {

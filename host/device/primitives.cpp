@@ -129,6 +129,8 @@ uint32_t compact_values(Context& ctx, const DeviceBuffer<T>& values, const Devic
   return count;
 }
 
+std::string sort_options(Context& ctx) { return "-DTC_RADIX_BITS=" + std::to_string(tuning_for(ctx).radix_bits); }
+
 void radix_sort_impl(Context& ctx, DeviceBuffer<uint64_t>& keys, DeviceBuffer<uint32_t>* values, size_t n,
                      int key_bits) {
   check_n(n, "radix_sort");
@@ -138,7 +140,7 @@ void radix_sort_impl(Context& ctx, DeviceBuffer<uint64_t>& keys, DeviceBuffer<ui
   if (n <= 1) return;
   Tuning t = tuning_for(ctx);
   const unsigned kRadixBits = static_cast<unsigned>(t.radix_bits), kSortChunk = t.sort_chunk;
-  const std::string kSortOptions = "-DTC_RADIX_BITS=" + std::to_string(kRadixBits);
+  const std::string kSortOptions = sort_options(ctx);
   size_t items = (n + kSortChunk - 1) / kSortChunk;
   size_t radix = size_t{1} << kRadixBits;
   DeviceBuffer<uint64_t> keys_tmp(ctx, n);
@@ -177,6 +179,7 @@ void radix_sort_impl(Context& ctx, DeviceBuffer<uint64_t>& keys, DeviceBuffer<ui
 }  // namespace
 
 void prefetch_scan(Context& ctx) { ctx.prefetch("scan.cl", scan_options(ctx)); }
+void prefetch_sort(Context& ctx) { ctx.prefetch("sort.cl", sort_options(ctx)); }
 
 Tuning default_tuning(bool cpu) {
   Tuning t;

@@ -37,6 +37,8 @@ Tuning tuning_for(const Context& ctx);
 // in and out may be the same buffer. out must hold at least n values.
 // Queues the scan's program (Context::prefetch).
 void prefetch_scan(Context& ctx);
+// Queues the radix sort's program (Context::prefetch).
+void prefetch_sort(Context& ctx);
 uint32_t exclusive_scan(Context& ctx, const DeviceBuffer<uint32_t>& in, DeviceBuffer<uint32_t>& out, size_t n);
 inline uint32_t exclusive_scan(Context& ctx, const DeviceBuffer<uint32_t>& in, DeviceBuffer<uint32_t>& out) {
   return exclusive_scan(ctx, in, out, in.size());
