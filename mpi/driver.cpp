@@ -130,7 +130,7 @@ int run(Options& o, MPI_Comm comm) {
   const double bound = o.max_boundary_error_abs > 0 ? o.max_boundary_error_abs : o.max_boundary_error * s.whole_diagonal;
   stats.boundary_error_bound = bound;
   if (bound > 0 && rank == 0) whole.vertex_fields.push_back({kSpentField, 1, std::vector<double>(size_t(whole.num_vertices()), 0.0)});
-  // (none after a user's placement or predicate, as tc::coarsen)
+  // (none after a user's placement or predicate, or with every operation off, as tc::coarsen)
   CoarsenOptions as_coarsen;
   as_coarsen.collapse = s.collapse, as_coarsen.improve = !o.no_improve, as_coarsen.improvement = s.improve;
   const bool improve_phase = improvement_follows(as_coarsen);

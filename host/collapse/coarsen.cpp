@@ -78,7 +78,8 @@ bool improvement_follows(const CoarsenOptions& options) {
   const CollapseOptions& co = options.collapse;
   const ImproveOptions& io = options.improvement;
   return options.improve && co.predicate_cl_source.empty() && co.placement_cl_source.empty() &&
-         !(co.max_field_error > 0) && (io.flips || io.smoothing || io.collapse);
+         !(co.max_field_error > 0) && io.max_iterations > 0 &&
+         (io.flips || io.smoothing || (io.collapse && io.collapse_rounds > 0));
 }
 
 CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, const Mesh* original) {
@@ -124,7 +125,7 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
     io.eps_f = co.eps_f;
     io.eps_r = co.eps_r;
     io.use_labels = co.use_labels;
-    // what the collapse left of the boundary error bound (DBL_MIN: only exact changes)
+    // the whole boundary error bound, from what the collapse spent at each vertex
     if (bound > 0) {
       io.max_boundary_error_abs = bound;
       io.vertex_boundary_error = r.collapse.vertex_boundary_error;

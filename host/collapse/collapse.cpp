@@ -62,11 +62,12 @@ CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Cont
   o.selection_rounds = 1;  // (a two-pass option)
   // The user's functions read the first vertex field as f0 (0 when there is none): a field of
   // zeros keeps the bound's field from being the first.
-  std::vector<double> start = initial_boundary_error(mesh, options);
+  Field bound_field{kBoundField, 1, initial_boundary_error(mesh, options)};
   const size_t added = mesh.vertex_fields.empty() && options.has_user_functions() ? 2 : 1;
-  const size_t nv = size_t(mesh.num_vertices());
-  if (added == 2) mesh.vertex_fields.push_back({"tetcollapse:none", 1, std::vector<double>(nv, 0.0)});
-  mesh.vertex_fields.push_back({kBoundField, 1, std::move(start)});
+  Field none{"tetcollapse:none", 1, std::vector<double>(added == 2 ? size_t(mesh.num_vertices()) : 0, 0.0)};
+  mesh.vertex_fields.reserve(mesh.vertex_fields.size() + added);  // (the moves below cannot throw)
+  if (added == 2) mesh.vertex_fields.push_back(std::move(none));
+  mesh.vertex_fields.push_back(std::move(bound_field));
   o.vertex_boundary_error.clear();  // (in the field now)
   const auto drop_added = [&] { mesh.vertex_fields.resize(mesh.vertex_fields.size() - added); };
   CollapseReport report;

@@ -176,16 +176,21 @@ int64_t collapse_bad(Mesh& mesh, ImproveOptions& options, bool harmonic) {
   // is selected: the mean of two ones); under a bound the step goes on from what was spent at
   // each vertex, which reaches the star mesh and comes back through the splice as the last field.
   const bool masked = !selected.empty();
-  if (masked) mesh.vertex_fields.push_back({kMaskField, 1, std::vector<double>(selected.begin(), selected.end())});
   const bool bounded = options.boundary == CollapseOptions::Features && options.max_boundary_error_abs > 0;
-  if (bounded) {
-    o.max_boundary_error_abs = options.max_boundary_error_abs;
-    std::vector<double> spent = options.vertex_boundary_error;
-    spent.resize(size_t(mesh.num_vertices()), 0.0);
-    mesh.vertex_fields.push_back({collapse_detail::kBoundField, 1, std::move(spent)});
-  }
+  if (bounded) o.max_boundary_error_abs = options.max_boundary_error_abs;
+  const size_t fields = mesh.vertex_fields.size();
   int64_t collapsed = 0;
   try {
+    if (masked) {
+      std::vector<double> ones(selected.size());
+      for (size_t v = 0; v < selected.size(); ++v) ones[v] = selected[v] ? 1.0 : 0.0;
+      mesh.vertex_fields.push_back({kMaskField, 1, std::move(ones)});
+    }
+    if (bounded) {
+      std::vector<double> spent = options.vertex_boundary_error;
+      spent.resize(size_t(mesh.num_vertices()), 0.0);
+      mesh.vertex_fields.push_back({collapse_detail::kBoundField, 1, std::move(spent)});
+    }
     StarMesh star = star_mesh(mesh, mask);
     o.vertex_mask.resize(star.verts.size());
     for (size_t i = 0; i < star.verts.size(); ++i) o.vertex_mask[i] = mask[size_t(star.verts[i])];
@@ -198,8 +203,7 @@ int64_t collapse_bad(Mesh& mesh, ImproveOptions& options, bool harmonic) {
     if (bounded) star.mesh.vertex_fields.back().values = run.boundary_errors();
     if (collapsed > 0) splice(mesh, star, run);
   } catch (...) {
-    if (bounded) mesh.vertex_fields.pop_back();  // (the bound's field, last)
-    if (masked) mesh.vertex_fields.pop_back();
+    mesh.vertex_fields.resize(fields);  // (the mask's and the bound's, last)
     throw;
   }
   if (bounded) {
@@ -209,7 +213,7 @@ int64_t collapse_bad(Mesh& mesh, ImproveOptions& options, bool harmonic) {
   if (masked) {
     const std::vector<double>& m = mesh.vertex_fields.back().values;
     options.vertex_mask.assign(m.size(), 0);
-    for (size_t v = 0; v < m.size(); ++v) options.vertex_mask[v] = m[v] == 1.0;
+    for (size_t v = 0; v < m.size(); ++v) options.vertex_mask[v] = m[v] > 0.5;
     mesh.vertex_fields.pop_back();
   }
   return collapsed;

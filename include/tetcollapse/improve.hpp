@@ -31,12 +31,12 @@
 //     largest drop first, the survivor where a line search along the edge puts the smallest
 //     sum), then the shortest; each only when it does not lower the worst quality of what it
 //     reshapes; then the passes above again; up to 4 such rounds, each only after one that
-//     raised the smallest angle or removed a tenth of the tets below 10 or 13 degrees (one
-//     round under a boundary error bound)
+//     raised the smallest angle or removed a tenth of the tets below 10 or 13 degrees
 //
 // The worst quality of the mesh never falls: each operation is accepted only when the worst
 // quality of what it changes rises. Flips change interior faces of one label only, so the
-// material interfaces and vertex numbering are kept; the outer boundary changes only by the
+// material interfaces are kept (and the vertex numbering, but by the collapse step); the outer
+// boundary changes only by the
 // removal of thin boundary tets (within max_boundary_move, tagged triangles following), and in
 // strict mode not at all: no boundary vertex moves, so the boundary stays bit for bit.
 #pragma once

@@ -209,7 +209,7 @@ TEST(ImproveOps, ASliverOnlyACollapseRemoves) {
   // under a vertex mask the step collapses between selected vertices only (the mask follows
   // its renumbering into the passes after it)
   Mesh all = without;
-  o.vertex_mask.assign(size_t(all.num_vertices()), 1);
+  o.vertex_mask.assign(size_t(all.num_vertices()), 7);  // (non-zero: selected)
   const ImproveReport ra = improve(all, o);
   EXPECT_EQ(all.tets, m.tets) << "a mask of every vertex is none";
   EXPECT_EQ(ra.after.below_13_deg, 0);
