@@ -55,6 +55,10 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context* ctx
     }
   r.frozen = int64_t(frozen_at.size());
   const std::vector<double> points_in = m.points;  // only the frozen ones are read back
+  // The user's functions read the first vertex field as f0, 0 when the mesh has none (as in
+  // tetcollapse): a field of zeros keeps the id field from being the first.
+  const bool placeholder = m.vertex_fields.empty() && s.collapse.has_user_functions();
+  if (placeholder) m.vertex_fields.push_back({"tetcollapse-mpi:none", 1, std::vector<double>(nv, 0.0)});
   m.vertex_fields.push_back(std::move(id));
 
   // (an all-ones mask: none)
@@ -91,6 +95,7 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context* ctx
   // The frozen vertices again: the id field exact and the position bit for bit.
   const std::vector<double> ids = std::move(m.vertex_fields.back().values);
   m.vertex_fields.pop_back();
+  if (placeholder) m.vertex_fields.pop_back();
   const size_t n_out = size_t(m.num_vertices());
   part.gid.assign(n_out, -1);
   part.frozen.assign(n_out, 0);

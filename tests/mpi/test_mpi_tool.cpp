@@ -294,6 +294,19 @@ TEST(MpiToolOptions, UserFunctionsAndSizingFieldAsTetcollapse) {
   }
   EXPECT_EQ(run_mpi(2, in + " " + dir.file("x.vtu") + " --cost-cl " + dir.file("cost.cl"), &log), 2) << log;
   EXPECT_NE(log.find("needs --target-length"), std::string::npos) << log;
+  // on a mesh without vertex fields f0 and f1 are 0, as in tetcollapse (not the tool's own fields)
+  const std::string bare = tc::test::project_mesh("bracket.msh");
+  tc::test::write_text(dir.file("any.cl"), "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) { return 1; }\n");
+  tc::test::write_text(dir.file("zero.cl"),
+                       "int tc_user_predicate(double3 p0, double3 p1, double f0, double f1) { return f0 == 0.0 && f1 == 0.0; }\n");
+  for (const char* bound : {"", " --max-boundary-error 0"}) {
+    ASSERT_EQ(run_mpi(2, bare + " " + dir.file("any.msh") + " -q --target-factor 2 --predicate-cl " + dir.file("any.cl") + bound, &log), 0)
+        << log;
+    ASSERT_EQ(run_mpi(2, bare + " " + dir.file("zero.msh") + " -q --target-factor 2 --predicate-cl " + dir.file("zero.cl") + bound, &log),
+              0)
+        << log;
+    EXPECT_EQ(tc::read_mesh(dir.file("zero.msh")).tets, tc::read_mesh(dir.file("any.msh")).tets) << bound;
+  }
 }
 
 // Two labels with an interface plane, a linear vertex field and a tet field: the labels' volumes
