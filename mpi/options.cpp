@@ -46,6 +46,9 @@ void add_options(CLI::App& app, Options& o) {
                  "Direct volume rendering (the paper's Section 4.5), as tetcollapse: collapse the edges whose\n"
                  "two ends differ in vertex field NAME by less than --field-tolerance x its range over the\n"
                  "whole input (instead of --target-length / --target-factor)");
+  app.add_option("--max-field-error", o.max_field_error,
+                 "Not here (tetcollapse's only): a round's check would measure the field at the vertices of\n"
+                 "the mesh it is given, not at the input's, and the error would add up over the rounds");
   app.add_option("--field-tolerance", o.field_tolerance, "With --preserve-field: T (the paper's 0.02)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -145,6 +148,10 @@ void validate(const Options& o) {
                      {"--sizing-field", &o.sizing_field},
                      {"--placement-cl", &o.placement_cl},
                      {"--predicate-cl", &o.predicate_cl}});
+  if (o.max_field_error != 0)
+    throw CLI::ValidationError("--max-field-error",
+                               "is tetcollapse's only: a round of tetcollapse-mpi would check the field at the vertices "
+                               "of the mesh it is given, not at the input's (use tetcollapse, or --field-tolerance)");
   if (!o.preserve_field.empty() && !o.sizing_field.empty())
     throw CLI::ValidationError("--preserve-field", "cannot be combined with --sizing-field");
   if (!o.cost_cl.empty() && (!o.preserve_field.empty() || !o.sizing_field.empty()))

@@ -464,6 +464,9 @@ TEST(MpiToolOptions, TheCommandsOptionsMeanTheSame) {
     EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --target-factor 2 -q --check --conflicts " + c, &log), 0)
         << c << "\n" << log;
   EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --conflicts two-pass --priority-levels 3", &log), 2) << log;
+  // the one option of tetcollapse's it has not: refused, saying why
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --max-field-error 0.01", &log), 2) << log;
+  EXPECT_NE(log.find("--max-field-error: is tetcollapse's only"), std::string::npos) << log;
 }
 
 // --method sequential: every rank on the CPU, with no device opened; valid and within 5% of
