@@ -148,7 +148,7 @@ Kernel user_kernel(Context& ctx, const std::string& what, const std::string& fil
 }
 
 Kernel stage_kernel(Context& ctx, const StageParams& p, const std::string& file, const char* name) {
-  if (p.user_source.empty()) return Kernel(ctx.kernel(file, name, p.user_defines), name, file);
+  if (p.user_source.empty()) return kernel(ctx, file, name);
   return user_kernel(ctx, "user placement / predicate", file, name, p.user_source, p.user_defines);
 }
 
