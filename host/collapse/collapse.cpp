@@ -93,13 +93,17 @@ CollapsePath collapse_path(const CollapseOptions& o) {
   return o.bounds_boundary_error() ? CollapsePath::DeviceBounded : CollapsePath::Device;
 }
 
+// Under a bound the programs with the selection's test are built with kBoundDefines, for the
+// run (collapse_on_device) and for its prefetch (which tc::coarsen calls earlier).
+Context::ProgramOptions program_variant(Context& ctx, const CollapseOptions& o) {
+  return {ctx, collapse_path(o) == CollapsePath::DeviceBounded ? kBoundDefines : "", kBoundHeader};
+}
+
 void prefetch_programs(Context& ctx, const CollapseOptions& o) {
   const CollapsePath path = collapse_path(o);
   if (path == CollapsePath::Host) return;
-  // under a bound the selection is greedy, and the programs with its test are built with
-  // kBoundDefines
-  const bool bounded = path == CollapsePath::DeviceBounded;
-  const Context::ProgramOptions variant(ctx, bounded ? kBoundDefines : "", kBoundHeader);
+  const bool bounded = path == CollapsePath::DeviceBounded;  // (the selection then greedy)
+  const Context::ProgramOptions variant = program_variant(ctx, o);
   // the first needed, then the largest (the group of collapse_admissible.cl), so that the
   // compiles of a first run end together
   ctx.prefetch("collapse_connectivity.cl");
@@ -136,7 +140,7 @@ namespace {
 CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
   check_options(options, ctx);
   check_device_memory(ctx, mesh, options);
-  const Context::ProgramOptions variant(ctx, options.max_boundary_error_abs > 0 ? kBoundDefines : "", kBoundHeader);
+  const Context::ProgramOptions variant = program_variant(ctx, options);
   prefetch_programs(ctx, options);
   CollapseReport report = report_for(mesh, ctx);
   StageParams p = params_from(options);
