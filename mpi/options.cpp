@@ -1,5 +1,6 @@
 #include "options.hpp"
 
+#include "cli/common.hpp"
 #include "cli/masks.hpp"
 #include "tetcollapse/coarsen.hpp"
 
@@ -138,7 +139,7 @@ void add_options(CLI::App& app, Options& o) {
 
 void resolve_defaults(Options& o) {
   if (o.max_boundary_error < 0)
-    o.max_boundary_error = o.boundary == "features" && !(o.max_boundary_error_abs > 0) ? kDefaultMaxBoundaryError : 0;
+    o.max_boundary_error = o.max_boundary_error_abs > 0 ? 0 : default_max_boundary_error(cli::boundary_mode(o.boundary));
 }
 
 void validate(const Options& o) {

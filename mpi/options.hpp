@@ -45,7 +45,7 @@ void add_options(CLI::App& app, Options& o);
 // What CLI11 cannot check alone; throws CLI::ValidationError.
 void validate(const Options& o);
 // The defaults that depend on other options, as tetcollapse's: the boundary error bound
-// (kDefaultMaxBoundaryError in features mode, none in the other modes).
+// (default_max_boundary_error).
 void resolve_defaults(Options& o);
 
 }  // namespace tc::mpi

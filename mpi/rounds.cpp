@@ -1,7 +1,6 @@
 #include "rounds.hpp"
 
 #include <algorithm>
-#include <limits>
 #include <cstdio>
 #include <malloc.h>
 

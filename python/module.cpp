@@ -141,9 +141,8 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
   o.boundary = boundary_of(boundary);
   o.min_quality = min_quality;
   // the command line's default: a bound in features mode unless one is given (None)
-  o.max_boundary_error = !max_boundary_error.is_none()                ? max_boundary_error.cast<double>()
-                         : o.boundary == CollapseOptions::Features ? kDefaultMaxBoundaryError
-                                                                    : 0.0;
+  o.max_boundary_error =
+      !max_boundary_error.is_none() ? max_boundary_error.cast<double>() : default_max_boundary_error(o.boundary);
   o.max_field_error = max_field_error;
   co.improve = improve_phase;
   co.resample_fields = !average_fields;

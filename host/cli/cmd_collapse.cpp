@@ -274,7 +274,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
     }
     // the default bound, in features mode only (the other modes refuse one given)
     if (c->bound_options[0]->count() == 0 && c->bound_options[1]->count() == 0)
-      opt.max_boundary_error = opt.boundary == CollapseOptions::Features ? kDefaultMaxBoundaryError : 0.0;
+      opt.max_boundary_error = default_max_boundary_error(opt.boundary);
     if (opt.bounds_boundary_error()) {
       if (opt.boundary != CollapseOptions::Features)
         throw CLI::ValidationError("--max-boundary-error",

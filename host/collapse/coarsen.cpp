@@ -71,6 +71,10 @@ size_t apply_field_options(const Mesh& mesh, const CoarsenOptions& options, Coll
   return 0;
 }
 
+double default_max_boundary_error(CollapseOptions::Boundary mode) {
+  return mode == CollapseOptions::Features ? kDefaultMaxBoundaryError : 0.0;
+}
+
 bool improvement_follows(const CoarsenOptions& options) {
   // A user's predicate or placement states rules the improvement cannot know; the improvement's
   // moves are not checked against a field error bound; with its every operation off it would

@@ -8,14 +8,18 @@
 
 namespace tc::collapse_detail {
 
+void check_bound_mode(bool bounded, CollapseOptions::Boundary mode, const char* option) {
+  if (bounded && mode != CollapseOptions::Features)
+    throw std::invalid_argument(std::string(option) +
+                                " applies to the features boundary mode (strict keeps the boundary exactly, free "
+                                "does not bound it)");
+}
+
 void check_boundary_error_options(const CollapseOptions& o) {
   if (!(o.max_boundary_error >= 0) || !(o.max_boundary_error_abs >= 0) || std::isinf(o.max_boundary_error) ||
       std::isinf(o.max_boundary_error_abs))
     throw std::invalid_argument("max_boundary_error and max_boundary_error_abs must be finite and >= 0");
-  if (o.bounds_boundary_error() && o.boundary != CollapseOptions::Features)
-    throw std::invalid_argument(
-        "max_boundary_error applies to the features boundary mode (strict keeps the boundary exactly, free "
-        "does not bound it)");
+  check_bound_mode(o.bounds_boundary_error(), o.boundary, "max_boundary_error");
   if (!o.vertex_boundary_error.empty() && !o.bounds_boundary_error())
     throw std::invalid_argument("vertex_boundary_error needs a boundary error bound (max_boundary_error)");
 }

@@ -76,6 +76,9 @@ constexpr const char* kBoundField = "tetcollapse:boundary_error";
 // The boundary error bound's options, for both methods (std::invalid_argument): finite, >= 0,
 // and only in the features mode.
 void check_boundary_error_options(const CollapseOptions& o);
+// That a bound (`bounded`; `option` names it) comes only with the features mode
+// (std::invalid_argument): the collapse's and the improvement's.
+void check_bound_mode(bool bounded, CollapseOptions::Boundary mode, const char* option);
 // The bound per vertex at the start of a run: CollapseOptions::vertex_boundary_error, checked
 // against the mesh (std::invalid_argument), or zeros.
 std::vector<double> initial_boundary_error(const Mesh& mesh, const CollapseOptions& o);

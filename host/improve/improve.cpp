@@ -225,10 +225,7 @@ ImproveReport improve_on(Mesh& mesh, const ImproveOptions& given, Context* ctx) 
   ImproveReport report;
   report.before = quality_summary(mesh);
   // Under a boundary error bound, options.vertex_boundary_error follows each stage's changes.
-  if (given.max_boundary_error_abs > 0 && given.boundary != CollapseOptions::Features)
-    throw std::invalid_argument(
-        "max_boundary_error_abs applies to the features boundary mode (strict keeps the boundary exactly, free does "
-        "not bound it)");
+  collapse_detail::check_bound_mode(given.max_boundary_error_abs > 0, given.boundary, "max_boundary_error_abs");
   ImproveOptions options = given;
   passes(mesh, options, ctx, options.max_iterations, report, true);
   // Rounds of the collapse step and the passes after it, while a round raises the smallest angle

@@ -59,6 +59,9 @@ struct CoarsenReport {
 // diagonal) that the command lines and the Python module apply in features mode unless told
 // otherwise (0 there: none, the paper's method). CollapseOptions itself keeps 0.
 constexpr double kDefaultMaxBoundaryError = 0.001;
+// That default for a boundary mode: kDefaultMaxBoundaryError in features mode, 0 in the others
+// (which refuse a bound).
+double default_max_boundary_error(CollapseOptions::Boundary mode);
 
 // The share of a boundary error bound the collapse may use when the improvement phase follows
 // (the rest is for the improvement's boundary moves, which remove the slivers at a curved
