@@ -71,20 +71,21 @@ inline double tcc_bound_change(int x, int y, int moves_y, double3 p, __global co
   return tcc_fan_distance(olds, no, news, nn);
 }
 
-/* Whether the collapse of e = (a, b) in direction dir keeps the bound (the bound per vertex in
- * component eps_col of the vertex fields). */
-inline int tcc_bound_holds(int a, int b, int dir, __global const int* tets, __global const uint* vt_off,
-                           __global const int* vt, __global const int* tet_nbr, __global const int* labels,
-                           int use_labels, __global const double* pts, __global const double* vfield,
-                           uint vfield_stride, __global const uchar* vflags, double bound, uint eps_col) {
+/* The bound the survivor of the collapse of e = (a, b) in direction dir would take (the bound
+ * per vertex in component eps_col of the vertex fields): -1 when S is not touched, INFINITY when
+ * the change cannot be bounded; the collapse keeps the bound when this is at most the bound. */
+inline double tcc_bound_after(int a, int b, int dir, __global const int* tets, __global const uint* vt_off,
+                              __global const int* vt, __global const int* tet_nbr, __global const int* labels,
+                              int use_labels, __global const double* pts, __global const double* vfield,
+                              uint vfield_stride, __global const uchar* vflags, uint eps_col) {
   int x = (dir & TCC_DIR_REMOVE_V1) ? b : a, y = x == a ? b : a;
   double3 p = tcc_placement(pts, vfield, vfield_stride, a, b, (uint)dir), py = tc_point(pts, y);
   int moves_y = !(py.x == p.x && py.y == p.y && py.z == p.z);
-  if (!vflags[x] && !(moves_y && vflags[y])) return 1; /* S is not touched */
+  if (!vflags[x] && !(moves_y && vflags[y])) return -1.0; /* S is not touched */
   double base;
   double change = tcc_bound_change(x, y, moves_y, p, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, vfield,
                                    vfield_stride, eps_col, &base);
-  return base + change <= bound;
+  return change == 0.0 ? -1.0 : base + change; /* (NaN: refused by the caller's <=) */
 }
 
 #endif /* TETCOLLAPSE_COLLAPSE_BOUND_H */

@@ -58,7 +58,7 @@
       __global const uchar *vclass, __global const uchar *eflags, int mode, int paper_rule, double eps_v,              \
       double q_min, double field_eps, __global const double *tets2quality, __global uchar *edges2dir,                  \
       __global uchar *edges2reason, __global uint *counters, __global uchar *edges2verdict, double bound,             \
-      uint eps_col, double eps_r, double eps_f, __global uchar *tets_are_dead
+      uint eps_col, __global double *edges2eps, double eps_r, double eps_f, __global uchar *tets_are_dead
 #define TCC_MATCH_ARGS TCC_TEST_ARGS, eps_r, eps_f, tets_are_dead
 
 /* Live: the S-faces through v owned by the tets of ring(v) that are left (tcc_owned_sface with

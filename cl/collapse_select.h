@@ -228,11 +228,11 @@ inline uchar tcc_link_and_volume(int a, int b, uint fa, uint fb, uint fe, int di
       __global const uchar *vflags, __global const uchar *vclass, __global const uchar *eflags, int mode,           \
       int paper_rule, double eps_v, double q_min, double field_eps, __global const double *tets2quality,            \
       __global uchar *edges2dir, __global uchar *edges2reason, __global uint *counters, __global uchar *edges2verdict, \
-      double bound, uint eps_col
+      double bound, uint eps_col, __global double *edges2eps
 #define TCC_TEST_ARGS                                                                                             \
   tets, vt_off, vt, tet_nbr, nb_off, nb, nb_edge, labels, use_labels, pts, vfield, vfield_stride, vflags, vclass, \
       eflags, mode, paper_rule, eps_v, q_min, field_eps, tets2quality, edges2dir, edges2reason, counters,         \
-      edges2verdict, bound, eps_col
+      edges2verdict, bound, eps_col, edges2eps
 
 /* Q's direction bits of the candidate e = (a, b), with the user's placement (tcc_user_dir). */
 inline int tcc_lazy_dir(int e, int a, int b, TCC_TEST_PARAMS) {
@@ -276,12 +276,17 @@ inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* edg
   uchar r = tcc_lazy_verdict(e, a, b, dir, TCC_TEST_ARGS);
 #ifdef TCC_BOUND
   /* the boundary error bound (collapse_bound.h), after the tests: not carried as a pass, since
-   * the bounds of the fan's vertices may grow while the rings stay (a refusal stays one) */
-  if (r == TCC_OK && !tcc_bound_holds(a, b, dir, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, vfield,
-                                      vfield_stride, vflags, bound, eps_col)) {
-    r = TCC_REFUSED_SURFACE;
-    edges2verdict[e] = r;
-    atomic_inc(&counters[TCC_COUNTER_BOUND_REFUSED]);
+   * the bounds of the fan's vertices may grow while the rings stay (a refusal stays one); the
+   * survivor's new bound of a collapse taken, for bound_apply (collapse_bound.cl) */
+  if (r == TCC_OK) {
+    const double after = tcc_bound_after(a, b, dir, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, vfield,
+                                         vfield_stride, vflags, eps_col);
+    edges2eps[e] = after;
+    if (!(after <= bound)) {
+      r = TCC_REFUSED_SURFACE;
+      edges2verdict[e] = r;
+      atomic_inc(&counters[TCC_COUNTER_BOUND_REFUSED]);
+    }
   }
 #endif
   edges2reason[e] = r;

@@ -51,6 +51,7 @@ void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, con
   s.lazy.verts2slot[0].fill(-1);
   run_stage(ctx, p, A, "lazy_init", c.ne, arg("ne", c.ne), arg("edges", c.edges), arg("edges_are_marked", s.cost.edges_are_marked), arg("vflags", c.vflags), arg("vclass", c.vclass), arg("eflags", c.eflags), arg("mode", mode), arg("paper_rule", paper_rule), arg("pts", dm.points), arg("vfield", dm.vfields), arg("vfield_stride", dm.vfield_comps), arg("edges2state", s.result.edges2state), arg("edges2dir", s.result.edges2dir), arg("edges2reason", s.result.edges2reason), arg("edges_are_candidates", s.lazy.edges_are_candidates), arg("counters", s.cost.counters), arg("restrict_clean", cl_int(restrict_clean ? 1 : 0)), arg("prev_verts_are_dirty", restrict_clean ? s.carry.prev_verts_are_dirty.buffer() : c.vflags.buffer()), arg("edges2verdict", s.carry.edges2verdict), arg("edges2order", order), arg("verts2slot", s.lazy.verts2slot[0]), arg("keep_refused", cl_int(keep_refused ? 1 : 0)));
   const cl::Buffer& quality = tet_qualities(ctx, dm, c, s.quality, p);
+  ensure(s.result.edges2eps, ctx, p.bound > 0 ? c.ne : 1);  // (read only under the bound: TCC_BOUND)
   for (Kernel* k : tests)
     k->set(arg("tets", dm.tets), arg("vt_off", c.vt_off), arg("vt", c.vt), arg("tet_nbr", c.tet_nbr),
            arg("nb_off", c.nb_off), arg("nb", c.nb), arg("nb_edge", c.nb_edge), arg("labels", dm.primary_labels()),
@@ -59,7 +60,7 @@ void lazy_start(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, con
            arg("eflags", c.eflags), arg("mode", mode), arg("paper_rule", paper_rule), arg("eps_v", p.eps_v),
            arg("q_min", p.min_quality), arg("field_eps", p.field_eps), arg("tets2quality", quality), arg("edges2dir", s.result.edges2dir), arg("edges2reason", s.result.edges2reason),
            arg("counters", s.cost.counters), arg("edges2verdict", s.carry.edges2verdict), arg("bound", p.bound),
-           arg("eps_col", p.eps_col));
+           arg("eps_col", p.eps_col), arg("edges2eps", s.result.edges2eps));
 }
 
 // The priority of the greedy and matching selections: greedy_priority with levels > 0, else the

@@ -1,6 +1,7 @@
 // The selection and surface guard loop every conflict detection shares (selection.hpp).
 #include "collapse/selection.hpp"
 
+#include "collapse/bound.hpp"
 #include "collapse/edge_state.hpp"
 #include "stopwatch.hpp"
 
@@ -26,20 +27,11 @@ uint32_t Selection::select(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeSt
     }
     stats.seconds_select += clock.lap();
     uint32_t left = chosen.selected;
-    if (p.bound > 0 && left > 0) {
-      const uint32_t out = bound_.test(ctx, dm, c, s, p);
-      stats.refused_by_bound += out;
-      stats.seconds_guard += clock.lap();
-      if (out > 0) {
-        s.carry.verdict_ready = true;  // as after the guard's refusals
-        continue;
-      }
-    }
     const uint32_t refused = guard(ctx, dm, c, s, p, left);
     stats.refused_by_guard += refused;
     stats.seconds_guard += clock.lap();
     if (refused == 0 || guard_leaves_final()) {
-      if (p.bound > 0 && left > 0) bound_.apply(ctx, dm, c, s, p);
+      if (p.bound > 0 && left > 0) bound_apply(ctx, dm, c, s, p);
       return left;
     }
     s.carry.verdict_ready = true;  // this iteration's verdicts still hold for the next selection
@@ -57,8 +49,8 @@ void Selection::release(EdgeState& s) {
   s.cost.edges_are_marked = DeviceBuffer<uint32_t>();
   s.result.edges_are_final = s.result.edges_are_admissible = s.result.edges_pass1 = DeviceBuffer<uint32_t>();
   s.result.edges2state = s.result.edges2reason = DeviceBuffer<uint8_t>();
+  s.result.edges2eps = DeviceBuffer<double>();
   guard_.release();
-  bound_.release();
 }
 
 std::unique_ptr<Selection> make_selection(const CollapseOptions& o) {

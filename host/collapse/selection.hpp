@@ -15,7 +15,6 @@
 #include <cstdint>
 #include <memory>
 
-#include "collapse/bound.hpp"
 #include "collapse/connectivity.hpp"
 #include "collapse/guard_surface.hpp"
 #include "collapse/params.hpp"
@@ -59,7 +58,6 @@ class Selection {
   virtual bool guard_leaves_final() const { return false; }
 
   SurfaceGuard guard_;
-  BoundStage bound_;  // with a boundary error bound (StageParams::bound), before the guard
 };
 
 std::unique_ptr<Selection> make_two_pass_selection(int rounds);

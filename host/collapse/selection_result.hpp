@@ -23,6 +23,9 @@ struct SelectionResult {
   // and tets_are_dead holds the tets they removed.
   DeviceBuffer<uint8_t> tets_are_dead;
   bool in_place = false;
+  // Under a boundary error bound (StageParams::bound): per edge taken, the bound its survivor
+  // takes (-1: S unchanged), from the selection's test (bound.hpp).
+  DeviceBuffer<double> edges2eps;
 };
 
 }  // namespace tc::collapse_detail
