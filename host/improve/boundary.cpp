@@ -2,9 +2,11 @@
 // coarsening, typically four surface vertices nearly in a plane). No flip or move of interior
 // vertices removes it, and its vertices may not move; taking it away exposes its two other
 // faces, so the boundary quad (a, x2, b, x1) changes its diagonal from (a, b) to (x1, x2). The
-// boundary moves by the tet's thickness, which must stay within max_boundary_move.
+// boundary moves by the tet's thickness, which must stay within max_boundary_move (under a
+// boundary error bound: the bound of the quad's corners plus that move).
 #include <cmath>
 
+#include "collapse_surface_error.h"
 #include "improve/improve_mesh.hpp"
 
 namespace tc::improve_detail {
@@ -32,9 +34,29 @@ bool flat_quad(const ImpMesh& m, int32_t a, int32_t b, int32_t x1, int32_t x2) {
   return boundary_quad_height(m, a, b, x1, x2) <= kFlat * geo::length(m.point(b) - m.point(a));
 }
 
+// Under a boundary error bound: a bound on the two-sided distance between the tet's boundary
+// faces (those opposite x1 and x2) and the faces its removal exposes (opposite a and b), which
+// span the same quad (cl/collapse_surface_error.h); INFINITY when it cannot be bounded.
+double sliver_surface_change(const ImpMesh& m, int32_t t, int32_t x1, int32_t x2) {
+  const Tet& q = m.tet(t);
+  tc_d3 olds[6], news[6];
+  int no = 0, nn = 0;
+  for (int f = 0; f < 4; ++f) {
+    const auto& F = geo::TC_TET_FACES[f];  // oriented away from q[f]: out of t
+    const bool gone = q[size_t(f)] == x1 || q[size_t(f)] == x2;
+    for (int k = 0; k < 3; ++k) {
+      // the exposed faces reversed: out of the mesh that is left, the side the gone ones face
+      const tc_d3 p = m.point(q[size_t(F[gone ? k : 2 - k])]);
+      if (gone) olds[3 * no + k] = p;
+      else news[3 * nn + k] = p;
+    }
+    ++(gone ? no : nn);
+  }
+  return geo::tcc_fan_distance(olds, no, news, nn);
+}
+
 bool try_remove_boundary_sliver(ImpMesh& m, int32_t t) {
-  // (under a bound: repeated removals in one place would add up, untracked)
-  if (!m.may_change_boundary() || m.bounded()) return false;
+  if (!m.may_change_boundary()) return false;
   const Tet q = m.tet(t);
   int boundary[4], nb = 0;
   for (int f = 0; f < 4; ++f) {
@@ -61,9 +83,15 @@ bool try_remove_boundary_sliver(ImpMesh& m, int32_t t) {
     for (int32_t y : r)
       if (y != x1 && y != x2 && m.across(s, x1, x2, y) < 0) return false;
   }
-  if (boundary_quad_height(m, a, b, x1, x2) > m.max_boundary_move()) return false;
-  return m.replace_on_boundary({t}, {}, {{{a, b, x2}, {a, b, x1}}}, {{{b, x1, x2}, {a, x1, x2}}},
-                               flat_quad(m, a, b, x1, x2));
+  const bool flat = flat_quad(m, a, b, x1, x2);
+  double change = 0;
+  if (m.bounded()) {  // (replace_on_boundary adds it to the quad's bounds)
+    change = flat ? 0 : sliver_surface_change(m, t, x1, x2);
+    if (!(change <= m.max_boundary_move())) return false;
+  } else if (boundary_quad_height(m, a, b, x1, x2) > m.max_boundary_move()) {
+    return false;
+  }
+  return m.replace_on_boundary({t}, {}, {{{a, b, x2}, {a, b, x1}}}, {{{b, x1, x2}, {a, x1, x2}}}, flat, change);
 }
 
 }  // namespace tc::improve_detail

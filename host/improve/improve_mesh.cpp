@@ -340,7 +340,23 @@ int32_t ImpMesh::across(int32_t t, int32_t a, int32_t b, int32_t c) const {
 
 bool ImpMesh::replace_on_boundary(const std::vector<int32_t>& old, const std::vector<Tet>& added,
                                   const std::array<std::array<int32_t, 3>, 2>& gone,
-                                  const std::array<std::array<int32_t, 3>, 2>& exposed, bool flat) {
+                                  const std::array<std::array<int32_t, 3>, 2>& exposed, bool flat,
+                                  double change) {
+  // Under the bound: the new triangles lie within `change` of the old ones, which lay within
+  // their corners' largest bound (e); their own corners are three of the quad's four.
+  // And the bound by displacement: the old triangles were within max A + max D (A their
+  // corners' start bounds, D their displacements), and a corner's move since is at most its
+  // displacement now plus max D, so the corners' start bounds become max A + 2 max D (+ change).
+  double e = 0, a = 0, d = 0;
+  if (bounded_) {
+    for (const auto& g : gone)
+      for (int32_t v : g) {
+        e = std::max(e, err_[size_t(v)]);
+        a = std::max(a, err_start_[size_t(v)]);
+        d = std::max(d, geo::length(point(v) - start_[size_t(v)]));
+      }
+    if (!(e + change <= max_boundary_move_)) return false;
+  }
   // A removal: the tets across the exposed faces must not become fins (three or four faces on
   // the surface). Either way the exposed faces must not touch the rest of the surface (on thin
   // parts of a model, or where near-degenerate tets fold it).
@@ -383,25 +399,12 @@ bool ImpMesh::replace_on_boundary(const std::vector<int32_t>& old, const std::ve
   if (!flat)
     for (int32_t t : old)
       for (int32_t v : tets_[size_t(t)]) motion_[size_t(v)] = kFixed;
-  // Under the bound: the new triangles cover what the old ones did, whose corners' bounds they
-  // take (their own corners are three of the quad's four).
-  // And the bound by displacement: the old triangles were within max A + max D (A their
-  // corners' start bounds, D their displacements), and a corner's move since is at most its
-  // displacement now plus max D, so the corners' start bounds become max A + 2 max D.
-  if (bounded_) {
-    double e = 0, a = 0, d = 0;
+  if (bounded_)
     for (const auto& g : gone)
       for (int32_t v : g) {
-        e = std::max(e, err_[size_t(v)]);
-        a = std::max(a, err_start_[size_t(v)]);
-        d = std::max(d, geo::length(point(v) - start_[size_t(v)]));
+        err_[size_t(v)] = std::max(err_[size_t(v)], e + change);
+        err_start_[size_t(v)] = std::max(err_start_[size_t(v)], a + 2 * d + change);
       }
-    for (const auto& g : gone)
-      for (int32_t v : g) {
-        err_[size_t(v)] = e;
-        err_start_[size_t(v)] = std::max(err_start_[size_t(v)], a + 2 * d);
-      }
-  }
   replace(old, added, old[0]);
   if (!sfaces_.empty()) {
     for (const auto& g : gone) {

@@ -91,10 +91,12 @@ class ImpMesh {
   // done) if the tags do not allow it, if an exposed face would touch the rest of the surface,
   // or (a removal: `added` empty) if a tet across an exposed face would become a fin.
   // `flat`: the four vertices of the two pairs of faces lie in one plane (to rounding), so the
-  // surface keeps its shape and its vertices may go on moving as they did.
+  // surface keeps its shape and its vertices may go on moving as they did. Under a boundary
+  // error bound, `change` bounds the two-sided distance between the gone and the exposed pair
+  // (0 when flat), and it fails when the bound would not hold.
   bool replace_on_boundary(const std::vector<int32_t>& old, const std::vector<Tet>& added,
                            const std::array<std::array<int32_t, 3>, 2>& gone,
-                           const std::array<std::array<int32_t, 3>, 2>& exposed, bool flat);
+                           const std::array<std::array<int32_t, 3>, 2>& exposed, bool flat, double change = 0);
 
   // Replaces the tets `old` by `added` (label and tet fields of `like`).
   void replace(const std::vector<int32_t>& old, const std::vector<Tet>& added, int32_t like);

@@ -280,6 +280,33 @@ TEST(ImproveOps, AThinBoundaryTetIsRemovedWithinTheBound) {
       << "two surfaces the input tags apart";
 }
 
+// Under a boundary error bound the removal moves the surface by the tet's thickness (5e-4 here):
+// done while the quad's corners' bounds plus that stay within the bound, which they then take.
+TEST(ImproveOps, AThinBoundaryTetIsRemovedUnderTheErrorBoundWhenItFits) {
+  const auto attempt = [](double bound, double spent, std::vector<double>* reached) {
+    Mesh m = roof(5e-4);
+    ImproveOptions o;
+    o.max_boundary_error_abs = bound;
+    o.vertex_boundary_error.assign(size_t(m.num_vertices()), 0.0);
+    o.vertex_boundary_error[0] = spent;  // a
+    ImpMesh im(m, o);
+    const bool removed = improve_detail::try_remove_boundary_sliver(im, 0);
+    if (reached) *reached = im.boundary_errors();
+    return removed;
+  };
+  std::vector<double> e;
+  ASSERT_TRUE(attempt(1e-3, 0, &e));
+  for (int v = 0; v < 4; ++v) {  // a, b, x1, x2: the new surface is 5e-4 below the old one's ridge
+    EXPECT_GE(e[size_t(v)], 5e-4) << "vertex " << v;
+    EXPECT_LE(e[size_t(v)], 5.1e-4) << "vertex " << v;
+  }
+  EXPECT_EQ(e[4], 0.0) << "c is no corner of the quad";
+  EXPECT_FALSE(attempt(4e-4, 0, nullptr)) << "thicker than the bound";
+  EXPECT_FALSE(attempt(1e-3, 6e-4, nullptr)) << "a corner already spent 6e-4 of 1e-3";
+  EXPECT_TRUE(attempt(1e-3, 4e-4, &e));
+  EXPECT_GE(e[1], 9e-4) << "b takes what a spent plus the move";
+}
+
 TEST(ImproveOps, TheSurfaceGuardSeesAMoveThroughTheSurface) {
   Mesh m = cube_tets(3);
   int32_t v = -1;  // a vertex inside the face z = 0
