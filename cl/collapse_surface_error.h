@@ -99,25 +99,63 @@ TC_FN double tcc_fan_distance(const tc_d3* olds, int no, const tc_d3* news, int 
   }
   /* the same boundary loop, each covered once: the same projected area */
   if (!(fabs(area_old - area_new) <= 1e-9 * (area_old + area_new))) return INFINITY;
+  /* What the two fans share has no gap, and the rest meets it only at its end points (each
+   * covers the polygon once): the boundary loop, and whatever the change left. So the gap is
+   * measured at the vertices of each fan that the other does not have, and at the crossings of
+   * the edges that neither has twice (each such edge once: it borders two of its fan's
+   * triangles). */
+  unsigned char v_own[2][3 * TCC_MAX_FAN], e_own[2][3 * TCC_MAX_FAN];
+  for (int side = 0; side < 2; ++side) {
+    const int n = side == 0 ? no : nn, m = side == 0 ? nn : no;
+    const double* pu = side == 0 ? ou : nu;
+    const double* pv = side == 0 ? ov : nv;
+    const double* ph = side == 0 ? oh : nh;
+    const double* qu = side == 0 ? nu : ou;
+    const double* qv = side == 0 ? nv : ov;
+    const double* qh = side == 0 ? nh : oh;
+    for (int j = 0; j < 3 * n; ++j) {
+      const int j2 = j % 3 == 2 ? j - 2 : j + 1;
+      int own_v = 1, own_e = 1;
+      for (int k = 0; k < 3 * m; ++k) {
+        const int k2 = k % 3 == 2 ? k - 2 : k + 1;
+        const int same_j = qu[k] == pu[j] && qv[k] == pv[j] && qh[k] == ph[j];
+        const int same_j2 = qu[k2] == pu[j2] && qv[k2] == pv[j2] && qh[k2] == ph[j2];
+        const int rev_j = qu[k2] == pu[j] && qv[k2] == pv[j] && qh[k2] == ph[j];
+        const int rev_j2 = qu[k] == pu[j2] && qv[k] == pv[j2] && qh[k] == ph[j2];
+        own_v &= !same_j;
+        own_e &= !((same_j && same_j2) || (rev_j && rev_j2));
+      }
+      for (int k = 0; k < j && own_e; ++k) { /* the same edge, the other way, earlier in this fan */
+        const int k2 = k % 3 == 2 ? k - 2 : k + 1;
+        own_e = !(pu[k2] == pu[j] && pv[k2] == pv[j] && ph[k2] == ph[j] && pu[k] == pu[j2] && pv[k] == pv[j2] &&
+                  ph[k] == ph[j2]);
+      }
+      v_own[side][j] = (unsigned char)own_v;
+      e_own[side][j] = (unsigned char)own_e;
+    }
+  }
   double tol = 1e-9, gap = 0;
-  /* the vertices of both fans */
+  /* the vertices */
   for (int side = 0; side < 2; ++side) {
     int n = side == 0 ? no : nn;
     const double* pu = side == 0 ? ou : nu;
     const double* pv = side == 0 ? ov : nv;
     const double* ph = side == 0 ? oh : nh;
     for (int j = 0; j < 3 * n; ++j) {
+      if (!v_own[side][j]) continue;
       double h = side == 0 ? tcc_fan_height(nu, nv, nh, nn, pu[j], pv[j], tol)
                            : tcc_fan_height(ou, ov, oh, no, pu[j], pv[j], tol);
       double g = fabs(h - ph[j]);
       gap = g > gap ? g : gap;
     }
   }
-  /* the crossings of their edges */
+  /* the crossings of the edges */
   for (int i = 0; i < 3 * no; ++i) {
+    if (!e_own[0][i]) continue;
     int i2 = i % 3 == 2 ? i - 2 : i + 1;
     double ax = ou[i], ay = ov[i], bx = ou[i2], by = ov[i2];
     for (int j = 0; j < 3 * nn; ++j) {
+      if (!e_own[1][j]) continue;
       int j2 = j % 3 == 2 ? j - 2 : j + 1;
       double cx = nu[j], cy = nv[j], dx = nu[j2], dy = nv[j2];
       double den = (bx - ax) * (dy - cy) - (by - ay) * (dx - cx);

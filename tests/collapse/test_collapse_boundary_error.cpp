@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <random>
 #include <stdexcept>
 
 #include "check/check_cgal.hpp"  // check_detail::hausdorff, for the interface
@@ -67,6 +68,64 @@ TEST(BoundaryErrorFan, FoldedFanGetsNoBound) {
   EXPECT_TRUE(std::isinf(geo::tcc_fan_distance(olds.data(), 6, folded.data(), 6)));
   const auto half = fan_from_corner(4);  // covers another area
   EXPECT_TRUE(std::isinf(geo::tcc_fan_distance(olds.data(), 6, half.data(), 2)));
+}
+
+// The height of the fan `t` (n triangles, counter-clockwise seen from +z) over (x, y), or NaN
+// when no triangle holds the point.
+double fan_height_at(const std::vector<tc_d3>& t, double x, double y) {
+  for (size_t i = 0; i + 2 < t.size(); i += 3) {
+    const tc_d3 a = t[i], b = t[i + 1], c = t[i + 2];
+    const double det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+    const double l1 = ((x - a.x) * (c.y - a.y) - (c.x - a.x) * (y - a.y)) / det;
+    const double l2 = ((b.x - a.x) * (y - a.y) - (x - a.x) * (b.y - a.y)) / det;
+    if (l1 >= -1e-12 && l2 >= -1e-12 && l1 + l2 <= 1 + 1e-12) return (1 - l1 - l2) * a.z + l1 * b.z + l2 * c.z;
+  }
+  return std::nan("");
+}
+
+// Random fans over one polygon in z = 0 (the mean plane is then z = 0 exactly): the old one
+// around a lifted centre, the new one around another or from a corner. The bound is the largest
+// vertical gap between the two: at least every gap sampled, and at most the largest sampled plus
+// what the samples' spacing can miss.
+TEST(BoundaryErrorFan, TheBoundIsTheLargestGapOfRandomFans) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-1, 1);
+  int bounded = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const int n = 5 + trial % 6;
+    std::vector<tc_d3> rim;
+    for (int i = 0; i < n; ++i) {
+      const double a = 2 * kPi * (i + 0.3 * U(rng)) / n, r = 1 + 0.2 * U(rng);
+      rim.push_back({r * std::cos(a), r * std::sin(a), 0});
+    }
+    const auto around = [&](tc_d3 c) {
+      std::vector<tc_d3> t;
+      for (int i = 0; i < n; ++i) t.insert(t.end(), {c, rim[size_t(i)], rim[size_t((i + 1) % n)]});
+      return t;
+    };
+    const std::vector<tc_d3> olds = around({0.2 * U(rng), 0.2 * U(rng), 0.3 * U(rng)});
+    std::vector<tc_d3> news;
+    if (trial % 3 == 0) {
+      for (int i = 1; i + 1 < n; ++i) news.insert(news.end(), {rim[0], rim[size_t(i)], rim[size_t(i + 1)]});
+    } else {
+      news = around({0.2 * U(rng), 0.2 * U(rng), 0.3 * U(rng)});
+    }
+    const double d = geo::tcc_fan_distance(olds.data(), int(olds.size() / 3), news.data(), int(news.size() / 3));
+    if (std::isinf(d)) continue;
+    ++bounded;
+    double sampled = 0;
+    const int k = 200;
+    for (int i = 0; i <= k; ++i)
+      for (int j = 0; j <= k; ++j) {
+        const double x = -1.2 + 2.4 * i / k, y = -1.2 + 2.4 * j / k;
+        const double ho = fan_height_at(olds, x, y), hn = fan_height_at(news, x, y);
+        if (!std::isnan(ho) && !std::isnan(hn)) sampled = std::max(sampled, std::fabs(ho - hn));
+      }
+    EXPECT_GE(d, sampled - 1e-12) << "trial " << trial;
+    // the gap is 2-Lipschitz-ish in (x, y) at these slopes (below 1): a sample lies within 0.012
+    EXPECT_LE(d, sampled + 0.03) << "trial " << trial;
+  }
+  EXPECT_GE(bounded, 150);
 }
 
 double hausdorff_rel(const Mesh& out, const Mesh& in) {
