@@ -18,7 +18,9 @@ inline double tcc_bound_change(int x, int y, int moves_y, double3 p, __global co
                                __global const int* labels, int use_labels, __global const double* pts,
                                __global const double* vfield, uint vfield_stride, uint eps_col, double* base) {
   tc_d3 olds[3 * TCC_MAX_FAN], news[3 * TCC_MAX_FAN];
+  int oid[3 * TCC_MAX_FAN], nid[3 * TCC_MAX_FAN];
   int no = 0, nn = 0;
+  const int pid = moves_y ? -1 : y; /* the survivor's name in the new fan */
   *base = 0.0;
   for (int side = 0; side < (moves_y ? 2 : 1); ++side) {
     int z = side == 0 ? x : y;
@@ -34,6 +36,7 @@ inline double tcc_bound_change(int x, int y, int moves_y, double3 p, __global co
         for (int k = 0; k < 3; ++k) {
           int v = q[TC_TET_FACES[f][k]];
           olds[3 * no + k] = tc_point(pts, v);
+          oid[3 * no + k] = v;
           *base = fmax(*base, vfield[(size_t)v * vfield_stride + eps_col]);
         }
         ++no;
@@ -62,13 +65,14 @@ inline double tcc_bound_change(int x, int y, int moves_y, double3 p, __global co
         for (int k = 0; k < 3; ++k) {
           int v = q[TC_TET_FACES[f][k]];
           news[3 * nn + k] = v == x || v == y ? p : tc_point(pts, v);
+          nid[3 * nn + k] = v == x || v == y ? pid : v;
         }
         ++nn;
       }
     }
   }
   if (no == 0 && nn == 0) return 0.0;
-  return tcc_fan_distance(olds, no, news, nn);
+  return tcc_fan_distance(olds, oid, no, news, nid, nn);
 }
 
 /* The bound the survivor of the collapse of e = (a, b) in direction dir would take (the bound

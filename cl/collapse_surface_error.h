@@ -50,8 +50,10 @@ TC_FN double tcc_fan_height(const double* pu, const double* pv, const double* ph
 
 /* A bound on the two-sided Hausdorff distance between the old fan (no triangles, 3 corners
  * each in order, consistently oriented) and the new fan (nn) over the same boundary loop, or
- * INFINITY when it cannot be bounded this way (see the top). */
-TC_FN double tcc_fan_distance(const tc_d3* olds, int no, const tc_d3* news, int nn) {
+ * INFINITY when it cannot be bounded this way (see the top). oid and nid name each corner: one
+ * name, one point (the mesh's vertex ids, and for a point that moved a name no corner of the
+ * other fan has, e.g. -1). */
+TC_FN double tcc_fan_distance(const tc_d3* olds, const int* oid, int no, const tc_d3* news, const int* nid, int nn) {
   if (no < 1 || nn < 1 || no > TCC_MAX_FAN || nn > TCC_MAX_FAN) return INFINITY;
   /* the mean plane: the sum of the old triangles' area vectors */
   tc_d3 nsum = TC_D3(0, 0, 0), o = olds[0];
@@ -99,37 +101,25 @@ TC_FN double tcc_fan_distance(const tc_d3* olds, int no, const tc_d3* news, int 
   }
   /* the same boundary loop, each covered once: the same projected area */
   if (!(fabs(area_old - area_new) <= 1e-9 * (area_old + area_new))) return INFINITY;
-  /* What the two fans share has no gap, and the rest meets it only at its end points (each
-   * covers the polygon once): the boundary loop, and whatever the change left. So the gap is
-   * measured at the vertices of each fan that the other does not have, and at the crossings of
-   * the edges that neither has twice (each such edge once: it borders two of its fan's
-   * triangles). */
+  /* Both fans hold the boundary loop and whatever the change left: at a vertex they share the
+   * gap is zero, and so it is at every point of an edge they share, crossings included. So the
+   * gap is measured at the vertices one fan has alone and at the crossings of the edges neither
+   * shares, each edge once (an inner edge borders two triangles of its fan). */
   unsigned char v_own[2][3 * TCC_MAX_FAN], e_own[2][3 * TCC_MAX_FAN];
   for (int side = 0; side < 2; ++side) {
     const int n = side == 0 ? no : nn, m = side == 0 ? nn : no;
-    const double* pu = side == 0 ? ou : nu;
-    const double* pv = side == 0 ? ov : nv;
-    const double* ph = side == 0 ? oh : nh;
-    const double* qu = side == 0 ? nu : ou;
-    const double* qv = side == 0 ? nv : ov;
-    const double* qh = side == 0 ? nh : oh;
+    const int* pid = side == 0 ? oid : nid;
+    const int* qid = side == 0 ? nid : oid;
     for (int j = 0; j < 3 * n; ++j) {
-      const int j2 = j % 3 == 2 ? j - 2 : j + 1;
+      const int j2 = j % 3 == 2 ? j - 2 : j + 1, a = pid[j], b = pid[j2];
       int own_v = 1, own_e = 1;
       for (int k = 0; k < 3 * m; ++k) {
-        const int k2 = k % 3 == 2 ? k - 2 : k + 1;
-        const int same_j = qu[k] == pu[j] && qv[k] == pv[j] && qh[k] == ph[j];
-        const int same_j2 = qu[k2] == pu[j2] && qv[k2] == pv[j2] && qh[k2] == ph[j2];
-        const int rev_j = qu[k2] == pu[j] && qv[k2] == pv[j] && qh[k2] == ph[j];
-        const int rev_j2 = qu[k] == pu[j2] && qv[k] == pv[j2] && qh[k] == ph[j2];
-        own_v &= !same_j;
-        own_e &= !((same_j && same_j2) || (rev_j && rev_j2));
+        const int c = qid[k], d = qid[k % 3 == 2 ? k - 2 : k + 1];
+        own_v &= c != a;
+        own_e &= !((c == a && d == b) || (c == b && d == a));
       }
-      for (int k = 0; k < j && own_e; ++k) { /* the same edge, the other way, earlier in this fan */
-        const int k2 = k % 3 == 2 ? k - 2 : k + 1;
-        own_e = !(pu[k2] == pu[j] && pv[k2] == pv[j] && ph[k2] == ph[j] && pu[k] == pu[j2] && pv[k] == pv[j2] &&
-                  ph[k] == ph[j2]);
-      }
+      for (int k = 0; k < j && own_e; ++k) /* the same edge, the other way, earlier in this fan */
+        own_e = !(pid[k] == b && pid[k % 3 == 2 ? k - 2 : k + 1] == a);
       v_own[side][j] = (unsigned char)own_v;
       e_own[side][j] = (unsigned char)own_e;
     }

@@ -22,7 +22,9 @@ double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vec
   const bool moves_y = !(py.x == p.x && py.y == p.y && py.z == p.z);
   if (!vflags_[x] && !(moves_y && vflags_[y])) return 0;  // S is not touched
   tc_d3 olds[3 * TCC_MAX_FAN], news[3 * TCC_MAX_FAN];
+  int oid[3 * TCC_MAX_FAN], nid[3 * TCC_MAX_FAN];
   int no = 0, nn = 0;
+  const int32_t pid = moves_y ? -1 : y;  // the survivor's name in the new fan
   // the owned S faces through x, those of the tets the collapse removes, and through y when it
   // moves (each once: a tet through x is seen from ring(x))
   for (int side = 0; side < (moves_y ? 2 : 1); ++side) {
@@ -39,6 +41,7 @@ double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vec
         for (int k = 0; k < 3; ++k) {
           const int32_t v = q[geo::TC_TET_FACES[f][k]];
           olds[3 * no + k] = point(v);
+          oid[3 * no + k] = v;
           *base = std::max(*base, eps[size_t(v)]);
         }
         ++no;
@@ -56,11 +59,12 @@ double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vec
     for (int k = 0; k < 3; ++k) {
       const int32_t v = q[geo::TC_TET_FACES[f][k]];
       news[3 * nn + k] = v == x || v == y ? p : point(v);
+      nid[3 * nn + k] = v == x || v == y ? pid : v;
     }
     ++nn;
   });
   if (!fits) return INFINITY;
-  return geo::tcc_fan_distance(olds, no, news, nn);
+  return geo::tcc_fan_distance(olds, oid, no, news, nid, nn);
 }
 
 }  // namespace tc::sequential_detail

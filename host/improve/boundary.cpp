@@ -40,19 +40,20 @@ bool flat_quad(const ImpMesh& m, int32_t a, int32_t b, int32_t x1, int32_t x2) {
 double sliver_surface_change(const ImpMesh& m, int32_t t, int32_t x1, int32_t x2) {
   const Tet& q = m.tet(t);
   tc_d3 olds[6], news[6];
+  int oid[6], nid[6];
   int no = 0, nn = 0;
   for (int f = 0; f < 4; ++f) {
     const auto& F = geo::TC_TET_FACES[f];  // oriented away from q[f]: out of t
     const bool gone = q[size_t(f)] == x1 || q[size_t(f)] == x2;
     for (int k = 0; k < 3; ++k) {
       // the exposed faces reversed: out of the mesh that is left, the side the gone ones face
-      const tc_d3 p = m.point(q[size_t(F[gone ? k : 2 - k])]);
-      if (gone) olds[3 * no + k] = p;
-      else news[3 * nn + k] = p;
+      const int32_t v = q[size_t(F[gone ? k : 2 - k])];
+      (gone ? olds[3 * no + k] : news[3 * nn + k]) = m.point(v);
+      (gone ? oid[3 * no + k] : nid[3 * nn + k]) = v;
     }
     ++(gone ? no : nn);
   }
-  return geo::tcc_fan_distance(olds, no, news, nn);
+  return geo::tcc_fan_distance(olds, oid, no, news, nid, nn);
 }
 
 bool try_remove_boundary_sliver(ImpMesh& m, int32_t t) {

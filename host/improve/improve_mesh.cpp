@@ -280,6 +280,7 @@ double ImpMesh::boundary_error_at(int32_t v, tc_d3 p) const {
   // by at most what its corners do)
   double base = err_[size_t(v)], base_start = err_start_[size_t(v)], shift = geo::length(p - start_[size_t(v)]);
   tc_d3 olds[3 * TCC_MAX_FAN], news[3 * TCC_MAX_FAN];
+  int oid[3 * TCC_MAX_FAN], nid[3 * TCC_MAX_FAN];
   int n = 0;
   bool fits = true;
   // v's surface triangles, each once: from the tet on the owner's side (outside, or the smaller
@@ -304,6 +305,8 @@ double ImpMesh::boundary_error_at(int32_t v, tc_d3 p) const {
       for (int k = 0; k < 3; ++k) {
         olds[3 * n + k] = point(c[k]);
         news[3 * n + k] = c[k] == v ? p : point(c[k]);
+        oid[3 * n + k] = c[k];
+        nid[3 * n + k] = c[k] == v ? -1 : c[k];  // (v moved)
       }
       ++n;
     }
@@ -312,7 +315,7 @@ double ImpMesh::boundary_error_at(int32_t v, tc_d3 p) const {
   const double moved = geo::length(p - here);
   double fan = moved;
   if (fits && motion(v) == kInPlane) {
-    fan = geo::tcc_fan_distance(olds, n, news, n);
+    fan = geo::tcc_fan_distance(olds, oid, n, news, nid, n);
     if (!(fan < moved)) fan = std::min(fan, slab_distance(olds, news, n, here, normal_[size_t(v)]));
   } else if (fits && motion(v) == kAlongLine) {
     fan = std::min(moved, line_distance(olds, n, moved, normal_[size_t(v)]));
