@@ -30,6 +30,14 @@ Mesh bumpy_cube(unsigned seed) {
   return m;
 }
 
+// Coarsening to twice the median edge length within 0.002 of the diagonal.
+CoarsenOptions bounded_to_twice_the_median() {
+  CoarsenOptions co;
+  co.collapse.target_factor = 2;
+  co.collapse.max_boundary_error = 0.002;
+  return co;
+}
+
 // The same mesh as the collapse, the improvement and the resampling called one after the other.
 TEST(Coarsen, IsTheCollapseThenTheImprovementThenTheFields) {
   Context ctx;
@@ -55,9 +63,7 @@ TEST(Coarsen, IsTheCollapseThenTheImprovementThenTheFields) {
 TEST(Coarsen, NoImprovementPhaseWithEveryOperationOff) {
   Context ctx;
   const Mesh in = test::ball(8);
-  CoarsenOptions co;
-  co.collapse.target_factor = 2;
-  co.collapse.max_boundary_error = 0.002;
+  CoarsenOptions co = bounded_to_twice_the_median();
   co.improvement.flips = co.improvement.smoothing = co.improvement.collapse = false;
   Mesh off = in, none = in;
   const CoarsenReport r = coarsen(off, co, &ctx);
@@ -76,9 +82,7 @@ TEST(Coarsen, NoImprovementPhaseWithEveryOperationOff) {
 TEST(Coarsen, SharesABoundaryErrorBoundWithTheImprovement) {
   Context ctx;
   Mesh m = bumpy_cube(2);
-  CoarsenOptions co;
-  co.collapse.target_factor = 2;
-  co.collapse.max_boundary_error = 0.002;
+  CoarsenOptions co = bounded_to_twice_the_median();
   const double bound = boundary_error_bound(m, co.collapse);
   const CoarsenReport r = coarsen(m, co, &ctx);
   EXPECT_TRUE(r.improved);
@@ -92,9 +96,7 @@ TEST(Coarsen, SharesABoundaryErrorBoundWithTheImprovement) {
 TEST(Coarsen, TheImprovementKeepsTheBoundVertexByVertex) {
   Context ctx;
   const Mesh in = test::ball(8);
-  CoarsenOptions co;
-  co.collapse.target_factor = 2;
-  co.collapse.max_boundary_error = 0.002;
+  CoarsenOptions co = bounded_to_twice_the_median();
   Mesh m = in;
   const CoarsenReport r = coarsen(m, co, &ctx);
   ASSERT_TRUE(r.improved);
