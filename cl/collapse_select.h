@@ -281,7 +281,7 @@ inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* edg
   if (r == TCC_OK) {
     const double after = tcc_bound_after(a, b, dir, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, vfield,
                                          vfield_stride, vflags, eps_col);
-    edges2eps[e] = after;
+    if (bound > 0.0) edges2eps[e] = after; /* (sized for the edges only under a bound: lazy_start) */
     if (!(after <= bound)) {
       r = TCC_REFUSED_SURFACE;
       edges2verdict[e] = r;

@@ -45,11 +45,12 @@ uint32_t dm_bound_column(const Mesh& mesh) {
   return n - 1;
 }
 
-// The boundary error bound on the parallel method: the device tests each chosen collapse that
-// changes S against the bound (cl/collapse_bound.cl) with the bound per vertex in a last vertex
-// field, which the compaction carries and the host tail continues. The selection is the greedy
-// one: the matching selection applies its collapses before the tests, which read the mesh
-// before them.
+// The boundary error bound on the parallel method: the selection's test on the device refuses a
+// collapse that would change S past the bound (cl/collapse_bound.h, in the programs built with
+// kBoundDefines), with the bound per vertex in a last vertex field, which the compaction carries
+// and the host tail continues. The selection is the greedy one: the matching selection applies
+// its collapses as it takes them, and chains of them within one iteration spend the bound faster
+// (bench/README.md).
 CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
   check_boundary_error_options(options);
   if (options.field_difference_cost && mesh.vertex_fields.empty())

@@ -346,19 +346,19 @@ bool ImpMesh::replace_on_boundary(const std::vector<int32_t>& old, const std::ve
                                   const std::array<std::array<int32_t, 3>, 2>& exposed, bool flat,
                                   double change) {
   // Under the bound: the new triangles lie within `change` of the old ones, which lay within
-  // their corners' largest bound (e); their own corners are three of the quad's four.
+  // their corners' largest bound (spent); their own corners are three of the quad's four.
   // And the bound by displacement: the old triangles were within max A + max D (A their
   // corners' start bounds, D their displacements), and a corner's move since is at most its
   // displacement now plus max D, so the corners' start bounds become max A + 2 max D (+ change).
-  double e = 0, a = 0, d = 0;
+  double spent = 0, a = 0, d = 0;
   if (bounded_) {
     for (const auto& g : gone)
       for (int32_t v : g) {
-        e = std::max(e, err_[size_t(v)]);
+        spent = std::max(spent, err_[size_t(v)]);
         a = std::max(a, err_start_[size_t(v)]);
         d = std::max(d, geo::length(point(v) - start_[size_t(v)]));
       }
-    if (!(e + change <= max_boundary_move_)) return false;
+    if (!(spent + change <= max_boundary_move_)) return false;
   }
   // A removal: the tets across the exposed faces must not become fins (three or four faces on
   // the surface). Either way the exposed faces must not touch the rest of the surface (on thin
@@ -405,7 +405,7 @@ bool ImpMesh::replace_on_boundary(const std::vector<int32_t>& old, const std::ve
   if (bounded_)
     for (const auto& g : gone)
       for (int32_t v : g) {
-        err_[size_t(v)] = std::max(err_[size_t(v)], e + change);
+        err_[size_t(v)] = std::max(err_[size_t(v)], spent + change);
         err_start_[size_t(v)] = std::max(err_start_[size_t(v)], a + 2 * d + change);
       }
   replace(old, added, old[0]);

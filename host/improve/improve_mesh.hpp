@@ -76,8 +76,8 @@ class ImpMesh {
   // The tet other than t with the face (a, b, c), or -1 (a boundary face).
   int32_t across(int32_t t, int32_t a, int32_t b, int32_t c) const;
   bool may_change_boundary() const { return max_boundary_move_ > 0; }
-  // Under a boundary error bound (ImproveOptions::max_boundary_error_abs): only relocations
-  // within it and flips of flat quads change the boundary.
+  // Under a boundary error bound (ImproveOptions::max_boundary_error_abs): only relocations,
+  // flips of flat quads and removals of thin tets within it change the boundary.
   bool bounded() const { return bounded_; }
   double max_boundary_move() const { return max_boundary_move_; }
   // Under the bound, each vertex carries a bound on how far the surface triangles at it are

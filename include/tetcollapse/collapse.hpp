@@ -213,9 +213,9 @@ struct CollapseOptions {
   // (cl/collapse_surface_error.h); it is conservative, so the measured distance is smaller. With
   // a bound, eps_f is not used: a vertex of a smoothly curved face is a face vertex (ridges and
   // corners as eps_r says), so curved faces coarsen within the bound. The parallel method tests
-  // it on the device (cl/collapse_bound.cl) with the greedy selection whatever `conflicts` says
-  // (the matching selection applies its collapses before the test could read the mesh as it
-  // was); its host tail goes on from the device's bounds. 0 (both): no bound.
+  // it on the device as its selection tests an edge (cl/collapse_bound.h), with the greedy
+  // selection whatever `conflicts` says (the matching one would spend the bound faster:
+  // bench/README.md); its host tail goes on from the device's bounds. 0 (both): no bound.
   double max_boundary_error = 0;
   double max_boundary_error_abs = 0;
   // With a bound: per vertex of the mesh given, what earlier changes of S already spent of it,

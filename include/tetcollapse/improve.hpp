@@ -108,8 +108,9 @@ struct ImproveOptions {
   // smaller of two: the largest bound of its fan plus the distance between the fan before and
   // after (cl/collapse_surface_error.h; along a line, how far the vertex moved), or the fan's
   // largest bound at the start of its series of passes plus how far a vertex of the fan got
-  // from where that series started. No thin boundary tet is removed (max_boundary_move is not
-  // used).
+  // from where that series started. A thin boundary tet is removed while the largest bound of
+  // its four corners plus how far the removal moves the boundary stays within it (the corners
+  // then take that; max_boundary_move is not used).
   double max_boundary_error_abs = 0;
   // With max_boundary_error_abs: per vertex, what earlier changes of S already spent of it
   // (CollapseReport::vertex_boundary_error, which the coarsening command passes); empty: none.

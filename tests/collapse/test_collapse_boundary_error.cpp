@@ -222,7 +222,7 @@ TEST(BoundaryErrorRun, TheInterfaceOfTwoMaterialsKeepsItsShapeAndLabels) {
   EXPECT_LT(m.num_tets(), in.num_tets() / 2);
 }
 
-// The parallel method tests the bound on the device (cl/collapse_bound.cl): the ball within it,
+// The parallel method tests the bound on the device (cl/collapse_bound.h): the ball within it,
 // refusals counted, the bound per vertex reported, about the sequential method's tet count; the
 // host tail (when it runs) goes on from the device's bounds; with a mask only the selected half
 // coarsens; a user cost keeps the bound too.
