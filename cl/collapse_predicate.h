@@ -31,6 +31,11 @@
 /* bit 2 set (with bit 1): the user's placement instead of the midpoint (tcc_user_dir in
  * collapse_common.h; never set by tcc_predicate_q) */
 #define TCC_DIR_USER 4u
+/* Under the boundary error bound, a collapse of S to the midpoint may keep an end point instead
+ * where that changes S less (tcc_lazy_decide, SequentialRun::closest_placement): only while the
+ * tets it reshapes keep this mean ratio (or what they had), since an end point of a curved face
+ * skews its fan more than the midpoint does. */
+#define TCC_END_POINT_MIN_QUALITY 0.3
 
 #ifndef __OPENCL_C_VERSION__
 namespace tc::rules {

@@ -279,8 +279,22 @@ inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* edg
    * the bounds of the fan's vertices may grow while the rings stay (a refusal stays one); the
    * survivor's new bound of a collapse taken, for bound_apply (collapse_bound.cl) */
   if (r == TCC_OK) {
-    const double after = tcc_bound_after(a, b, dir, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, vfield,
-                                         vfield_stride, vflags, eps_col);
+    double after = tcc_bound_after(a, b, dir, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, vfield,
+                                   vfield_stride, vflags, eps_col);
+    /* beyond the paper: a collapse of S to the midpoint may keep either end point instead, where
+     * that changes S least and the tets keep their shape (TCC_END_POINT_MIN_QUALITY) */
+    if ((dir & TCC_DIR_MIDPOINT) && !(dir & TCC_DIR_USER) && after > 0.0)
+      for (int d = (int)TCC_DIR_REMOVE_V1; d >= 0; --d) {
+        if (tcc_volume_test(a, b, d, tets, vt_off, vt, pts, vfield, vfield_stride, eps_v,
+                            fmax(q_min, TCC_END_POINT_MIN_QUALITY), field_eps, tets2quality, 0, TCC_NO_DEAD) != TCC_OK)
+          continue;
+        const double other = tcc_bound_after(a, b, d, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, vfield,
+                                             vfield_stride, vflags, eps_col);
+        if (other < after) {
+          after = other;
+          dir = d;
+        }
+      }
     if (bound > 0.0) edges2eps[e] = after; /* (sized for the edges only under a bound: lazy_start) */
     if (!(after <= bound)) {
       r = TCC_REFUSED_SURFACE;

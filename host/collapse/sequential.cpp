@@ -281,6 +281,7 @@ bool SequentialRun::step() {
       if (d < 0 || !sm_.admissible(e.a, e.b, fe, d)) continue;
       dir = uint8_t(d);
     }
+    if (bound_ > 0) dir = sm_.closest_placement(e.a, e.b, dir, eps_);
     if (!sm_.guard_ok(e.a, e.b, dir)) {
       // refused by the surface guard, which looks beyond the star: its end points count as
       // touched, so the edge is tested again next iteration (S nearby may have moved away)

@@ -124,4 +124,9 @@ uint8_t SeqMesh::volume_and_quality(int32_t a, int32_t b, int dir) const {
   return uint8_t(geo::tcc_volume_verdict(star(), a, b, placement(a, b, unsigned(dir)), p_.eps_v, p_.min_quality));
 }
 
+bool SeqMesh::keeps_shape(int32_t a, int32_t b, int dir, double q) const {
+  return geo::tcc_volume_verdict(star(), a, b, placement(a, b, unsigned(dir)), p_.eps_v, std::max(p_.min_quality, q)) ==
+         kOk;
+}
+
 }  // namespace tc::sequential_detail

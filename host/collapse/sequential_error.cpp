@@ -67,4 +67,24 @@ double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vec
   return geo::tcc_fan_distance(olds, oid, no, news, nid, nn);
 }
 
+// On a curved face the midpoint lies on the chord and an end point on the surface: keeping the
+// one that changes S least lets the bound last for more collapses. As the device's selection
+// (tcc_lazy_decide, collapse_select.h).
+uint8_t SeqMesh::closest_placement(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps) {
+  if (!(dir & TCC_DIR_MIDPOINT) || (dir & TCC_DIR_USER)) return dir;
+  double base = 0;
+  const double change = surface_change(a, b, dir, eps, &base);
+  if (!(change > 0)) return dir;  // S unchanged (or NaN: refused later)
+  double best = base + change;
+  for (const uint8_t d : {uint8_t(TCC_DIR_REMOVE_V1), uint8_t(0)}) {
+    if (!keeps_shape(a, b, d, TCC_END_POINT_MIN_QUALITY)) continue;
+    const double c = surface_change(a, b, d, eps, &base);
+    if (base + c < best) {
+      best = base + c;
+      dir = d;
+    }
+  }
+  return dir;
+}
+
 }  // namespace tc::sequential_detail

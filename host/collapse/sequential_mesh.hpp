@@ -101,6 +101,8 @@ class SeqMesh {
   Verdict check(int32_t a, int32_t b);
   // link_and_volume(...) == kOk, the cheaper test first (for when the reason does not matter).
   bool admissible(int32_t a, int32_t b, uint8_t fe, int dir);
+  // The volume test with the quality guard at max(its own, q) (the link condition aside).
+  bool keeps_shape(int32_t a, int32_t b, int dir, double q) const;
 
   // Collapses the edge (a, b) in the direction `dir` (bits for the ordered pair (min, max), as
   // check() returns them). Returns the survivor. touched() then lists every vertex whose star
@@ -132,6 +134,10 @@ class SeqMesh {
   // and in *base the largest of eps over the vertices of the S faces it replaces. The run
   // carries eps per vertex: the survivor's becomes *base + the bound.
   double surface_change(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base);
+  // Beyond the paper, under the bound: for a collapse of S to the edge's midpoint (dir), the
+  // direction among the midpoint and either end point kept that gives the smallest bound, an
+  // end point only where the reshaped tets keep TCC_END_POINT_MIN_QUALITY (or what they had).
+  uint8_t closest_placement(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps);
 
   // The tets the collapse of (a, b) in direction dir removes or reshapes (those of ring(a) U
   // ring(b), each once), in `tets`; in `after` four vertices per tet as the collapse leaves it

@@ -9,9 +9,12 @@
 #include <limits>
 #include <map>
 #include <random>
+#include <set>
 #include <stdexcept>
 
 #include "check/check_cgal.hpp"  // check_detail::hausdorff, for the interface
+#include "collapse/sequential_run.hpp"
+#include "collapse_predicate.h"
 #include "collapse_surface_error.h"
 #include "geometry.h"
 #include "test_support.hpp"
@@ -176,6 +179,44 @@ TEST(BoundaryErrorRun, ABallStaysWithinTheBoundAndCoarsens) {
     for (const auto& it : r.iterations) refused += it.refused_by_bound;
     EXPECT_GT(refused, 0) << e << ": the bound refused some collapses";
   }
+}
+
+// Under the bound a collapse of a curved face to the midpoint (on the chord) may keep an end
+// point (on the surface) instead, where that changes S less and the tets keep their shape:
+// every edge of the sphere's surface gets the smallest bound of the three, and some an end point.
+TEST(BoundaryErrorRun, ACollapseOfACurvedFaceTakesTheCloserPlacement) {
+  Mesh m = ball(10);
+  CollapseOptions o;
+  o.max_boundary_error = 0.01;
+  sequential_detail::SeqParams p = sequential_detail::seq_params_from(o);
+  p.eps_f = 2;  // as under the bound: the sphere's vertices are face vertices
+  sequential_detail::SeqMesh sm(m, p);
+  const std::vector<double> eps(size_t(m.num_vertices()), 0.0);
+  std::set<std::pair<int32_t, int32_t>> edges;
+  for (int64_t t = 0; t < m.num_tets(); ++t)
+    for (const auto& E : geo::TC_TET_EDGES) {
+      const int32_t a = m.tets[size_t(4 * t + E[0])], b = m.tets[size_t(4 * t + E[1])];
+      edges.insert({std::min(a, b), std::max(a, b)});
+    }
+  int surface = 0, end_points = 0;
+  for (const auto& [a, b] : edges) {
+    uint8_t fe = 0;
+    const int dir = sm.predicate(a, b, fe);
+    if (dir < 0 || !(dir & TCC_DIR_MIDPOINT)) continue;
+    double base = 0, base_chosen = 0;
+    const double mid = sm.surface_change(a, b, uint8_t(dir), eps, &base);
+    if (!(mid > 0)) continue;  // S unchanged
+    ++surface;
+    const uint8_t chosen = sm.closest_placement(a, b, uint8_t(dir), eps);
+    const double change = sm.surface_change(a, b, chosen, eps, &base_chosen);
+    EXPECT_LE(base_chosen + change, base + mid) << a << " " << b;
+    if (chosen == dir) continue;
+    ++end_points;
+    EXPECT_FALSE(chosen & TCC_DIR_MIDPOINT);
+    EXPECT_TRUE(sm.keeps_shape(a, b, chosen, TCC_END_POINT_MIN_QUALITY));
+  }
+  EXPECT_GT(surface, 100);
+  EXPECT_GT(end_points, 0) << "of " << surface;
 }
 
 // The faces between tets of labels 1 and 2, as a triangle soup oriented out of label 1.
