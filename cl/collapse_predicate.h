@@ -32,7 +32,7 @@
  * collapse_common.h; never set by tcc_predicate_q) */
 #define TCC_DIR_USER 4u
 /* Under the boundary error bound, a collapse of S to the midpoint may keep an end point instead
- * where that changes S less (tcc_lazy_decide, SequentialRun::closest_placement): only while the
+ * where that changes S less (tcc_lazy_decide, SeqMesh::closest_placement): only while the
  * tets it reshapes keep this mean ratio (or what they had), since an end point of a curved face
  * skews its fan more than the midpoint does. */
 #define TCC_END_POINT_MIN_QUALITY 0.3

@@ -281,7 +281,8 @@ bool SequentialRun::step() {
       if (d < 0 || !sm_.admissible(e.a, e.b, fe, d)) continue;
       dir = uint8_t(d);
     }
-    if (bound_ > 0) dir = sm_.closest_placement(e.a, e.b, dir, eps_);
+    double base = 0, change = 0;  // (the bound's, for dir)
+    if (bound_ > 0) dir = sm_.closest_placement(e.a, e.b, dir, eps_, &base, &change);
     if (!sm_.guard_ok(e.a, e.b, dir)) {
       // refused by the surface guard, which looks beyond the star: its end points count as
       // touched, so the edge is tested again next iteration (S nearby may have moved away)
@@ -293,8 +294,6 @@ bool SequentialRun::step() {
     }
     double eps_after = 0;
     if (bound_ > 0) {
-      double base = 0;
-      const double change = sm_.surface_change(e.a, e.b, dir, eps_, &base);
       if (!(base + change <= bound_)) {
         ++s.refused_by_bound;
         continue;  // (the verdict depends on the star alone: no retest unless it changes)

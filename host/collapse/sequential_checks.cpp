@@ -71,7 +71,7 @@ tc_d3 SeqMesh::placement(int32_t a, int32_t b, unsigned dir) const {
 
 // tcc_link_and_volume, over the current rings (a < b): the volume and quality test first.
 uint8_t SeqMesh::link_and_volume(int32_t a, int32_t b, uint8_t fe, int dir) {
-  const uint8_t r = volume_and_quality(a, b, dir);
+  const uint8_t r = volume_and_quality(a, b, dir, p_.min_quality);
   if (r != kOk) return r;
   return link_ok(a, b, fe) ? kOk : kRefusedLink;
 }
@@ -120,13 +120,12 @@ bool SeqMesh::link_ok(int32_t a, int32_t b, uint8_t fe) {
 }
 
 // The volumes (and the quality guard) after the tentative collapse: cl/collapse_checks.h's.
-uint8_t SeqMesh::volume_and_quality(int32_t a, int32_t b, int dir) const {
-  return uint8_t(geo::tcc_volume_verdict(star(), a, b, placement(a, b, unsigned(dir)), p_.eps_v, p_.min_quality));
+uint8_t SeqMesh::volume_and_quality(int32_t a, int32_t b, int dir, double q_min) const {
+  return uint8_t(geo::tcc_volume_verdict(star(), a, b, placement(a, b, unsigned(dir)), p_.eps_v, q_min));
 }
 
 bool SeqMesh::keeps_shape(int32_t a, int32_t b, int dir, double q) const {
-  return geo::tcc_volume_verdict(star(), a, b, placement(a, b, unsigned(dir)), p_.eps_v, std::max(p_.min_quality, q)) ==
-         kOk;
+  return volume_and_quality(a, b, dir, std::max(p_.min_quality, q)) == kOk;
 }
 
 }  // namespace tc::sequential_detail

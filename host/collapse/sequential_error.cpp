@@ -70,17 +70,18 @@ double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vec
 // On a curved face the midpoint lies on the chord and an end point on the surface: keeping the
 // one that changes S least lets the bound last for more collapses. As the device's selection
 // (tcc_lazy_decide, collapse_select.h).
-uint8_t SeqMesh::closest_placement(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps) {
-  if (!(dir & TCC_DIR_MIDPOINT) || (dir & TCC_DIR_USER)) return dir;
-  double base = 0;
-  const double change = surface_change(a, b, dir, eps, &base);
-  if (!(change > 0)) return dir;  // S unchanged (or NaN: refused later)
-  double best = base + change;
+uint8_t SeqMesh::closest_placement(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base,
+                                   double* change) {
+  *change = surface_change(a, b, dir, eps, base);
+  // (S unchanged, or NaN: refused by the caller)
+  if (!(dir & TCC_DIR_MIDPOINT) || (dir & TCC_DIR_USER) || !(*change > 0)) return dir;
   for (const uint8_t d : {uint8_t(TCC_DIR_REMOVE_V1), uint8_t(0)}) {
     if (!keeps_shape(a, b, d, TCC_END_POINT_MIN_QUALITY)) continue;
-    const double c = surface_change(a, b, d, eps, &base);
-    if (base + c < best) {
-      best = base + c;
+    double b2 = 0;
+    const double c = surface_change(a, b, d, eps, &b2);
+    if (b2 + c < *base + *change) {
+      *base = b2;
+      *change = c;
       dir = d;
     }
   }

@@ -136,8 +136,10 @@ class SeqMesh {
   double surface_change(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base);
   // Beyond the paper, under the bound: for a collapse of S to the edge's midpoint (dir), the
   // direction among the midpoint and either end point kept that gives the smallest bound, an
-  // end point only where the reshaped tets keep TCC_END_POINT_MIN_QUALITY (or what they had).
-  uint8_t closest_placement(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps);
+  // end point only where the reshaped tets keep TCC_END_POINT_MIN_QUALITY (or what they had);
+  // any other dir as it is. Its surface_change in *change and *base.
+  uint8_t closest_placement(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base,
+                            double* change);
 
   // The tets the collapse of (a, b) in direction dir removes or reshapes (those of ring(a) U
   // ring(b), each once), in `tets`; in `after` four vertices per tet as the collapse leaves it
@@ -346,7 +348,8 @@ class SeqMesh {
   // the link and volume tests of cl/collapse_checks.h over star()
   SeqStar star() const;
   bool link_ok(int32_t a, int32_t b, uint8_t fe);
-  uint8_t volume_and_quality(int32_t a, int32_t b, int dir) const;
+  // (with the quality guard at q_min)
+  uint8_t volume_and_quality(int32_t a, int32_t b, int dir, double q_min) const;
   geo::tc_d3 placement(int32_t a, int32_t b, unsigned dir) const;
 
   std::function<bool(int32_t, int32_t, geo::tc_d3*)> free_placement_;

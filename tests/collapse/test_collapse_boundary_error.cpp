@@ -19,9 +19,9 @@
 #include "geometry.h"
 #include "test_support.hpp"
 #include "tetcollapse/check.hpp"
+#include "tetcollapse/coarsen.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/topology.hpp"
-#include "tetcollapse/coarsen.hpp"
 
 namespace tc {
 namespace {
@@ -207,8 +207,11 @@ TEST(BoundaryErrorRun, ACollapseOfACurvedFaceTakesTheCloserPlacement) {
     const double mid = sm.surface_change(a, b, uint8_t(dir), eps, &base);
     if (!(mid > 0)) continue;  // S unchanged
     ++surface;
-    const uint8_t chosen = sm.closest_placement(a, b, uint8_t(dir), eps);
-    const double change = sm.surface_change(a, b, chosen, eps, &base_chosen);
+    double change = 0;
+    const uint8_t chosen = sm.closest_placement(a, b, uint8_t(dir), eps, &base_chosen, &change);
+    double base_again = 0;
+    EXPECT_EQ(sm.surface_change(a, b, chosen, eps, &base_again), change) << "the chosen direction's own";
+    EXPECT_EQ(base_again, base_chosen);
     EXPECT_LE(base_chosen + change, base + mid) << a << " " << b;
     if (chosen == dir) continue;
     ++end_points;
