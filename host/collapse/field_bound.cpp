@@ -61,27 +61,49 @@ FieldBound::FieldBound(const Mesh& mesh, const CollapseOptions& o, const SeqMesh
   const Field& f = bounded(input_, o.bounded_field, &in_field_);
   bounded(mesh, o.bounded_field, &mesh_field_);
   nc_ = f.components;
-  const int64_t nv = input_.num_vertices();
-  range_.assign(size_t(nc_), 0.0);
-  tol_.assign(size_t(nc_), 0.0);
-  for (int c = 0; c < nc_; ++c) {
+  const size_t nc = size_t(nc_);
+  const bool given = !o.field_points.empty() || !o.field_point_tets.empty() || !o.field_point_values.empty();
+  size_t np = size_t(input_.num_vertices());
+  if (given) {
+    np = o.field_point_tets.size();
+    if (o.field_points.size() != 3 * np || o.field_point_values.size() != nc * np)
+      throw std::invalid_argument("field_points: 3 coordinates, field_point_values: " + std::to_string(nc) +
+                                  " values and field_point_tets: a tet per point (" + std::to_string(np) + " tets)");
+    for (int32_t t : o.field_point_tets)
+      if (t < 0 || t >= sm.num_tets()) throw std::invalid_argument("field_point_tets: a tet the mesh does not have");
+    for (double x : o.field_points)
+      if (!std::isfinite(x)) throw std::invalid_argument("field_points: a coordinate that is not finite");
+    owned_points_ = o.field_points;
+    owned_values_ = o.field_point_values;
+    points_at_ = owned_points_.data();
+    values_at_ = owned_values_.data();
+  } else {
+    points_at_ = input_.points.data();
+    values_at_ = f.values.data();
+  }
+  if (!o.field_range.empty() && o.field_range.size() != nc)
+    throw std::invalid_argument("field_range: one range per component of the bounded field");
+  range_.assign(nc, 0.0);
+  tol_.assign(nc, 0.0);
+  for (size_t c = 0; c < nc; ++c) {
     double lo = INFINITY, hi = -INFINITY, big = 0;
-    for (int64_t v = 0; v < nv; ++v) {
-      const double x = f.values[size_t(v) * size_t(nc_) + size_t(c)];
+    for (size_t v = 0; v < np; ++v) {
+      const double x = values_at_[v * nc + c];
       lo = std::min(lo, x);
       hi = std::max(hi, x);
       big = std::max(big, std::abs(x));
     }
-    if (nv == 0 || !std::isfinite(hi - lo))
+    const double range = o.field_range.empty() ? hi - lo : o.field_range[c];
+    if ((np == 0 && o.field_range.empty()) || !std::isfinite(range) || !(range >= 0) || !std::isfinite(big))
       throw std::invalid_argument("max_field_error: field '" + f.name + "' has no finite range");
-    range_[size_t(c)] = hi - lo;
+    range_[c] = range;
     // the bound, and room for the rounding of an interpolation that should be exact
-    tol_[size_t(c)] = share_ * (hi - lo) + 64 * std::numeric_limits<double>::epsilon() * big;
+    tol_[c] = share_ * range + 64 * std::numeric_limits<double>::epsilon() * big;
   }
   head_.assign(size_t(sm.num_tets()), -1);
-  next_.assign(size_t(nv), -1);
-  for (int32_t v = 0; v < int32_t(nv); ++v) {  // a vertex is in each tet of its ring: the first
-    const int32_t t = sm.some_tet(v);
+  next_.assign(np, -1);
+  for (int32_t v = 0; v < int32_t(np); ++v) {  // a vertex is in each tet of its ring: the first
+    const int32_t t = given ? o.field_point_tets[size_t(v)] : sm.some_tet(v);
     if (t < 0) continue;  // an unused vertex: not part of the field
     next_[size_t(v)] = head_[size_t(t)];
     head_[size_t(t)] = v;
@@ -97,7 +119,7 @@ double FieldBound::at_survivor(const Field& f, size_t c) const {
 }
 
 double FieldBound::value_error(double value, int32_t v, int c) const {
-  return std::abs(value - input_.vertex_fields[in_field_].values[size_t(v) * size_t(nc_) + size_t(c)]);
+  return std::abs(value - values_at_[size_t(v) * size_t(nc_) + size_t(c)]);
 }
 
 bool FieldBound::admits(SeqMesh& sm, const Mesh& mesh, int32_t a, int32_t b, uint8_t dir) {
@@ -123,7 +145,7 @@ bool FieldBound::admits(SeqMesh& sm, const Mesh& mesh, int32_t a, int32_t b, uin
     }
   };
   for (size_t j = 0; j < points_.size(); ++j) {
-    const tc_d3 q = geo::tc_point(input_.points.data(), points_[j]);
+    const tc_d3 q = geo::tc_point(points_at_, points_[j]);
     // the tet that holds q best (largest smallest coordinate); outside all of them, the nearest
     size_t best = SIZE_MAX;
     double best_min = -INFINITY, bary[4], b[4];
@@ -188,7 +210,7 @@ double FieldBound::max_error(const SeqMesh& sm, const Mesh& mesh) const {
     for (int k = 0; k < 4; ++k) c[k] = geo::tc_point(mesh.points.data(), q[k]);
     for (int32_t v = head_[size_t(t)]; v >= 0; v = next_[size_t(v)]) {
       double b[4];
-      fields_detail::distance_to_tet(c, geo::tc_point(input_.points.data(), v), b);
+      fields_detail::distance_to_tet(c, geo::tc_point(points_at_, v), b);
       for (int comp = 0; comp < nc_; ++comp) {
         if (!(range_[size_t(comp)] > 0)) continue;
         double x = 0;

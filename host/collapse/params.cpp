@@ -35,6 +35,12 @@ std::vector<double> initial_boundary_error(const Mesh& mesh, const CollapseOptio
   return o.vertex_boundary_error;
 }
 
+void check_field_points_options(const CollapseOptions& o) {
+  if (!(o.max_field_error > 0) &&
+      !(o.field_points.empty() && o.field_point_values.empty() && o.field_point_tets.empty() && o.field_range.empty()))
+    throw std::invalid_argument("field_points, field_point_values, field_point_tets and field_range need max_field_error");
+}
+
 CheckParams check_params_from(const CollapseOptions& o) {
   CheckParams p;
   p.mode = o.boundary == CollapseOptions::Strict ? 0 : o.boundary == CollapseOptions::Features ? 1 : 2;
@@ -72,6 +78,7 @@ StageParams params_from(const CollapseOptions& o) {
 
 void check_options(const CollapseOptions& o, const Context& ctx) {
   check_boundary_error_options(o);
+  check_field_points_options(o);
   if (o.max_iterations < 0) throw std::invalid_argument("max_iterations must be >= 0");
   if (o.selection_rounds < 1) throw std::invalid_argument("selection_rounds must be >= 1");
   if (o.selection_rounds > 1 && o.conflicts != CollapseOptions::TwoPass)

@@ -73,6 +73,9 @@ constexpr const char* kBoundHeader = "collapse_select.h";
 // The hidden last vertex field that carries the boundary error bound per vertex through a run
 // on the device or through the improvement's collapse step (popped before the caller sees it).
 constexpr const char* kBoundField = "tetcollapse:boundary_error";
+// The field error bound's points (CollapseOptions::field_points and the rest) come only with
+// the bound (std::invalid_argument), for both methods; their sizes are FieldBound's to check.
+void check_field_points_options(const CollapseOptions& o);
 // The boundary error bound's options, for both methods (std::invalid_argument): finite, >= 0,
 // and only in the features mode.
 void check_boundary_error_options(const CollapseOptions& o);

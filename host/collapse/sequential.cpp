@@ -35,6 +35,7 @@ SeqParams checked_params(const Mesh& mesh, const CollapseOptions& o) {
     throw std::invalid_argument("vertex_mask has " + std::to_string(o.vertex_mask.size()) + " entries for " +
                                 std::to_string(mesh.num_vertices()) + " vertices");
   collapse_detail::check_boundary_error_options(o);
+  collapse_detail::check_field_points_options(o);
   if (!(o.max_field_error >= 0) || std::isinf(o.max_field_error))
     throw std::invalid_argument("max_field_error must be finite and >= 0");
   if (o.field_difference_cost && (!(o.target_length > 0) || mesh.vertex_fields.empty()))

@@ -238,6 +238,14 @@ struct CollapseOptions {
   // with user functions (std::invalid_argument). 0: no bound.
   double max_field_error = 0;
   std::string bounded_field;
+  // With max_field_error, a run that goes on from an earlier coarsening of the same input (as
+  // the MPI tool's rounds do): the points where the bound is measured, instead of the vertices
+  // of the mesh given: 3 coordinates per point (the input's vertices), their input values of
+  // the bounded field (its components per point), and the tet of the mesh given that holds each
+  // (one on a shared face: either); field_range: the field's range over the input per
+  // component (empty: over the points' values). Empty points: the mesh's own vertices.
+  std::vector<double> field_points, field_point_values, field_range;
+  std::vector<int32_t> field_point_tets;
   // Tets of the collapsed neighbourhood must keep a volume >= eps_v. With eps_v_relative the
   // threshold is eps_v x (bounding-box diagonal of the input)^3.
   double eps_v = 2e-12;

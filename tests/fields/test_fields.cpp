@@ -2,6 +2,7 @@
 // field kept exact by any coarsening, the field errors, and the CLI's --preserve-field.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -289,6 +290,94 @@ TEST(FieldBound, EveryInputVertexKeepsItsValueWithinTheBound) {
       EXPECT_LE(field_errors(in, m, 0)[0].max_vertex_rel, bound * (1 + 1e-9));
     }
   }
+}
+
+// The points where the bound is measured, given (CollapseOptions::field_points, for a run that
+// goes on from an earlier one): the input's vertices located in the mesh given, their input
+// values and the input's range.
+void give_field_points(const Mesh& input, const Mesh& mesh, CollapseOptions& o) {
+  const TetLocator loc(mesh);
+  o.field_points = input.points;
+  o.field_point_values = input.vertex_fields[0].values;
+  o.field_point_tets.clear();
+  for (int64_t v = 0; v < input.num_vertices(); ++v) {
+    double b[4];
+    o.field_point_tets.push_back(int32_t(loc.locate(&input.points[3 * size_t(v)], b)));
+  }
+  const auto [lo, hi] = std::minmax_element(input.vertex_fields[0].values.begin(), input.vertex_fields[0].values.end());
+  o.field_range = {*hi - *lo};
+}
+
+// A second run on the output of a first, as the MPI tool's rounds go on: given the input's
+// vertices as the points, the bound still holds at them; measured at its own vertices instead,
+// the second run adds its error to the first's and goes past the bound (the check can fail).
+// Given the mesh's own vertices, a run is the one without points, bit for bit.
+TEST(FieldBound, ARunGoesOnFromTheInputsPointsWhereOneBeforeEnded) {
+  const Mesh in = with_bump(10, 3);
+  const double bound = 0.02;
+  CollapseOptions o;
+  o.method = CollapseOptions::Sequential;
+  o.max_field_error = bound;
+  o.target_length = 0.15;  // the first run leaves longer edges for the second
+  Mesh first = in;
+  collapse_sequential(first, o);
+  ASSERT_LE(field_errors(in, first, 0)[0].max_vertex_rel, bound * (1 + 1e-9));
+  o.target_length = 0;  // (the bound alone)
+
+  Mesh own = first;
+  collapse_sequential(own, o);
+  EXPECT_GT(field_errors(in, own, 0)[0].max_vertex_rel, bound * 1.1) << "the errors of two runs add up";
+
+  Mesh goes_on = first;
+  CollapseOptions g = o;
+  give_field_points(in, first, g);
+  const CollapseReport r = collapse_sequential(goes_on, g);
+  const double e = field_errors(in, goes_on, 0)[0].max_vertex_rel;
+  EXPECT_LE(e, bound * (1 + 1e-9));
+  EXPECT_NEAR(r.field_error, e, 1e-9) << "the run measures at the points given";
+  EXPECT_LT(goes_on.num_vertices(), first.num_vertices()) << "and still coarsens";
+
+  Mesh a = first, b = first;
+  CollapseOptions self = o;
+  give_field_points(first, first, self);
+  collapse_sequential(a, o);
+  collapse_sequential(b, self);
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_EQ(a.tets, b.tets);
+}
+
+TEST(FieldBound, GivenPointsNeedTheBoundAndMatchingSizes) {
+  const Mesh in = with_bump(4, 1);
+  CollapseOptions o;
+  o.method = CollapseOptions::Sequential;
+  o.max_field_error = 0.01;
+  give_field_points(in, in, o);
+  {
+    Mesh m = in;
+    EXPECT_NO_THROW(collapse_sequential(m, o));
+  }
+  auto throws = [&](CollapseOptions bad) {
+    Mesh m = in;
+    EXPECT_THROW(collapse_sequential(m, bad), std::invalid_argument);
+  };
+  CollapseOptions bad = o;
+  bad.field_point_values.pop_back();
+  throws(bad);
+  bad = o;
+  bad.field_point_tets[0] = int32_t(in.num_tets());
+  throws(bad);
+  bad = o;
+  bad.field_range = {1, 2};
+  throws(bad);
+  bad = o;
+  bad.field_points[4] = NAN;
+  throws(bad);
+  bad = o;
+  bad.max_field_error = 0;
+  throws(bad);
+  Context ctx;
+  Mesh m = in;
+  EXPECT_THROW(collapse(m, bad, ctx), std::invalid_argument) << "nor on the device";
 }
 
 // A linear field is exact in any coarsening, so the bound refuses nothing on its account; a
