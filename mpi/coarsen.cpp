@@ -71,6 +71,12 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context* ctx
       co.max_boundary_error = 0, co.max_boundary_error_abs = s.boundary_bound;
       co.vertex_boundary_error = std::move(spent);
     }
+    if (co.max_field_error > 0) {
+      co.field_points = std::move(part.field_points);
+      co.field_point_values = std::move(part.field_values);
+      co.field_point_tets = std::move(part.field_tets);
+      co.field_range = s.field_range;
+    }
     CollapseReport cr = ctx ? collapse(m, co, *ctx) : collapse_sequential(m, co);
     if (bounded) spent = std::move(cr.vertex_boundary_error);
     r.seconds_collapse = clock.lap();

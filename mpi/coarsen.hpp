@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "part.hpp"
 #include "tetcollapse/collapse.hpp"
@@ -25,6 +26,10 @@ struct Settings {
   // --region and --labels: only their vertices change (tetcollapse's masks, found on each part:
   // a vertex that is not frozen has its whole star in the part)
   std::string region, labels;
+  // Under --max-field-error (collapse.max_field_error): the bounded field's range over the whole
+  // input, per component; each part's round measures the bound at the input's vertices its tets
+  // hold (Part::field_points).
+  std::vector<double> field_range;
 };
 
 // Under a boundary error bound, the whole mesh's and each part's last vertex field between the

@@ -10,6 +10,7 @@
 #include "agree.hpp"
 #include "cli/common.hpp"
 #include "cli/masks.hpp"
+#include "field_points.hpp"
 #include "report.hpp"
 #include "rounds.hpp"
 #include "tetcollapse/coarsen.hpp"
@@ -40,7 +41,9 @@ Settings make_settings(Options& o) {
   // the cost of the field options on every rank (rank 0 adds the target from the whole mesh:
   // tc::apply_field_options)
   if (!o.sizing_field.empty()) c.cost_cl_source = sizing_cost_source();
-  c.field_difference_cost = !o.preserve_field.empty();
+  c.max_field_error = o.max_field_error;
+  if (o.max_field_error > 0) c.bounded_field = o.preserve_field;
+  c.field_difference_cost = !o.preserve_field.empty() && !(o.max_field_error > 0);
   c.field_check = o.field_check;
   c.conflicts = cli::conflicts_mode(o.conflicts);
   c.method = cli::method_mode(o.method);
@@ -70,6 +73,7 @@ int run(Options& o, MPI_Comm comm) {
   stats.input = o.in, stats.output = o.out, stats.ranks = nranks, stats.boundary = o.boundary;
   Mesh whole, input;  // rank 0: the mesh of the round; the input for --check and the fields
   size_t field_front = 0;  // rank 0, the field options' field: its place, which it leaves for the run
+  const bool field_bound = o.max_field_error > 0;
 
   // Rank 0 reads the input and turns every bound relative to the whole mesh into an absolute one.
   int code = guarded(rank, [&] {
@@ -85,12 +89,17 @@ int run(Options& o, MPI_Comm comm) {
     Stopwatch clock;
     whole = cli::read_input(o.in, o.input, o.quiet);
     stats.seconds_read = clock.lap();
-    if (o.check || (!whole.vertex_fields.empty() && !o.average_fields)) input = whole;
+    if (o.check || (!whole.vertex_fields.empty() && !o.average_fields) || field_bound) input = whole;
     stats.vertices_in = whole.num_vertices(), stats.tets_in = whole.num_tets();
     if (!o.labels.empty()) cli::require_labels(whole);
     stats.median_edge_length = median_edge_length(whole);
-    s.collapse.target_length = o.target_length > 0 ? o.target_length : s.collapse.target_factor * stats.median_edge_length;
-    if (!(s.collapse.target_length > 0)) throw InputError(o.in, "the mesh has no edges: nothing to coarsen");
+    // (under the field error bound without a target, the bound alone decides: 0, which the
+    // library reads as +infinity)
+    s.collapse.target_length = o.target_length > 0                       ? o.target_length
+                               : field_bound && !(o.target_factor > 0) ? 0.0
+                                                                       : s.collapse.target_factor * stats.median_edge_length;
+    if (!(s.collapse.target_length > 0) && !(field_bound && stats.median_edge_length > 0))
+      throw InputError(o.in, "the mesh has no edges: nothing to coarsen");
     // the field options' target over the whole mesh, their field first for the run (the
     // library's field cost reads the first vertex field), as tc::coarsen does
     CoarsenOptions fo;
@@ -104,6 +113,7 @@ int run(Options& o, MPI_Comm comm) {
     if (field_front > 0) std::swap(whole.vertex_fields[0], whole.vertex_fields[field_front]);
     s.collapse.eps_v = volume_threshold(whole, s.collapse);
     s.whole_diagonal = bbox_diagonal(whole);
+    if (field_bound) s.field_range = field_range(whole, o.preserve_field);
   });
   if ((code = agree(code, comm))) return code;
   double shared[3] = {s.collapse.target_length, s.collapse.eps_v, s.whole_diagonal};
@@ -111,6 +121,13 @@ int run(Options& o, MPI_Comm comm) {
   s.collapse.target_length = shared[0], s.collapse.eps_v = shared[1], s.whole_diagonal = shared[2];
   s.collapse.eps_v_relative = false;
   stats.target_length = s.collapse.target_length;
+  if (field_bound) {
+    uint64_t nc = s.field_range.size();
+    MPI_Bcast(&nc, 1, MPI_UINT64_T, 0, comm);
+    s.field_range.resize(size_t(nc));
+    bcast(s.field_range.data(), int(nc), comm);
+    stats.field_error_bound = o.max_field_error;
+  }
 
   // Every rank its own device context: the device chosen now (a --device naming none fails
   // before any work), the context opened when the rank first coarsens.
@@ -134,7 +151,8 @@ int run(Options& o, MPI_Comm comm) {
   CoarsenOptions as_coarsen;
   as_coarsen.collapse = s.collapse, as_coarsen.improve = !o.no_improve, as_coarsen.improvement = s.improve;
   const bool improve_phase = improvement_follows(as_coarsen);
-  Round state{whole, {}, 0};
+  Round state{whole, {}, 0, nullptr, {}};
+  if (field_bound && rank == 0) state.field_input = &input, state.field_name = o.preserve_field;
   s.boundary_bound = improve_phase ? kCollapseShareOfBound * bound : bound;
   code = run_phase(Phase::Collapse, state, s, o, device, stats, comm);
   if (code == cli::kOk && improve_phase) {
@@ -158,7 +176,11 @@ int run(Options& o, MPI_Comm comm) {
   code = guarded(rank, [&] {
     if (rank != 0) return;
     if (field_front > 0) std::swap(whole.vertex_fields[0], whole.vertex_fields[field_front]);
-    if (!whole.vertex_fields.empty() && !o.average_fields) {
+    // Under the field error bound the vertex fields are those the rounds checked: after the first
+    // round a survivor's values come from the round's mesh, not the input, and resampling them
+    // from the input would change what the bound was measured on.
+    if (field_bound) stats.field_error = measured_field_error(input, o.preserve_field, whole, s.field_range);
+    if (!whole.vertex_fields.empty() && !o.average_fields && !field_bound) {
       const int64_t outside = resample_vertex_fields(input, whole);
       if (outside > 0 && talk)
         std::fprintf(stderr, "note: %lld vertices lie outside the input; their fields come from the nearest tet\n",
@@ -176,6 +198,9 @@ int run(Options& o, MPI_Comm comm) {
                    o.out.c_str(), (long long)stats.tets_in, (long long)stats.tets_out,
                    stats.tets_in ? 100.0 * (1.0 - double(stats.tets_out) / double(stats.tets_in)) : 0.0,
                    stats.rounds.size(), stats.seconds_total);
+    if (talk && field_bound)
+      std::fprintf(stderr, "  field error at the input's vertices: %.4g%% of the range (bound %.4g%%)\n",
+                   100 * stats.field_error, 100 * o.max_field_error);
     if (!o.stats.empty()) cli::write_report(o.stats, stats_json(stats));
   });
   if (code == cli::kOk) code = exit_code;

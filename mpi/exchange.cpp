@@ -111,6 +111,9 @@ std::vector<char> pack(const Part& part) {
   p.put(part.gid);
   p.put(part.frozen);
   p.put(part.select);
+  p.put(part.field_points);
+  p.put(part.field_values);
+  p.put(part.field_tets);
   return std::move(p.bytes());
 }
 
@@ -136,6 +139,9 @@ Part unpack(const std::vector<char>& bytes) {
   u.get(part.gid);
   u.get(part.frozen);
   u.get(part.select);
+  u.get(part.field_points);
+  u.get(part.field_values);
+  u.get(part.field_tets);
   return part;
 }
 

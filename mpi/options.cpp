@@ -48,16 +48,24 @@ void add_options(CLI::App& app, Options& o) {
                  "two ends differ in vertex field NAME by less than --field-tolerance x its range over the\n"
                  "whole input (instead of --target-length / --target-factor)");
   app.add_option("--max-field-error", o.max_field_error,
-                 "Not here (tetcollapse's only): a round's check would measure the field at the vertices of\n"
-                 "the mesh it is given, not at the input's, and the error would add up over the rounds");
+                 "With --preserve-field NAME, in place of --field-tolerance, as tetcollapse: collapse every\n"
+                 "edge (up to --target-length or --target-factor when given) while each input vertex keeps\n"
+                 "its value of NAME, in the output's piecewise linear field, within E x the field's range\n"
+                 "over the whole input. Every round measures at the input's vertices (rank 0 locates them in\n"
+                 "the round's mesh and sends each part those its tets hold), so the rounds keep the bound as\n"
+                 "one run does. The collapses run on the CPU; no improvement phase; the vertex fields are\n"
+                 "those the rounds checked (not resampled from the input at the end)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--field-tolerance", o.field_tolerance, "With --preserve-field: T (the paper's 0.02)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::PositiveNumber)
+      ->each([&o](const std::string&) { o.field_tolerance_given = true; });
   app.add_option("--field-check", o.field_check,
                  "With --preserve-field, as tetcollapse: also refuse a collapse that would change the field at an\n"
                  "end point's old place by more than K x T x the range; 0: the paper's cost alone")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::NonNegativeNumber)
+      ->each([&o](const std::string&) { o.field_check_given = true; });
   app.add_option("--sizing-field", o.sizing_field,
                  "As tetcollapse: a vertex field giving the wanted edge length; an edge is collapsed when\n"
                  "shorter than the field's mean at its ends");
@@ -149,10 +157,14 @@ void validate(const Options& o) {
                      {"--sizing-field", &o.sizing_field},
                      {"--placement-cl", &o.placement_cl},
                      {"--predicate-cl", &o.predicate_cl}});
-  if (o.max_field_error != 0)
-    throw CLI::ValidationError("--max-field-error",
-                               "is tetcollapse's only: a round of tetcollapse-mpi would check the field at the vertices "
-                               "of the mesh it is given, not at the input's (use tetcollapse, or --field-tolerance)");
+  if (o.max_field_error > 0) {
+    if (o.preserve_field.empty())
+      throw CLI::ValidationError("--max-field-error", "needs --preserve-field NAME (the field it bounds)");
+    if (o.field_tolerance_given)
+      throw CLI::ValidationError("--field-tolerance", "cannot be combined with --max-field-error (the bound decides)");
+    if (o.field_check_given)
+      throw CLI::ValidationError("--field-check", "cannot be combined with --max-field-error (the bound decides)");
+  }
   if (!o.preserve_field.empty() && !o.sizing_field.empty())
     throw CLI::ValidationError("--preserve-field", "cannot be combined with --sizing-field");
   if (!o.cost_cl.empty() && (!o.preserve_field.empty() || !o.sizing_field.empty()))

@@ -27,7 +27,8 @@ struct Options {
   std::string sizing_field, cost_cl, placement_cl, predicate_cl;
   std::string region, labels;  // only there (tetcollapse's --region, --labels)
   double field_tolerance = 0.02;
-  double max_field_error = 0;  // refused (validate): tetcollapse's only
+  double max_field_error = 0;  // tetcollapse's --max-field-error, measured at the input's vertices
+  bool field_tolerance_given = false, field_check_given = false;  // (refused with the bound)
   double field_check = CoarsenOptions{}.field_check;  // tetcollapse's --field-check
   double priority_levels = -1, host_tail = -1;  // -1: not given (the library's defaults)
   cli::ImproveCli improve;  // the improvement's options, as tetcollapse's

@@ -18,6 +18,12 @@ struct Part {
   // first round only the band around the last round's interface is still to do: coarsening
   // what is done already again would coarsen more than one run of `tetcollapse` does.
   std::vector<uint8_t> select;
+  // Under --max-field-error: the input's vertices that the part's tets hold, where its round
+  // measures the bound (CollapseOptions::field_points, field_point_values, field_point_tets:
+  // local tet indices); empty otherwise. Sent to the ranks, not back (rank 0 locates them anew
+  // in each round's mesh).
+  std::vector<double> field_points, field_values;
+  std::vector<int32_t> field_tets;
 };
 
 // How rank 0 cuts `whole` along `tet_part` (one part index per tet, nparts parts): which

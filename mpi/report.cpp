@@ -65,6 +65,8 @@ std::string stats_json(const RunStats& s) {
       .field("target_length", s.target_length)
       .field("boundary_error_bound", s.boundary_error_bound)
       .field("boundary_error", s.boundary_error)
+      .field("field_error_bound", s.field_error_bound)
+      .field("field_error", s.field_error)
       .field("seconds_total", s.seconds_total)
       .field("seconds_read", s.seconds_read)
       .field("seconds_write", s.seconds_write);

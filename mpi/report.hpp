@@ -40,6 +40,9 @@ struct RunStats {
   double median_edge_length = 0, target_length = 0;
   double boundary_error_bound = 0;  // mesh units; 0: none
   double boundary_error = 0;        // the largest bound a vertex of the output reached
+  // --max-field-error (a share of the range; 0: none), and the largest difference, as a share of
+  // the range, between an input vertex's value and the output's field there
+  double field_error_bound = 0, field_error = 0;
   double seconds_total = 0, seconds_read = 0, seconds_write = 0;
   std::string check;  // "valid" / "invalid" with --check
   std::vector<RoundStats> rounds;

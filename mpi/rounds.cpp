@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cstdio>
 #include <malloc.h>
+#include <optional>
 
 #include "agree.hpp"
 #include "exchange.hpp"
+#include "field_points.hpp"
 #include "partition.hpp"
 #include "stopwatch.hpp"
 
@@ -44,13 +46,20 @@ int run_round(Phase phase, Round& st, const Settings& s, const Options& o, LazyD
     rs.tets_before = st.whole.num_tets();
     whole_vertices = st.whole.num_vertices();
     Splitter split(st.whole, tet_part, nranks);
+    std::optional<FieldPointCut> points;
+    if (st.field_input) points.emplace(*st.field_input, st.field_name, st.whole, tet_part, nranks);
+    auto extract = [&](int p) {
+      Part part = split.extract(p, st.band);
+      if (points) points->fill(p, part);
+      return part;
+    };
     rs.interface_vertices = split.interface_vertices();
     for (size_t v = 0; v < st.band.size(); ++v) rs.refrozen_vertices += st.band[v] && split.shared()[v];
     if (!o.quiet && st.number == 1 && (split.dropped_tris() || split.dropped_edges()))
       std::fprintf(stderr, "note: %lld tagged triangles and %lld edges are not faces or edges of a tet: dropped\n",
                    (long long)split.dropped_tris(), (long long)split.dropped_edges());
-    for (int p = 1; p < nranks; ++p) send_part(split.extract(p, st.band), p, comm);
-    mine = split.extract(0, st.band);
+    for (int p = 1; p < nranks; ++p) send_part(extract(p), p, comm);
+    mine = extract(0);
     st.whole = Mesh();
   } else {
     mine = recv_part(0, comm);

@@ -23,6 +23,10 @@ struct Round {
   // band.
   std::vector<uint8_t> band;
   int number;  // rounds so far, over both phases
+  // Under --max-field-error: the input and its bounded field, whose vertices every round
+  // measures at (field_points.hpp); null otherwise.
+  const Mesh* field_input = nullptr;
+  std::string field_name;
 };
 
 // The rank's device context, opened when first needed: on rank 0 after the first cut, whose
