@@ -26,6 +26,7 @@ results files:
     cold_start      bench/results/cold_start.json                       (bench/cold_start.py; its table)
     mpi_scale       bench/results/mpi_scale.json                        (bench/mpi_scale.py; its table)
     mpi_scale_10m   bench/results/mpi_scale_10m.json                    (the same on the 10.7M-tet mesh)
+    mpi_field       bench/results/mpi_field.json                        (the same with --max-field-error)
     scale           bench/results/scale.json                            (bench/scale.py; its table)
     robustness      bench/robustness/results.json                       (scripts/robustness.py)
     io, primitives, bench/results/io.json, primitives.json, connectivity.json, checker.json,
@@ -378,6 +379,7 @@ BLOCKS = {
     "python_overhead": lambda: recorded_block("python_overhead", "python_overhead"),
     "mpi_scale": lambda: printed_block("mpi_scale", "mpi_scale"),
     "mpi_scale_10m": lambda: printed_block("mpi_scale_10m", "mpi_scale"),
+    "mpi_field": lambda: printed_block("mpi_field", "mpi_scale"),
     "scale": lambda: printed_block("scale", "scale"),
     "robustness": robustness_block,
     "io": io_block,

@@ -4,6 +4,8 @@
     bench/mpi_scale.py [--build DIR] [--mesh M] [--ranks 2,3] [--runs 3] [--factor 2]
                        [--max-boundary-error 0.001] [--out bench/results/mpi_scale.json]
     bench/mpi_scale.py --table bench/results/mpi_scale.json    prints the markdown table
+    bench/mpi_scale.py --mesh gen_tetgen_octagonal_pocket_160k.msh --gaussians --max-field-error 0.01 \
+                       --out bench/results/mpi_field.json
 
 Runs, one after the other, `runs` times each (the median is reported):
   tetcollapse M OUT --target-factor F --max-boundary-error E --stats S     (one process, one device)
@@ -15,6 +17,11 @@ resident set (wait4), that of each rank the VmHWM tetcollapse-mpi reports in --s
 measured: with N ranks a valid result within 5% of tetcollapse's tets, and each rank's peak at
 most tetcollapse's / N + 20%, also counted above a process's fixed cost (tetcollapse-mpi -n 1 on
 two tets: the OpenCL runtime and kernels, which every rank pays).
+
+With --max-field-error E both tools run `--preserve-field F --max-field-error E` instead of the
+target (the bound alone decides; --gaussians writes the mesh with field F = "gauss", the
+Gaussians of bench/volume_rendering.py, first), and the table adds the field error at the input's
+vertices by `tetcollapse check OUT --reference IN` (what the bound bounds: at most E).
 """
 import argparse
 import json
@@ -61,7 +68,7 @@ def cpu_model():
     return platform.processor()
 
 
-def measure(name, ranks, cmd_for, tool, runs, tmp, env=None):
+def measure(name, ranks, cmd_for, tool, runs, tmp, env=None, reference=None):
     """Runs one configuration `runs` times; the record of its median run."""
     walls, tets, peaks, loads, stats = [], [], [], [], None
     out_path = None
@@ -80,7 +87,7 @@ def measure(name, ranks, cmd_for, tool, runs, tmp, env=None):
         tets.append(stats["tets_out"])
         peaks.append(stats.get("peak_rss_kb") or [maxrss])
         print(f"{name} run {i + 1}: {wall:.2f} s, {stats['tets_out']} tets, load {load:.2f}", file=sys.stderr)
-    rc, _, _, log = run([tool, "check", out_path])
+    rc, _, _, log = run([tool, "check", out_path] + (["--reference", reference] if reference else []))
     median_wall = statistics.median(walls)
     k = walls.index(min(walls, key=lambda w: abs(w - median_wall)))
     return {
@@ -97,6 +104,8 @@ def measure(name, ranks, cmd_for, tool, runs, tmp, env=None):
         "valid": rc == 0,
         "check": next((line for line in log.splitlines() if "VALID" in line), log.strip()[-300:]),
         "dihedral": next((line for line in log.splitlines() if line.startswith("dihedral angles")), None),
+        "field_check": next((line.strip() for line in log.splitlines() if line.strip().startswith("field '")), None),
+        "field_error": stats.get("field_error"),
         "peak_rss_kb": peaks[k],
         "rounds": [{key: r[key] for key in ("round", "phase", "tets_before", "tets_after", "interface_vertices",
                                             "seconds_partition", "seconds_scatter", "seconds_coarsen",
@@ -112,12 +121,31 @@ def below_10(c):
     return line.rsplit(":", 1)[1].split("/")[1] if "below 5/10/13" in line else "-"
 
 
+def vertex_max(c):
+    """The checker's largest difference at the input's vertices, from its field line ("... at the
+    reference's vertices max A (P%)")."""
+    line = c.get("field_check") or ""
+    return line.rsplit("(", 1)[1].rstrip(")") if "reference's vertices max" in line else "-"
+
+
 def table(path):
     with open(path) as f:
         res = json.load(f)
-    print(f"`{os.path.basename(res['mesh'])}`, --target-factor {res['target_factor']} "
+    field = res.get("max_field_error")
+    how = (f"--preserve-field {res['field']} --max-field-error {field:g}" if field else
+           f"--target-factor {res['target_factor']}")
+    print(f"`{os.path.basename(res['mesh'])}`{' with the Gaussians' if res.get('gaussians') else ''}, {how} "
           f"--max-boundary-error {res.get('max_boundary_error', 0):g}, median of {res['runs']} runs, "
           f"{res['machine']}, commit {res['commit'][:10]}\n")
+    if field:
+        print("| command | ranks | wall s (median) | tets | vs tetcollapse | valid | field error at the input's vertices "
+              "| peak memory per rank (MB) |")
+        print("|---|---:|---:|---:|---:|---|---:|---|")
+        for c in res["configurations"]:
+            peaks = ", ".join(f"{p / 1024:.0f}" for p in c["peak_rss_kb"])
+            print(f"| {c['name']} | {c['ranks']} | {c['wall_seconds_median']:.2f} | {c['tets_out']:,} | "
+                  f"{100 * (c['tets_vs_single'] - 1):+.2f}% | {'yes' if c['valid'] else 'NO'} | {vertex_max(c)} | {peaks} |")
+        return
     print(f"A process's fixed cost (tetcollapse-mpi -n 1 on two tets): {res['fixed_cost_rss_kb'] / 1024:.0f} MB.\n")
     print("| command | ranks | wall s (median) | tets | vs tetcollapse | valid | tets below 10 deg "
           "| peak memory per rank (MB) | goal: single / ranks + 20% | the same above the fixed cost |")
@@ -145,6 +173,11 @@ def main():
     ap.add_argument("--max-boundary-error", default="0.001",
                     help="passed to both tools (default: their default in features mode; 0: the paper's method)")
     ap.add_argument("--mpirun", default="mpirun")
+    ap.add_argument("--max-field-error", type=float, default=0,
+                    help="run both tools with --preserve-field FIELD --max-field-error E instead of the target")
+    ap.add_argument("--field", default="gauss", help="the field --max-field-error bounds")
+    ap.add_argument("--gaussians", action="store_true",
+                    help="give the mesh the field 'gauss' (bench/volume_rendering.py's Gaussians) first")
     ap.add_argument("--out", default=os.path.join(HERE, "results", "mpi_scale.json"))
     ap.add_argument("--table", metavar="JSON", help="print the markdown table of a results file and exit")
     a = ap.parse_args()
@@ -163,15 +196,24 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         f = str(a.factor)
         bound = ["--max-boundary-error", a.max_boundary_error]
-        single = measure("tetcollapse", 1, lambda out, st: [tool, a.mesh, out, "--target-factor", f, *bound,
-                                                            "-q", "--stats", st],
-                         tool, a.runs, tmp)
+        mesh = a.mesh
+        if a.gaussians:
+            import vtk
+            import volume_rendering
+            plain, mesh = os.path.join(tmp, "plain.vtu"), os.path.join(tmp, "with_field.vtu")
+            subprocess.run([tool, "convert", a.mesh, plain, "-q"], check=True)
+            volume_rendering.with_field(vtk, plain, mesh, "gauss", volume_rendering.gaussians)
+        how = ["--preserve-field", a.field, "--max-field-error", str(a.max_field_error)] if a.max_field_error else \
+            ["--target-factor", f]
+        reference = mesh if a.max_field_error else None
+        single = measure("tetcollapse", 1, lambda out, st: [tool, mesh, out, *how, *bound, "-q", "--stats", st],
+                         tool, a.runs, tmp, reference=reference)
         configs.append(single)
         for n in [int(x) for x in a.ranks.split(",") if x]:
             configs.append(measure(f"tetcollapse-mpi -n {n}", n,
-                                   lambda out, st, n=n: [a.mpirun, "--oversubscribe", "-n", str(n), mpi_tool, a.mesh, out,
-                                                         "--target-factor", f, *bound, "-q", "--stats", st],
-                                   tool, a.runs, tmp, mpi_env()))
+                                   lambda out, st, n=n: [a.mpirun, "--oversubscribe", "-n", str(n), mpi_tool, mesh, out,
+                                                         *how, *bound, "-q", "--stats", st],
+                                   tool, a.runs, tmp, mpi_env(), reference))
         # What a process costs before any mesh: the OpenCL runtime (PoCL links LLVM), the kernels.
         tiny = os.path.join(ROOT, "meshes", "two_tets.mesh")
         fixed = measure("fixed cost (two_tets.mesh)", 1,
@@ -192,6 +234,9 @@ def main():
         "mesh": a.mesh,
         "target_factor": a.factor,
         "max_boundary_error": float(a.max_boundary_error),
+        "max_field_error": a.max_field_error,
+        "field": a.field if a.max_field_error else None,
+        "gaussians": a.gaussians,
         "runs": a.runs,
         "commit": commit + (" (with uncommitted changes)" if dirty else ""),
         "machine": f"{cpu_model()}, {os.cpu_count()} cores",
