@@ -10,6 +10,7 @@ Runs, on mesh M with the uniform target edge length L, in this order:
   tetcollapse_noimprove ... --no-improve                             (the collapse alone)
   tetcollapse_bounded   ... --max-boundary-error 0.001 (the default's bound, given)
   tetcollapse_unbounded ... --max-boundary-error 0     (no bound: the paper's method)
+  tetcollapse_cyclesN   ... --cycles N                 (collapse and improvement N times)
                                                                        (the boundary error bound, as MMG's -hausd
                                                                         below: 0.001 x the bounding-box diagonal)
   tetcollapse_q0        ... --min-quality 0 --no-improve               (the paper: no quality guard, no
@@ -58,7 +59,8 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-ALL_PEERS = ["tetcollapse", "tetcollapse_noimprove", "tetcollapse_bounded", "tetcollapse_unbounded", "tetcollapse_q0", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "mmg3d_hmin", "mmg3d_hmin_nosurf", "mmg3d_hmin_hausd",
+ALL_PEERS = ["tetcollapse", "tetcollapse_noimprove", "tetcollapse_bounded", "tetcollapse_unbounded", "tetcollapse_q0",
+             "tetcollapse_cycles2", "tetcollapse_cycles3", "mmg3d_hsiz", "mmg3d_hsiz_nosurf", "mmg3d_hmin", "mmg3d_hmin_nosurf", "mmg3d_hmin_hausd",
              "cgal_remesh", "tetgen_rR", "tetgen_rR_keepbnd"]
 
 
@@ -268,11 +270,14 @@ def main():
                 cmd += ["--max-boundary-error", "0.001"]
             if peer == "tetcollapse_unbounded":
                 cmd += ["--max-boundary-error", "0"]
+            if peer.startswith("tetcollapse_cycles"):
+                cmd += ["--cycles", peer[len("tetcollapse_cycles"):]]
 
             def alg(stdout, stderr):  # the collapse and the improvement, without I/O
                 with open(stats) as f:
                     st = json.load(f)
-                return st["seconds_collapse"] + st.get("improve", {}).get("seconds", 0)
+                return (st["seconds_collapse"] + st.get("improve", {}).get("seconds", 0) +
+                        sum(c["seconds_collapse"] + c["seconds_improve"] for c in st.get("later_cycles", [])))
             return cmd, out, alg
         if peer.startswith("mmg3d"):
             if not mmg:

@@ -153,14 +153,23 @@ int run(Options& o, MPI_Comm comm) {
   const bool improve_phase = improvement_follows(as_coarsen);
   Round state{whole, {}, 0, nullptr, {}};
   if (field_bound && rank == 0) state.field_input = &input, state.field_name = o.preserve_field;
-  s.boundary_bound = improve_phase ? kCollapseShareOfBound * bound : bound;
-  code = run_phase(Phase::Collapse, state, s, o, device, stats, comm);
-  if (code == cli::kOk && improve_phase) {
+  // --cycles: collapse and improve again, as tc::coarsen does, until a collapse phase removes
+  // fewer than kCycleMinShare of the tets (improved still, unless it removed none)
+  for (int cycle = 0; code == cli::kOk && cycle < (improve_phase ? o.cycles : 1); ++cycle) {
+    s.boundary_bound = improve_phase ? kCollapseShareOfBound * bound : bound;
+    if (cycle > 0) s.collapse.min_quality = std::max(o.min_quality, kLaterCycleMinQuality);
+    double removed[2] = {double(whole.num_tets()), 0};
+    code = run_phase(Phase::Collapse, state, s, o, device, stats, comm);
+    if (code != cli::kOk || !improve_phase) break;
+    removed[1] = removed[0] - double(whole.num_tets());
+    bcast(removed, 2, comm);
+    if (cycle > 0 && removed[1] == 0) break;
     // the improvement's collapse step reaches as far as tc::improve's default on the whole mesh
     if (rank == 0) s.collapse_length = 1.5 * median_edge_length(whole);
     bcast(&s.collapse_length, 1, comm);
     s.boundary_bound = bound;
     code = run_phase(Phase::Improve, state, s, o, device, stats, comm);
+    if (cycle > 0 && removed[1] < kCycleMinShare * removed[0]) break;
   }
   if (code) return code;
   if (bound > 0 && rank == 0) {

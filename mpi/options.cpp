@@ -43,6 +43,12 @@ void add_options(CLI::App& app, Options& o) {
                "Coarsen only (default: each rank improves its part after coarsening it, the interface\n"
                "frozen)");
   cli::add_improve_options(app, o.improve);
+  app.add_option("--cycles", o.cycles,
+                 "As tetcollapse: collapse and improve N times (each later cycle collapses the edges the\n"
+                 "improvement made collapsible, the same target, within what is left of the boundary error\n"
+                 "bound, in rounds as the first); a cycle removing fewer than 1% of the tets is the last")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_option("--preserve-field", o.preserve_field,
                  "Direct volume rendering (the paper's Section 4.5), as tetcollapse: collapse the edges whose\n"
                  "two ends differ in vertex field NAME by less than --field-tolerance x its range over the\n"

@@ -34,6 +34,7 @@ struct Options {
   cli::ImproveCli improve;  // the improvement's options, as tetcollapse's
   bool eps_v_relative = false, no_labels = false, no_improve = false, quiet = false, check = false,
        average_fields = false;
+  int cycles = CoarsenOptions{}.cycles;  // tetcollapse's --cycles
   int max_rounds = 5;
   double round_threshold = 0.01;
   int seed = 1, avoid_weight = 50, rings = 2;

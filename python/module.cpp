@@ -132,7 +132,7 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
                      double min_quality, py::object max_boundary_error, bool average_fields,
                      const std::string& preserve_field, double field_tolerance, double field_check,
                      double max_field_error,
-                     const std::string& sizing_field) {
+                     const std::string& sizing_field, int cycles) {
   Mesh mesh = from_numpy(points, tets, labels, vertex_fields);
   CoarsenOptions co;
   CollapseOptions& o = co.collapse;
@@ -145,6 +145,7 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
       !max_boundary_error.is_none() ? max_boundary_error.cast<double>() : default_max_boundary_error(o.boundary);
   o.max_field_error = max_field_error;
   co.improve = improve_phase;
+  co.cycles = cycles;
   co.resample_fields = !average_fields;
   co.preserve_field = preserve_field;
   co.field_tolerance = field_tolerance;
@@ -179,10 +180,11 @@ py::dict collapse_py(py::array_t<double, py::array::c_style | py::array::forceca
   stats["boundary_error"] = r.boundary_error;
   stats["field_error_bound"] = r.field_error_bound;
   stats["field_error"] = r.field_error;
+  stats["cycles"] = 1 + cr.later_cycles.size();
   if (improve_phase) {
     stats["seconds_improve"] = ir.seconds_total;
     stats["quality_before_improve"] = quality_dict(ir.before);
-    stats["quality"] = quality_dict(ir.after);
+    stats["quality"] = quality_dict(last_improvement(cr).after);
   } else {
     stats["quality"] = quality_dict(quality_summary(mesh));
   }
@@ -250,6 +252,7 @@ PYBIND11_MODULE(_core, mod) {
           py::arg("improve") = true, py::arg("min_quality") = 0.1, py::arg("max_boundary_error") = py::none(),
           py::arg("average_fields") = false, py::arg("preserve_field") = "", py::arg("field_tolerance") = 0.02,
           py::arg("field_check") = CoarsenOptions{}.field_check, py::arg("max_field_error") = 0.0, py::arg("sizing_field") = "",
+          py::arg("cycles") = CoarsenOptions{}.cycles,
           "Coarsens a tet mesh; returns a dict: points, tets, labels (if given), vertex_fields, stats.");
   mod.def("improve", &improve_py, py::arg("points"), py::arg("tets"), py::kw_only(), py::arg("boundary") = "features",
           py::arg("labels") = py::none(), py::arg("vertex_fields") = py::none(), py::arg("device") = py::none(),

@@ -35,13 +35,15 @@ struct CollapseCli {
   CLI::Option* field_tolerance_option = nullptr;
   double field_check = CoarsenOptions{}.field_check;
   CLI::Option* field_check_option = nullptr;
+  int cycles = CoarsenOptions{}.cycles;
   CLI::Option* bound_options[2] = {nullptr, nullptr};  // --max-boundary-error(-abs)
   ImproveCli improve;
 };
 
 std::string stats_json(const CollapseCli& c, const CollapseReport& r, const ImproveReport* ir,
-                       const QualitySummary& quality_in, const QualitySummary& quality_collapsed, double seconds_total,
-                       double seconds_read, double seconds_write, const std::string& check_verdict) {
+                       const std::vector<CycleReport>& later_cycles, const QualitySummary& quality_in,
+                       const QualitySummary& quality_collapsed, double seconds_total, double seconds_read,
+                       double seconds_write, const std::string& check_verdict) {
   JsonWriter w;
   w.begin_object()
       .field("input", c.in)
@@ -75,6 +77,19 @@ std::string stats_json(const CollapseCli& c, const CollapseReport& r, const Impr
   write_quality(w, "quality_input", quality_in);
   write_quality(w, "quality_collapsed", quality_collapsed);
   if (ir) write_improve(w, *ir);
+  // the cycles past the first (--cycles): tets and seconds of each collapse and improvement
+  w.key("later_cycles").begin_array();
+  for (const CycleReport& cy : later_cycles) {
+    w.begin_object()
+        .field("tets_before", cy.tets_before)
+        .field("tets_collapsed", cy.tets_collapsed)
+        .field("tets_after", cy.tets_after)
+        .field("seconds_collapse", cy.collapse.seconds_total)
+        .field("seconds_improve", cy.improved ? cy.improvement.seconds_total : 0.0);
+    if (cy.improved) write_quality(w, "quality_after", cy.improvement.after);
+    w.end_object();
+  }
+  w.end_array();
   w.key("iterations").begin_array();
   for (const auto& it : r.iterations) {
     w.begin_object()
@@ -241,6 +256,13 @@ void register_collapse(CLI::App& app, int& exit_code) {
                "only within --region/--labels when given; not with --predicate-cl or --placement-cl;\n"
                "the relocation on the device, or with --method sequential on the CPU)");
   add_improve_options(app, c->improve);
+  app.add_option("--cycles", c->cycles,
+                 "Collapse and improve N times: the improvement's flips and moves make collapsible edges the\n"
+                 "collapse refused, so each later cycle collapses them (the same target length, within what\n"
+                 "is left of the boundary error bound) and improves again; a cycle removing fewer than 1%\n"
+                 "of the tets is the last. Not with --no-improve")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   app.add_flag("-q,--quiet", c->quiet, "No progress lines, only errors");
   add_input_options(app, c->input);
   add_output_options(app, c->output);
@@ -341,6 +363,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
     co.collapse = opt;
     co.improve = !c->no_improve;
     co.improvement = improve_options(c->improve, c->quiet);
+    co.cycles = c->cycles;
     // --region, --labels: improve there only (the masks of the coarse mesh)
     co.improve_mask = [c](const Mesh& coarse) { return region_and_label_mask(coarse, c->region, c->labels); };
     const CoarsenReport cr = coarsen(mesh, co, ctx.get(), input.num_tets() > 0 ? &input : nullptr);
@@ -383,9 +406,19 @@ void register_collapse(CLI::App& app, int& exit_code) {
                      100 * r.field_error, 100 * r.field_error_bound);
       if (!c->no_improve)
         std::fprintf(stderr, "  quality after improve:  %s (%.3f s)\n", quality_line(ir.after).c_str(), ir.seconds_total);
+      // (each later cycle's quality after its improvement, the last one the result's)
+      for (size_t k = 0; k < cr.later_cycles.size(); ++k) {
+        const CycleReport& cy = cr.later_cycles[k];
+        std::fprintf(stderr, "  cycle %zu: collapse %lld -> %lld tets (%.3f s)", k + 2, (long long)cy.tets_before,
+                     (long long)cy.tets_collapsed, cy.collapse.seconds_total);
+        if (cy.improved)
+          std::fprintf(stderr, ", improve -> %lld tets (%.3f s): %s", (long long)cy.tets_after,
+                       cy.improvement.seconds_total, quality_line(cy.improvement.after).c_str());
+        std::fprintf(stderr, "\n");
+      }
     }
     if (!c->stats.empty())
-      write_report(c->stats, stats_json(*c, r, c->no_improve ? nullptr : &ir, quality_in, quality_collapsed,
+      write_report(c->stats, stats_json(*c, r, c->no_improve ? nullptr : &ir, cr.later_cycles, quality_in, quality_collapsed,
                                         seconds_total, seconds_read, seconds_write, verdict));
     if (exit_code != kCheckFailed) exit_code = kOk;
   });

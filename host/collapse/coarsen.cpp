@@ -86,6 +86,13 @@ bool improvement_follows(const CoarsenOptions& options) {
          (io.flips || io.smoothing || (io.collapse && io.collapse_rounds > 0));
 }
 
+const ImproveReport& last_improvement(const CoarsenReport& r) {
+  const ImproveReport* last = &r.improvement;
+  for (const CycleReport& c : r.later_cycles)
+    if (c.improved) last = &c.improvement;
+  return *last;
+}
+
 CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, const Mesh* original) {
   CollapseOptions co = options.collapse;
   if (!ctx && co.method != CollapseOptions::Sequential)
@@ -111,36 +118,72 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
     co.max_boundary_error = 0;
   }
 
+  if (options.cycles < 1) throw std::invalid_argument("cycles must be >= 1");
+  if (options.cycles > 1 && improve_phase && !co.vertex_mask.empty() && !options.improve_mask)
+    throw std::invalid_argument("cycles > 1 with a collapse vertex_mask needs improve_mask (the mask of the coarse mesh)");
+
   if (ctx) collapse_detail::prefetch_programs(*ctx, co);
   if (ctx && improve_phase) improve_detail::prefetch_programs(*ctx);
   if (ctx && resample) fields_detail::prefetch_programs(*ctx);
-  CoarsenReport r;
-  {
-    const bool cost_by_field = by_field && !(co.max_field_error > 0);
+  // the cost's field first for the collapse, as its cost reads the first vertex field
+  const bool cost_by_field = by_field && !(co.max_field_error > 0);
+  auto collapse_now = [&](const CollapseOptions& o) {
     std::optional<FieldFirst> front;
     if (cost_by_field) front.emplace(mesh, first);
-    r.collapse = co.method == CollapseOptions::Sequential ? collapse_sequential(mesh, co) : collapse(mesh, co, *ctx);
-  }
-  if (bound > 0) r.collapse.boundary_error_bound = bound;
-
-  if (improve_phase) {
+    return o.method == CollapseOptions::Sequential ? collapse_sequential(mesh, o) : collapse(mesh, o, *ctx);
+  };
+  // the improvement with the collapse's boundary rules and the whole boundary error bound, from
+  // what the collapse spent at each vertex
+  auto improve_now = [&](const std::vector<double>& spent) {
     ImproveOptions io = options.improvement;
     io.boundary = co.boundary;
     io.eps_f = co.eps_f;
     io.eps_r = co.eps_r;
     io.use_labels = co.use_labels;
-    // the whole boundary error bound, from what the collapse spent at each vertex
     if (bound > 0) {
       io.max_boundary_error_abs = bound;
-      io.vertex_boundary_error = r.collapse.vertex_boundary_error;
+      io.vertex_boundary_error = spent;
     }
     if (options.improve_mask) io.vertex_mask = options.improve_mask(mesh);
-    r.improvement = ctx ? improve(mesh, io, *ctx) : improve(mesh, io);
+    return ctx ? improve(mesh, io, *ctx) : improve(mesh, io);
+  };
+
+  CoarsenReport r;
+  r.collapse = collapse_now(co);
+  if (bound > 0) r.collapse.boundary_error_bound = bound;
+  if (improve_phase) {
+    r.improvement = improve_now(r.collapse.vertex_boundary_error);
     r.improved = true;
-    // the output's counts (the improvement's collapse step may remove a few more)
-    r.collapse.vertices_out = mesh.num_vertices();
-    r.collapse.tets_out = mesh.num_tets();
   }
+  // Later cycles: the edges the improvement made collapsible, with the first cycle's target and
+  // the bounds the improvement left, then the improvement again.
+  std::vector<double> spent = r.improvement.vertex_boundary_error;
+  for (int cycle = 1; improve_phase && cycle < options.cycles; ++cycle) {
+    CycleReport c;
+    c.tets_before = mesh.num_tets();
+    CollapseOptions again = co;
+    again.target_length = r.collapse.target_length;
+    again.vertex_boundary_error = std::move(spent);
+    again.vertex_mask = options.improve_mask ? options.improve_mask(mesh) : std::vector<uint8_t>();
+    again.min_quality = std::max(co.min_quality, kLaterCycleMinQuality);
+    c.collapse = collapse_now(again);
+    c.tets_collapsed = mesh.num_tets();
+    const int64_t removed = c.tets_before - c.tets_collapsed;
+    const bool last = double(removed) < kCycleMinShare * double(c.tets_before);
+    spent = c.collapse.vertex_boundary_error;
+    if (removed > 0) {  // (a collapse leaves slivers where it works: improve after every one)
+      c.improvement = improve_now(spent);
+      c.improved = true;
+      spent = c.improvement.vertex_boundary_error;
+    }
+    c.tets_after = mesh.num_tets();
+    r.collapse.boundary_error = std::max(r.collapse.boundary_error, c.collapse.boundary_error);
+    r.later_cycles.push_back(std::move(c));
+    if (last) break;
+  }
+  // the output's counts (the improvement's collapse step may remove a few more)
+  r.collapse.vertices_out = mesh.num_vertices();
+  r.collapse.tets_out = mesh.num_tets();
   if (resample) r.outside = ctx ? resample_vertex_fields(input, mesh, *ctx) : resample_vertex_fields(input, mesh);
   return r;
 }

@@ -30,9 +30,10 @@ Mesh bumpy_cube(unsigned seed) {
   return m;
 }
 
-// Coarsening to twice the median edge length within 0.002 of the diagonal.
+// Coarsening to twice the median edge length within 0.002 of the diagonal, one cycle.
 CoarsenOptions bounded_to_twice_the_median() {
   CoarsenOptions co;
+  co.cycles = 1;
   co.collapse.target_factor = 2;
   co.collapse.max_boundary_error = 0.002;
   return co;
@@ -44,6 +45,7 @@ TEST(Coarsen, IsTheCollapseThenTheImprovementThenTheFields) {
   const Mesh in = bumpy_cube(1);
   CoarsenOptions co;
   co.collapse.target_factor = 2;
+  co.cycles = 1;
   Mesh a = in;
   const CoarsenReport r = coarsen(a, co, &ctx);
   EXPECT_TRUE(r.improved);
@@ -75,6 +77,55 @@ TEST(Coarsen, NoImprovementPhaseWithEveryOperationOff) {
   co.improve = true;
   co.improvement.collapse = true;
   EXPECT_TRUE(improvement_follows(co));
+}
+
+// Later cycles (CoarsenOptions::cycles) collapse the edges the improvement made collapsible:
+// fewer tets, the first cycle the one-cycle run's, each cycle starting where the one before
+// ended, the result valid and, since each cycle goes on from the bound each vertex spent,
+// within the boundary error bound by the checker's two-sided distance.
+TEST(Coarsen, LaterCyclesCollapseWhatTheImprovementFreed) {
+  Context ctx;
+  const Mesh in = test::torus(8, 24);
+  CoarsenOptions co = bounded_to_twice_the_median();
+  Mesh one = in, three = in;
+  co.cycles = 1;
+  const CoarsenReport r1 = coarsen(one, co, &ctx);
+  EXPECT_TRUE(r1.later_cycles.empty());
+  co.cycles = 3;
+  const CoarsenReport r3 = coarsen(three, co, &ctx);
+  ASSERT_FALSE(r3.later_cycles.empty());
+  EXPECT_LT(three.num_tets(), one.num_tets() * 19 / 20) << "a later cycle coarsens further";
+  EXPECT_EQ(r3.later_cycles[0].tets_before, one.num_tets()) << "the first cycle is the one-cycle run";
+  for (size_t k = 0; k < r3.later_cycles.size(); ++k) {
+    const CycleReport& c = r3.later_cycles[k];
+    if (k > 0) {
+      EXPECT_EQ(c.tets_before, r3.later_cycles[k - 1].tets_after);
+    }
+    EXPECT_LE(c.tets_collapsed, c.tets_before);
+    EXPECT_EQ(c.collapse.target_length, r3.collapse.target_length) << "the same target";
+    EXPECT_EQ(c.improved, c.tets_collapsed < c.tets_before) << "every collapse that removed a tet is improved";
+    if (double(c.tets_before - c.tets_collapsed) < kCycleMinShare * double(c.tets_before)) {
+      EXPECT_EQ(k + 1, r3.later_cycles.size()) << "a cycle that removed too few is the last";
+    }
+  }
+  EXPECT_EQ(r3.later_cycles.back().tets_after, three.num_tets());
+  EXPECT_EQ(last_improvement(r3).after.tets, three.num_tets()) << "the last improvement's quality is the result's";
+  EXPECT_EQ(r3.collapse.tets_out, three.num_tets());
+  CheckOptions check;
+  check.hausdorff = true;
+  const CheckReport cr = check_mesh(three, check, &in);
+  EXPECT_TRUE(cr.valid) << check_report_text(cr);
+  EXPECT_LE(cr.reference.hausdorff_rel, 0.002) << "the checker's two-sided distance within the bound";
+  EXPECT_LE(r3.collapse.boundary_error, boundary_error_bound(in, co.collapse) * (1 + 1e-12));
+
+  co.cycles = 0;
+  Mesh m = in;
+  EXPECT_THROW(coarsen(m, co, &ctx), std::invalid_argument);
+  co.cycles = 2;
+  co.collapse.vertex_mask.assign(size_t(in.num_vertices()), 1);
+  EXPECT_THROW(coarsen(m, co, &ctx), std::invalid_argument) << "the input's mask does not fit the coarse mesh";
+  co.improve_mask = [](const Mesh& coarse) { return std::vector<uint8_t>(size_t(coarse.num_vertices()), 1); };
+  EXPECT_NO_THROW(coarsen(m, co, &ctx));
 }
 
 // A boundary error bound: the collapse uses its share, the improvement the rest, and the result

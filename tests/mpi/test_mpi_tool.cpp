@@ -527,6 +527,29 @@ TEST(MpiToolOptions, TheCommandsOptionsMeanTheSame) {
   EXPECT_EQ(run_mpi(2, in + " " + dir.file("o.msh") + " --conflicts two-pass --priority-levels 3", &log), 2) << log;
 }
 
+// --cycles as tetcollapse: a second cycle collapses again after the improvement (a collapse
+// phase after an improvement phase in the rounds), for fewer tets, near tetcollapse's count.
+TEST(MpiToolOptions, CyclesAsTetcollapse) {
+  TempDir dir;
+  const std::string in = tc::test::project_mesh("bracket.msh");
+  std::string log;
+  auto tets = [&](const std::string& file) { return tc::read_mesh(dir.file(file)).num_tets(); };
+  ASSERT_EQ(run_mpi(2, in + " " + dir.file("one.msh") + " --target-factor 2 -q --cycles 1", &log), 0) << log;
+  ASSERT_EQ(run_mpi(2, in + " " + dir.file("two.msh") + " --target-factor 2 -q --cycles 2 --check --stats " +
+                           dir.file("s.json"),
+                    &log),
+            0)
+      << log;
+  ASSERT_EQ(run_single(in + " " + dir.file("single.msh") + " --target-factor 2 -q --cycles 2", &log), 0) << log;
+  EXPECT_LT(tets("two.msh"), tets("one.msh") * 19 / 20);
+  EXPECT_NEAR(double(tets("two.msh")) / double(tets("single.msh")), 1.0, 0.10);
+  const std::string json = tc::test::read_text(dir.file("s.json"));
+  const size_t improve = json.find("\"phase\":\"improve\"");
+  ASSERT_NE(improve, std::string::npos) << json.substr(0, 600);
+  EXPECT_NE(json.find("\"phase\":\"collapse\"", improve), std::string::npos) << "a collapse after the improvement";
+  EXPECT_EQ(run_mpi(2, in + " " + dir.file("x.msh") + " --cycles 0", &log), 2) << log;
+}
+
 // --method sequential: every rank on the CPU, with no device opened; valid and within 5% of
 // tetcollapse --method sequential; the options that need the parallel method refused as there.
 TEST(MpiToolOptions, SequentialMethodAsTetcollapse) {
