@@ -71,6 +71,20 @@ class Module(unittest.TestCase):
         with self.assertRaises(ValueError):
             bound(boundary="strict", max_boundary_error=0.01)
 
+    def test_cycles_as_the_command_line(self):
+        # two cycles of collapse and improvement by default; one gives more tets; 0 is refused
+        points, tets = cube(10)
+        inner = ((points > 1e-9) & (points < 1 - 1e-9)).all(axis=1)
+        points[inner] += np.random.default_rng(1).uniform(-0.02, 0.02, (int(inner.sum()), 3))  # not a lattice
+        one = tetcollapse.collapse(points, tets, target_factor=2, cycles=1)
+        two = tetcollapse.collapse(points, tets, target_factor=2)
+        self.assertEqual(one["stats"]["cycles"], 1)
+        self.assertEqual(two["stats"]["cycles"], 2)
+        self.assertLess(two["tets"].shape[0], one["tets"].shape[0])
+        self.assertTrue(tetcollapse.check(two["points"], two["tets"])["valid"])
+        with self.assertRaises(ValueError):
+            tetcollapse.collapse(points, tets, cycles=0)
+
     def test_field_options_of_the_command_line(self):
         points, tets = cube(8)
         rng = np.random.default_rng(5)
