@@ -83,10 +83,13 @@ __kernel void bvh_nodes(uint n_leaves, __global const ulong* keys, __global int*
 
 /* Leaf j's box (its tet's, widened by `margin` so that a point the barycentric test accepts is
  * never outside it), then up: the second child to reach a node writes the node's box. arrived[]
- * is 0 on entry. */
+ * is 0 on entry. The boxes are floats rounded outwards (a box only has to hold its tets): at 12
+ * doubles per tet (2 nodes of 6) they were the run's largest buffer, above a quarter of what the
+ * collapse needs in all, and so past CL_DEVICE_MAX_MEM_ALLOC_SIZE first (Context::
+ * largest_allocation). */
 __kernel void bvh_boxes(uint n_leaves, __global const ulong* keys, __global const int* tets,
                         __global const double* pts, double margin, __global const int* child,
-                        __global const int* parent, volatile __global double* boxes,
+                        __global const int* parent, volatile __global float* boxes,
                         volatile __global uint* arrived) {
   int j = (int)get_global_id(0), n = (int)n_leaves;
   if (j >= n) return;
@@ -98,8 +101,12 @@ __kernel void bvh_boxes(uint n_leaves, __global const ulong* keys, __global cons
     hi = fmax(hi, p);
   }
   int node = n - 1 + j;
-  boxes[6 * (ulong)node] = lo.x - margin, boxes[6 * (ulong)node + 1] = lo.y - margin, boxes[6 * (ulong)node + 2] = lo.z - margin;
-  boxes[6 * (ulong)node + 3] = hi.x + margin, boxes[6 * (ulong)node + 4] = hi.y + margin, boxes[6 * (ulong)node + 5] = hi.z + margin;
+  lo -= margin;
+  hi += margin;
+  boxes[6 * (ulong)node] = convert_float_rtn(lo.x), boxes[6 * (ulong)node + 1] = convert_float_rtn(lo.y);
+  boxes[6 * (ulong)node + 2] = convert_float_rtn(lo.z);
+  boxes[6 * (ulong)node + 3] = convert_float_rtp(hi.x), boxes[6 * (ulong)node + 4] = convert_float_rtp(hi.y);
+  boxes[6 * (ulong)node + 5] = convert_float_rtp(hi.z);
   node = parent[node];
   while (node >= 0) {
     mem_fence(CLK_GLOBAL_MEM_FENCE);
@@ -114,13 +121,14 @@ __kernel void bvh_boxes(uint n_leaves, __global const ulong* keys, __global cons
   }
 }
 
-inline int tcb_in_box(__global const double* b, double3 p) {
-  return p.x >= b[0] && p.y >= b[1] && p.z >= b[2] && p.x <= b[3] && p.y <= b[4] && p.z <= b[5];
+inline int tcb_in_box(__global const float* b, double3 p) {
+  return p.x >= (double)b[0] && p.y >= (double)b[1] && p.z >= (double)b[2] && p.x <= (double)b[3] &&
+         p.y <= (double)b[4] && p.z <= (double)b[5];
 }
 
 /* Query q: out_tet[q] and out_bary[4q..4q+3] (see the file's comment); n_leaves >= 1. */
 __kernel void bvh_locate(uint nq, __global const double* queries, uint n_leaves, __global const ulong* keys,
-                         __global const int* child, __global const double* boxes, __global const int* tets,
+                         __global const int* child, __global const float* boxes, __global const int* tets,
                          __global const double* pts, __global int* out_tet, __global double* out_bary) {
   uint q = get_global_id(0);
   if (q >= nq) return;

@@ -63,7 +63,7 @@ DeviceTetLocator::DeviceTetLocator(const Mesh& mesh, Context& ctx)
   child_ = DeviceBuffer<int32_t>(ctx, size_t(std::max<int64_t>(2 * (n_ - 1), 1)));
   DeviceBuffer<int32_t> parent(ctx, std::vector<int32_t>(size_t(nodes), -1));
   launch(ctx, "bvh_nodes", size_t(n_ - 1), u32(n_), keys_.buffer(), child_.buffer(), parent.buffer());
-  boxes_ = DeviceBuffer<double>(ctx, size_t(6 * nodes));
+  boxes_ = DeviceBuffer<float>(ctx, size_t(6 * nodes));  // (floats rounded outwards: cl/bvh.cl)
   DeviceBuffer<uint32_t> arrived(ctx, std::vector<uint32_t>(size_t(std::max<int64_t>(n_ - 1, 1)), 0));
   // the boxes a little wider than the tets, so that a point the barycentric test accepts
   // (coordinates >= -1e-12) is never outside its tet's box

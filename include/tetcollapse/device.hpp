@@ -18,6 +18,7 @@
 #endif
 #include <CL/opencl.hpp>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -177,6 +178,13 @@ class Context {
   void set_compile_notice(std::function<void(const std::string& file, int done, int total)> fn) {
     compile_notice_ = std::move(fn);
   }
+  // The largest buffer allocated in this context so far, in bytes (DeviceBuffer). No buffer is
+  // split over CL_DEVICE_MAX_MEM_ALLOC_SIZE: OpenCL grants at least a quarter of the global
+  // memory per allocation, and the largest buffer of a run stays below a quarter of the memory
+  // the run is checked to need (a test holds both to that), so a mesh that passes the memory
+  // check needs no split on a conforming device; past the limit a buffer is refused (DeviceError).
+  uint64_t largest_allocation() const { return largest_allocation_; }
+  void note_allocation(uint64_t bytes) { largest_allocation_ = std::max(largest_allocation_, bytes); }
 
  private:
   void init(const DeviceInfo& info);
@@ -195,6 +203,7 @@ class Context {
   cl::Context context_;
   cl::CommandQueue queue_;
   size_t work_group_size_ = 0;
+  uint64_t largest_allocation_ = 0;
   bool cpu_tuning_ = false;
   std::map<std::pair<std::string, std::string>, cl::Program> programs_;
   BuildSource last_build_source_ = BuildSource::Memory;
@@ -297,6 +306,7 @@ class DeviceBuffer {
                         std::to_string(ctx_->info().global_mem_bytes >> 20) +
                         " MiB); use a larger device or --method sequential");
     detail::cl_call("clCreateBuffer", [&] { buf_ = cl::Buffer(ctx_->context(), CL_MEM_READ_WRITE, cap * sizeof(T)); });
+    ctx_->note_allocation(bytes);
     capacity_ = cap;
     n_ = n;
   }

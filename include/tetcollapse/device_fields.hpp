@@ -36,7 +36,8 @@ class DeviceTetLocator {
   Context& ctx_;
   int64_t n_ = 0;  // leaves: the mesh's tets
   DeviceBuffer<int32_t> tets_;
-  DeviceBuffer<double> points_, boxes_;
+  DeviceBuffer<double> points_;
+  DeviceBuffer<float> boxes_;  // (floats rounded outwards: cl/bvh.cl)
   DeviceBuffer<uint64_t> keys_;
   DeviceBuffer<int32_t> child_;
 };

@@ -12,6 +12,8 @@
 #include "tetcollapse/check.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/improve.hpp"
+#include "tetcollapse/io.hpp"
+#include "collapse/upload.hpp"
 
 namespace tc {
 namespace {
@@ -126,6 +128,35 @@ TEST(Coarsen, LaterCyclesCollapseWhatTheImprovementFreed) {
   EXPECT_THROW(coarsen(m, co, &ctx), std::invalid_argument) << "the input's mask does not fit the coarse mesh";
   co.improve_mask = [](const Mesh& coarse) { return std::vector<uint8_t>(size_t(coarse.num_vertices()), 1); };
   EXPECT_NO_THROW(coarsen(m, co, &ctx));
+}
+
+// No buffer is split over CL_DEVICE_MAX_MEM_ALLOC_SIZE (Context::largest_allocation): OpenCL
+// grants a quarter of the global memory per allocation at least, so a run whose largest buffer
+// stays below a quarter of what the memory check estimates it needs never needs one. Held here
+// for the whole command (both cycles, the fields' resampling), with and without the boundary
+// error bound, on the CPU's and the GPU's code paths.
+TEST(Coarsen, TheLargestBufferIsUnderAQuarterOfTheEstimate) {
+  Mesh bracket = read_mesh(test::project_mesh("bracket.msh"));
+  bracket.vertex_fields.push_back({"z", 1, {}});
+  for (int64_t v = 0; v < bracket.num_vertices(); ++v) bracket.vertex_fields[0].values.push_back(bracket.points[3 * size_t(v) + 2]);
+  for (const Mesh& in : {bracket, test::ball(14)}) {
+    for (double bound : {0.0, 0.001}) {
+      for (bool cpu : {true, false}) {
+        Context ctx;
+        ctx.set_cpu_tuning(cpu);
+        CoarsenOptions co;
+        co.collapse.target_factor = 2;
+        co.collapse.max_boundary_error = bound;
+        Mesh m = in;
+        coarsen(m, co, &ctx);
+        const uint64_t estimate = collapse_detail::device_bytes_estimate(in, co.collapse);
+        EXPECT_LE(4 * ctx.largest_allocation(), estimate)
+            << in.num_tets() << " tets, bound " << bound << ", cpu tuning " << cpu << ": largest buffer "
+            << ctx.largest_allocation() << " bytes";
+        EXPECT_GT(ctx.largest_allocation(), estimate / 100) << "it counts the mesh's buffers";
+      }
+    }
+  }
 }
 
 // A boundary error bound: the collapse uses its share, the improvement the rest, and the result
