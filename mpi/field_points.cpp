@@ -10,16 +10,23 @@ namespace tc::mpi {
 
 namespace {
 
-size_t field_index(const Mesh& m, const std::string& name) {
-  for (size_t i = 0; i < m.vertex_fields.size(); ++i)
-    if (m.vertex_fields[i].name == name) return i;
-  throw std::invalid_argument("no vertex field named '" + name + "'");
+const Field& named_field(const Mesh& m, const std::string& name) {
+  const Field* f = m.find_vertex_field(name);
+  if (!f) throw std::invalid_argument("no vertex field named '" + name + "'");
+  return *f;
+}
+
+// The vertices some tet uses: an unused one is not part of the field (the library's rule).
+std::vector<uint8_t> used_vertices(const Mesh& m) {
+  std::vector<uint8_t> used(size_t(m.num_vertices()), 0);
+  for (int32_t v : m.tets) used[size_t(v)] = 1;
+  return used;
 }
 
 }  // namespace
 
 std::vector<double> field_range(const Mesh& input, const std::string& name) {
-  const Field& f = input.vertex_fields[field_index(input, name)];
+  const Field& f = named_field(input, name);
   const size_t nc = size_t(f.components);
   std::vector<double> lo(nc, INFINITY), hi(nc, -INFINITY), range(nc, 0.0);
   for (size_t i = 0; i < f.values.size(); ++i) {
@@ -32,13 +39,11 @@ std::vector<double> field_range(const Mesh& input, const std::string& name) {
 
 FieldPointCut::FieldPointCut(const Mesh& input, const std::string& name, const Mesh& whole,
                              const std::vector<int32_t>& tet_part, int nparts)
-    : input_(input), field_(field_index(input, name)) {
+    : input_(input), field_(named_field(input, name)) {
   // each tet's index within its part, in the global order (Splitter::extract's)
   std::vector<int32_t> local(tet_part.size()), count(size_t(nparts), 0);
   for (size_t t = 0; t < tet_part.size(); ++t) local[t] = count[size_t(tet_part[t])]++;
-  // an input vertex no tet uses is not part of the field (the library's rule)
-  std::vector<uint8_t> used(size_t(input.num_vertices()), 0);
-  for (int32_t v : input.tets) used[size_t(v)] = 1;
+  const std::vector<uint8_t> used = used_vertices(input);
   const TetLocator loc(whole);
   const int64_t nv = input.num_vertices();
   part_of_.assign(size_t(nv), -1);
@@ -54,7 +59,7 @@ FieldPointCut::FieldPointCut(const Mesh& input, const std::string& name, const M
 }
 
 void FieldPointCut::fill(int p, Part& part) const {
-  const Field& f = input_.vertex_fields[field_];
+  const Field& f = field_;
   const size_t nc = size_t(f.components);
   part.field_points.clear();
   part.field_values.clear();
@@ -69,12 +74,11 @@ void FieldPointCut::fill(int p, Part& part) const {
 
 double measured_field_error(const Mesh& input, const std::string& name, const Mesh& mesh,
                             const std::vector<double>& range) {
-  const Field& f = input.vertex_fields[field_index(input, name)];
-  const Field& g = mesh.vertex_fields[field_index(mesh, name)];
+  const Field& f = named_field(input, name);
+  const Field& g = named_field(mesh, name);
   const size_t nc = size_t(f.components);
   if (size_t(g.components) != nc) throw std::logic_error("the bounded field lost components");
-  std::vector<uint8_t> used(size_t(input.num_vertices()), 0);
-  for (int32_t v : input.tets) used[size_t(v)] = 1;
+  const std::vector<uint8_t> used = used_vertices(input);
   const TetLocator loc(mesh);
   double worst = 0;
   for (int64_t v = 0; v < input.num_vertices(); ++v) {

@@ -30,7 +30,7 @@ class FieldPointCut {
 
  private:
   const Mesh& input_;
-  size_t field_ = 0;
+  const Field& field_;  // the bounded field of the input
   std::vector<int32_t> part_of_, local_tet_;  // per input vertex (-1: no part, an unused vertex)
 };
 
