@@ -70,6 +70,7 @@ RankReport coarsen_part(Part& part, Phase phase, const Settings& s, Context* ctx
     if (bounded) {
       co.max_boundary_error = 0, co.max_boundary_error_abs = s.boundary_bound;
       co.vertex_boundary_error = std::move(spent);
+      co.boundary_reference = s.boundary_reference;
     }
     if (co.max_field_error > 0) {
       co.field_points = std::move(part.field_points);

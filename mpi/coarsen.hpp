@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ struct Settings {
   // (kSpentField) from round to round, so that every round goes on from there, as one run of
   // the library would (the frozen interface vertices keep theirs: nothing at them changes).
   double boundary_bound = 0;
+  // The whole input's S as triangles, the reference every round's collapse measures the bound
+  // against (CollapseOptions::boundary_reference); null: not measured.
+  std::shared_ptr<const std::vector<double>> boundary_reference;
   // --region and --labels: only their vertices change (tetcollapse's masks, found on each part:
   // a vertex that is not frozen has its whole star in the part)
   std::string region, labels;

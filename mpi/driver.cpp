@@ -147,6 +147,17 @@ int run(Options& o, MPI_Comm comm) {
   const double bound = o.max_boundary_error_abs > 0 ? o.max_boundary_error_abs : o.max_boundary_error * s.whole_diagonal;
   stats.boundary_error_bound = bound;
   if (bound > 0 && rank == 0) whole.vertex_fields.push_back({kSpentField, 1, std::vector<double>(size_t(whole.num_vertices()), 0.0)});
+  // the input's S, which every round's collapse measures against (rank 0 has the input)
+  if (bound > 0 && s.collapse.tuning.remeasure_boundary_error) {
+    std::vector<double> tris;
+    if (rank == 0) tris = feature_surface_triangles(whole, s.collapse.use_labels);
+    uint64_t n = tris.size();
+    MPI_Bcast(&n, 1, MPI_UINT64_T, 0, comm);
+    tris.resize(size_t(n));
+    for (uint64_t at = 0; at < n; at += uint64_t(1) << 30)  // (MPI counts are ints)
+      bcast(tris.data() + at, int(std::min<uint64_t>(n - at, uint64_t(1) << 30)), comm);
+    s.boundary_reference = std::make_shared<const std::vector<double>>(std::move(tris));
+  }
   // (none after a user's placement or predicate, or with every operation off, as tc::coarsen)
   CoarsenOptions as_coarsen;
   as_coarsen.collapse = s.collapse, as_coarsen.improve = !o.no_improve, as_coarsen.improvement = s.improve;

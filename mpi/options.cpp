@@ -33,7 +33,8 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--max-boundary-error", o.max_boundary_error,
                  "Features mode: keep the boundary and the material interfaces within E x the whole input's\n"
                  "bounding-box diagonal of where they were, both ways, as tetcollapse does (each vertex carries\n"
-                 "the bound it reached from round to round; the partition interfaces are frozen). Default\n"
+                 "the bound it reached from round to round, every rank measures against the input's boundary;\n"
+                 "the partition interfaces are frozen). Default\n"
                  "0.001 in features mode; 0: no bound (the paper's method)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--max-boundary-error-abs", o.max_boundary_error_abs,

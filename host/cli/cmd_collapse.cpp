@@ -154,8 +154,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
       app.add_option("--max-boundary-error", c->opt.max_boundary_error,
                      "Features mode: keep the boundary and the material interfaces within E x the input's\n"
                      "bounding-box diagonal of where they were, both ways (a conservative bound on the two-sided\n"
-                     "Hausdorff distance, carried per vertex); smoothly curved faces then coarsen (--eps-f is not\n"
-                     "used). Tested on the device; the parallel method then selects by --conflicts greedy.\n"
+                     "Hausdorff distance, carried per vertex, and where that refuses a change, the change measured\n"
+                     "against the input's boundary on the host); smoothly curved faces then coarsen (--eps-f is not\n"
+                     "used). The carried bound is tested on the device, which then selects by --conflicts greedy;\n"
+                     "the measured one in the host tail (not with --host-tail 0).\n"
                      "Default 0.001 in features mode; 0: no bound (the paper's method: curved faces stay as\n"
                      "--eps-f says, what moves is not bounded)")
           ->check(CLI::NonNegativeNumber);

@@ -164,6 +164,7 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
     CollapseOptions again = co;
     again.target_length = r.collapse.target_length;
     again.vertex_boundary_error = std::move(spent);
+    again.boundary_reference = r.collapse.boundary_reference;  // the input's S, not this mesh's
     again.vertex_mask = options.improve_mask ? options.improve_mask(mesh) : std::vector<uint8_t>();
     again.min_quality = std::max(co.min_quality, kLaterCycleMinQuality);
     c.collapse = collapse_now(again);

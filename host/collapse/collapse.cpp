@@ -9,6 +9,7 @@
 #include "collapse/cost.hpp"
 #include "collapse/edge_state.hpp"
 #include "collapse/host_tail.hpp"
+#include "collapse/reference.hpp"
 #include "collapse/programs.hpp"
 #include "collapse/selection.hpp"
 #include "collapse/target.hpp"
@@ -36,7 +37,10 @@ CollapseReport report_for(const Mesh& mesh, const Context& ctx) {
 
 namespace {
 
-CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Context& ctx);
+// reference: under a bound, where the boundary error bound's reference surface goes (computed
+// from the device's first connectivity when null) for the host tail, which then always runs.
+CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Context& ctx,
+                                  std::shared_ptr<const std::vector<double>>* reference = nullptr);
 
 // The bound's column in the packed vertex fields: the last component (of kBoundField, last).
 uint32_t dm_bound_column(const Mesh& mesh) {
@@ -71,9 +75,14 @@ CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Cont
   mesh.vertex_fields.push_back(std::move(bound_field));
   o.vertex_boundary_error.clear();  // (in the field now)
   const auto drop_added = [&] { mesh.vertex_fields.resize(mesh.vertex_fields.size() - added); };
+  // the reference surface: the one given, else the input's own S on a first run
+  std::shared_ptr<const std::vector<double>> reference = options.boundary_reference;
+  const bool remeasure = options.tuning.remeasure_boundary_error && !options.has_user_functions() &&
+                         options.tuning.host_tail != 0 &&
+                         (reference || first_bounded_run(options));
   CollapseReport report;
   try {
-    report = collapse_on_device(mesh, o, ctx);
+    report = collapse_on_device(mesh, o, ctx, remeasure ? &reference : nullptr);
   } catch (...) {
     drop_added();
     throw;
@@ -81,6 +90,7 @@ CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Cont
   report.vertex_boundary_error = std::move(mesh.vertex_fields.back().values);
   drop_added();
   report.boundary_error_bound = bound;
+  report.boundary_reference = std::move(reference);
   report.boundary_error = 0;
   for (double e : report.vertex_boundary_error) report.boundary_error = std::max(report.boundary_error, e);
   return report;
@@ -117,6 +127,7 @@ void prefetch_programs(Context& ctx, const CollapseOptions& o) {
   if (conflicts == CollapseOptions::TwoPass) ctx.prefetch("collapse_conflict.cl");
   if (conflicts == CollapseOptions::Greedy) ctx.prefetch("collapse_select_greedy.cl");
   if (bounded) ctx.prefetch("collapse_bound.cl");
+  if (bounded && o.tuning.remeasure_boundary_error) ctx.prefetch("collapse_reference.cl");
   if (o.boundary != CollapseOptions::Strict) {  // the surface guard
     ctx.prefetch("collapse_guard_applied.cl");
     ctx.prefetch("collapse_guard.cl");
@@ -138,7 +149,8 @@ CollapseReport collapse(Mesh& mesh, const CollapseOptions& options, Context& ctx
 
 namespace {
 
-CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Context& ctx) {
+CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Context& ctx,
+                                  std::shared_ptr<const std::vector<double>>* reference) {
   check_options(options, ctx);
   check_device_memory(ctx, mesh, options);
   const Context::ProgramOptions variant = program_variant(ctx, options);
@@ -179,6 +191,10 @@ CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Co
   if (options.max_iterations > 0 && dm.nt > 0) {
     seconds_connectivity = connectivity();
     p.target = target_length(ctx, dm, conn, st, p, options, report);
+    if (reference) {
+      if (!*reference) *reference = reference_surface(ctx, dm, conn);
+      tail.set_reference(*reference);
+    }
   }
   for (int it = 0; it < options.max_iterations && dm.nt > 0; ++it) {
     IterationStats s{.iteration = it, .vertices = dm.nv, .tets = dm.nt, .edges = conn.ne};
@@ -196,7 +212,14 @@ CollapseReport collapse_on_device(Mesh& mesh, const CollapseOptions& options, Co
     s.tets_after = dm.nt;
     report.iterations.push_back(s);
     if (options.progress) options.progress(s);
-    if (s.collapsed < std::max<int64_t>(options.eps_c, 1) || it + 1 >= options.max_iterations || dm.nt == 0) break;
+    if (s.collapsed < std::max<int64_t>(options.eps_c, 1) || it + 1 >= options.max_iterations || dm.nt == 0) {
+      // the collapses of S the carried bound refused, measured on the host
+      if (reference && options.eps_c <= 1 && it + 1 < options.max_iterations && dm.nt > 0) {
+        if (s.collapsed > 0) connectivity();
+        tail.seed(ctx, dm, conn, st, s.collapsed == 0);
+      }
+      break;
+    }
     seconds_connectivity = connectivity();
     if (tail.due(report.iterations)) {
       tail.seed(ctx, dm, conn, st);

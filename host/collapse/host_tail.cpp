@@ -55,7 +55,7 @@ bool HostTail::due(const std::vector<IterationStats>& its) const {
 // The seed: the connectivity, the tet neighbours, the flags and classes, and the touched flags
 // (tail_touched) where the last iteration's selection was greedy or matching and the verdicts
 // are carried; else every vertex counts as touched.
-void HostTail::seed(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s) {
+void HostTail::seed(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, bool nothing_collapsed) {
   seeded_ = true;
   if (dm.has_mask) mask_ = dm.vmask.download_range(0, dm.nv);
   if (!tail_seed_enabled()) return;
@@ -63,11 +63,15 @@ void HostTail::seed(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s)
   seed_.vclass = c.vclass.download_range(0, dm.nv);
   seed_.tet_nbr = c.tet_nbr.download_range(0, 4 * size_t(dm.nt));
   seed_.edges = c.edges.download_range(0, 2 * size_t(c.ne));
-  if (o_.tuning.reuse_across_iterations &&
-      (o_.conflicts == CollapseOptions::Greedy || o_.conflicts == CollapseOptions::Matching))
+  if (nothing_collapsed && reference_ && o_.tuning.reuse_across_iterations)
+    seed_.touched.assign(dm.nv, 0);
+  else if (o_.tuning.reuse_across_iterations &&
+           (o_.conflicts == CollapseOptions::Greedy || o_.conflicts == CollapseOptions::Matching))
     seed_.touched = tail_touched(ctx, dm, c, s);
   else
     seed_.touched.assign(dm.nv, 1);
+  if (reference_)  // the collapses of S the device's carried bound refused, measured now
+    for (size_t v = 0; v < seed_.touched.size(); ++v) seed_.touched[v] |= seed_.vflags[v] != 0;
 }
 
 void HostTail::finish(Mesh& mesh, const StageParams& p, CollapseReport& report) {
@@ -80,6 +84,8 @@ void HostTail::finish(Mesh& mesh, const StageParams& p, CollapseReport& report) 
   o.eps_v_relative = false;
   o.vertex_mask = std::move(mask_);
   o.max_iterations = o_.max_iterations - done;
+  o.boundary_reference = reference_;  // (none: the tail's own S is no reference)
+  o.tuning.remeasure_boundary_error = reference_ != nullptr;
   auto continued = [done](IterationStats t) {  // numbered on from the device's iterations
     t.iteration += done;
     t.on_host = true;

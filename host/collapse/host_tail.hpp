@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "collapse/connectivity.hpp"
@@ -24,11 +25,18 @@ class HostTail {
   bool due(const std::vector<IterationStats>& iterations) const;
   // Takes over the current mesh's connectivity (built and, with reuse, its verdicts carried) and
   // the vertex mask, before the mesh is downloaded.
-  void seed(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s);
+  // nothing_collapsed: the last iteration collapsed nothing (c is the mesh's connectivity and
+  // every marked edge was refused there: no vertex counts as touched but those the reference
+  // makes so).
+  void seed(Context& ctx, DeviceMesh& dm, Connectivity& c, EdgeState& s, bool nothing_collapsed = false);
   // Runs the rest on the downloaded mesh (current numbering; its triangles and edges remapped);
   // its iterations continue the report's.
   void finish(Mesh& mesh, const StageParams& p, CollapseReport& report);
   bool seeded() const { return seeded_; }
+  // Under a boundary error bound: the tail measures the changes of S the carried bound refuses
+  // against this surface (CollapseTuning::remeasure_boundary_error), those the device refused
+  // included (their end points count as touched).
+  void set_reference(std::shared_ptr<const std::vector<double>> r) { reference_ = std::move(r); }
 
  private:
   const CollapseOptions& o_;
@@ -36,6 +44,7 @@ class HostTail {
   bool seeded_ = false;
   sequential_detail::TailSeed seed_;
   std::vector<uint8_t> mask_;
+  std::shared_ptr<const std::vector<double>> reference_;
 };
 
 }  // namespace tc::collapse_detail

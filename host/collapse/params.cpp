@@ -1,10 +1,12 @@
 // StageParams from the user's options.
 #include "collapse/params.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include "tetcollapse/error.hpp"
+#include "tetcollapse/topology.hpp"
 
 namespace tc::collapse_detail {
 
@@ -22,6 +24,10 @@ void check_boundary_error_options(const CollapseOptions& o) {
   check_bound_mode(o.bounds_boundary_error(), o.boundary, "max_boundary_error");
   if (!o.vertex_boundary_error.empty() && !o.bounds_boundary_error())
     throw std::invalid_argument("vertex_boundary_error needs a boundary error bound (max_boundary_error)");
+}
+
+bool first_bounded_run(const CollapseOptions& o) {
+  return std::all_of(o.vertex_boundary_error.begin(), o.vertex_boundary_error.end(), [](double e) { return e == 0; });
 }
 
 std::vector<double> initial_boundary_error(const Mesh& mesh, const CollapseOptions& o) {
@@ -100,3 +106,17 @@ void check_options(const CollapseOptions& o, const Context& ctx) {
 }
 
 }  // namespace tc::collapse_detail
+
+namespace tc {
+
+std::vector<double> feature_surface_triangles(const Mesh& mesh, bool use_labels) {
+  TopologyOptions to;
+  to.use_labels = use_labels;
+  const Topology topo = build_topology(mesh, to);
+  std::vector<double> out;
+  out.reserve(9 * topo.sfaces.size() / 3);
+  for (int32_t v : topo.sfaces) out.insert(out.end(), &mesh.points[3 * size_t(v)], &mesh.points[3 * size_t(v) + 3]);
+  return out;
+}
+
+}  // namespace tc

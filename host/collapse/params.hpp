@@ -85,6 +85,9 @@ void check_bound_mode(bool bounded, CollapseOptions::Boundary mode, const char* 
 // The bound per vertex at the start of a run: CollapseOptions::vertex_boundary_error, checked
 // against the mesh (std::invalid_argument), or zeros.
 std::vector<double> initial_boundary_error(const Mesh& mesh, const CollapseOptions& o);
+// No bound spent before the run (vertex_boundary_error empty or zeros): the mesh's own S is the
+// reference surface of the bound when none is given (CollapseOptions::boundary_reference).
+bool first_bounded_run(const CollapseOptions& o);
 StageParams params_from(const CollapseOptions& o);
 // The options the parallel method refuses (std::invalid_argument), or this device cannot run
 // (tc::DeviceError).

@@ -74,6 +74,18 @@ SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const T
   mask_ = options.vertex_mask;
   bound_ = boundary_error_bound(mesh, options);
   if (bound_ > 0) eps_ = collapse_detail::initial_boundary_error(mesh, options);
+  if (bound_ > 0 && options.tuning.remeasure_boundary_error &&
+      (options.boundary_reference || collapse_detail::first_bounded_run(options))) {
+    reference_triangles_ = options.boundary_reference;
+    if (!reference_triangles_) {
+      auto own = std::make_shared<std::vector<double>>();
+      sm_.s_triangles(*own);
+      reference_triangles_ = std::move(own);
+    }
+    reference_ = std::make_unique<surface_distance::ReferenceSurface>(*reference_triangles_);
+    reach_ = bound_;
+    for (double e : eps_) reach_ = std::max(reach_, e);
+  }
   if (options.max_field_error > 0) {
     field_ = std::make_unique<FieldBound>(mesh, options, sm_);
     report_.field_error_bound = field_->bound();
@@ -294,8 +306,11 @@ bool SequentialRun::step() {
       continue;
     }
     double eps_after = 0;
+    bool measured = false;
     if (bound_ > 0) {
-      if (!(base + change <= bound_)) {
+      // the carried bound, else the change measured against the reference
+      measured = !(base + change <= bound_) && reference_ && measured_ok(e.a, e.b, dir);
+      if (!(base + change <= bound_) && !measured) {
         ++s.refused_by_bound;
         continue;  // (the verdict depends on the star alone: no retest unless it changes)
       }
@@ -308,7 +323,15 @@ bool SequentialRun::step() {
     const int32_t survivor = sm_.collapse(e.a, e.b, dir);
     ++collapses_;
     if (field_) field_->apply(mesh_, survivor);
-    if (eps_after > 0) eps_[size_t(survivor)] = std::max(eps_[size_t(survivor)], eps_after);
+    if (measured) {
+      // The new S triangles and those around them now stand for the reference near them, up
+      // to the whole bound: the carried bound never builds on them (a change of them it
+      // measures adds to the whole bound).
+      eps_[size_t(survivor)] = bound_;
+      for (int32_t v : corners_) eps_[size_t(v)] = std::max(eps_[size_t(v)], bound_);
+    } else if (eps_after > 0) {
+      eps_[size_t(survivor)] = std::max(eps_[size_t(survivor)], eps_after);
+    }
     ++s.collapsed;
     for (int32_t u : sm_.touched()) touched_[u] = cur;
     if (greedy_) {
@@ -397,6 +420,18 @@ void SequentialRun::seed_boundary_error(std::vector<double> eps) {
     throw std::invalid_argument("seed_boundary_error: " + std::to_string(eps.size()) + " values for " +
                                 std::to_string(eps_.size()) + " vertices");
   eps_ = std::move(eps);
+  // a run that goes on from an earlier one: its own S is no reference
+  if (!o_.boundary_reference) {
+    reference_.reset();
+    reference_triangles_.reset();
+  }
+  if (reference_)
+    for (double e : eps_) reach_ = std::max(reach_, e);
+}
+
+bool SequentialRun::measured_ok(int32_t a, int32_t b, uint8_t dir) {
+  sm_.collapse_fans(a, b, dir, olds_, news_, around_, corners_);
+  return reference_->change_ok(olds_, news_, around_, bound_, reach_);
 }
 
 void SequentialRun::keep_origin() {
@@ -417,6 +452,7 @@ CollapseReport SequentialRun::finish() {
   for (size_t v = 0; v < eps_.size(); ++v)
     if (sm_.alive(int32_t(v))) report_.boundary_error = std::max(report_.boundary_error, eps_[v]);
   if (bound_ > 0) report_.vertex_boundary_error = eps_;
+  report_.boundary_reference = reference_triangles_;
   if (field_) report_.field_error = field_->max_error(sm_, mesh_);
   report_.vertices_out = mesh_.num_vertices();
   report_.tets_out = mesh_.num_tets();

@@ -29,6 +29,7 @@
 // everything from scratch for the tests.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -140,6 +141,15 @@ class SeqMesh {
   // any other dir as it is. Its surface_change in *change and *base.
   uint8_t closest_placement(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base,
                             double* change);
+  // The boundary error bound measured (collapse/surface_distance.hpp): the S triangles now, one
+  // per face (9 coordinates each, appended to out); and for the collapse of (a, b) in direction
+  // dir the S triangles it replaces (olds), those it makes (news) and the S triangles that stay
+  // at the new ones' other corners (around), with in `corners` those corners and the corners of
+  // the triangles around (the survivor aside).
+  void s_triangles(std::vector<double>& out) const;
+  void collapse_fans(int32_t a, int32_t b, uint8_t dir, std::vector<std::array<geo::tc_d3, 3>>& olds,
+                     std::vector<std::array<geo::tc_d3, 3>>& news, std::vector<std::array<geo::tc_d3, 3>>& around,
+                     std::vector<int32_t>& corners) const;
 
   // The tets the collapse of (a, b) in direction dir removes or reshapes (those of ring(a) U
   // ring(b), each once), in `tets`; in `after` four vertices per tet as the collapse leaves it

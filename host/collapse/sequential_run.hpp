@@ -53,6 +53,7 @@
 #include "collapse/edge_key_set.hpp"
 #include "collapse/field_bound.hpp"
 #include "collapse/sequential_mesh.hpp"
+#include "collapse/surface_distance.hpp"
 #include "tetcollapse/collapse.hpp"
 #include "tetcollapse/mesh.hpp"
 
@@ -167,6 +168,17 @@ class SequentialRun {
   double bound_ = 0;
   std::vector<double> eps_;
   std::unique_ptr<FieldBound> field_;  // the field error bound (null: none)
+  // The boundary error bound measured where the carried one refuses (CollapseOptions::
+  // boundary_reference; null: not measured), and how far every point of the reference may be
+  // from S now (the bound, or more where the vertex bounds given say so).
+  std::shared_ptr<const std::vector<double>> reference_triangles_;
+  std::unique_ptr<surface_distance::ReferenceSurface> reference_;
+  double reach_ = 0;
+  std::vector<std::array<geo::tc_d3, 3>> olds_, news_, around_;
+  std::vector<int32_t> corners_;
+  // Whether the collapse of (a, b) in direction dir keeps S within the bound of the reference,
+  // measured; its corners (collapse_fans) in corners_.
+  bool measured_ok(int32_t a, int32_t b, uint8_t dir);
   std::vector<int32_t> tmap_;
   std::vector<int32_t> origin_;    // input vertex -> current vertex (only with tris or edges)
   std::vector<int32_t> source_;    // current vertex -> input vertex (keep_origin)

@@ -50,6 +50,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -106,6 +107,9 @@ struct CollapseReport {
   // at it are from the input's S (each S triangle is within the largest of its corners'); the
   // improvement phase goes on from it (ImproveOptions::vertex_boundary_error).
   std::vector<double> vertex_boundary_error;
+  // With a boundary error bound: the surface it measured from (CollapseOptions::
+  // boundary_reference), for a run that goes on from this one.
+  std::shared_ptr<const std::vector<double>> boundary_reference;
   // With a field error bound: the bound (a share of the field's range), and the largest
   // difference, as a share of the range, between an input vertex's value and the result's
   // piecewise linear field at it (over the bounded field's components).
@@ -153,6 +157,11 @@ struct CollapseTuning {
   // matching selection (its tail iterations cost more, and its tail shrinks faster).
   static constexpr double kHostTailIterations = 24, kHostTailIterationsMatching = 6;
   double host_tail_min_iterations = -1;
+  // Under a boundary error bound: measure a change of S the carried bound refuses against the
+  // reference surface (CollapseOptions::boundary_reference) on the host. The parallel method
+  // then always ends with its host tail, which measures the collapses of S the device refused
+  // (not with host_tail 0: all on the device, the carried bound alone).
+  bool remeasure_boundary_error = true;
 };
 
 struct CollapseOptions {
@@ -222,6 +231,15 @@ struct CollapseOptions {
   // in mesh units (as CollapseReport::vertex_boundary_error reports it: a run goes on from
   // where one before it ended, as the MPI tool's rounds do); empty: none.
   std::vector<double> vertex_boundary_error;
+  // With a bound: the input's S as triangles (9 coordinates each) for the re-measurement: a
+  // collapse the carried bound refuses is made when the distance between its new S triangles
+  // and this surface, and between this surface near the S triangles it replaces and the S
+  // around after it, both measured (collapse/surface_distance.hpp), stay within the bound. The
+  // S triangles it makes and those around them then count as having spent the whole bound in
+  // vertex_boundary_error, so that the carried bound never builds on them. Null: the mesh's own S
+  // when vertex_boundary_error is empty (a first run), else no re-measurement. A run reports the
+  // one it used (CollapseReport::boundary_reference) for a run that goes on from it.
+  std::shared_ptr<const std::vector<double>> boundary_reference;
   bool bounds_boundary_error() const { return max_boundary_error > 0 || max_boundary_error_abs > 0; }
   // Field error bound (beyond the paper, after Cignoni et al. 2000): a collapse is made only
   // while every input vertex keeps, in the result's piecewise linear vertex field
@@ -337,6 +355,11 @@ double median_edge_length(const Mesh& mesh);
 // The volume threshold a run uses: options.eps_v, or with eps_v_relative options.eps_v x (the
 // bounding-box diagonal of the mesh)^3.
 double volume_threshold(const Mesh& mesh, const CollapseOptions& options);
+// The feature surface S of `mesh` (its boundary faces and, with labels, the faces between
+// different primary labels) as triangles, 9 coordinates each: a reference surface for
+// CollapseOptions::boundary_reference.
+std::vector<double> feature_surface_triangles(const Mesh& mesh, bool use_labels = true);
+
 // The boundary error bound in mesh units: max_boundary_error_abs when > 0, else
 // max_boundary_error x the bounding-box diagonal of `mesh` (0: no bound).
 double boundary_error_bound(const Mesh& mesh, const CollapseOptions& options);

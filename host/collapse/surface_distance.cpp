@@ -1,0 +1,216 @@
+// The boundary error bound measured (surface_distance.hpp).
+#include "collapse/surface_distance.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace tc::surface_distance {
+
+using geo::dot;
+
+// The closest point of a triangle (Ericson, Real-Time Collision Detection, 5.1.5).
+double point_triangle_dist2(tc_d3 p, const Tri& t) {
+  const tc_d3 a = t[0], b = t[1], c = t[2];
+  const tc_d3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  tc_d3 q;
+  if (d1 <= 0 && d2 <= 0) {
+    q = a;
+  } else {
+    const tc_d3 bp = p - b;
+    const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+    const double vc = d1 * d4 - d3 * d2;
+    if (d3 >= 0 && d4 <= d3) {
+      q = b;
+    } else if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+      q = a + ab * (d1 / (d1 - d3));
+    } else {
+      const tc_d3 cp = p - c;
+      const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+      const double vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
+      if (d6 >= 0 && d5 <= d6) {
+        q = c;
+      } else if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+        q = a + ac * (d2 / (d2 - d6));
+      } else if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+        q = b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+      } else {
+        const double den = 1 / (va + vb + vc);
+        q = a + ab * (vb * den) + ac * (vc * den);
+      }
+    }
+  }
+  const tc_d3 d = p - q;
+  return dot(d, d);
+}
+
+void box_of(const Tri& t, tc_d3& lo, tc_d3& hi) {
+  lo = hi = t[0];
+  for (int k = 1; k < 3; ++k) {
+    lo = {std::min(lo.x, t[k].x), std::min(lo.y, t[k].y), std::min(lo.z, t[k].z)};
+    hi = {std::max(hi.x, t[k].x), std::max(hi.y, t[k].y), std::max(hi.z, t[k].z)};
+  }
+}
+
+namespace {
+
+bool boxes_apart(tc_d3 alo, tc_d3 ahi, tc_d3 blo, tc_d3 bhi, double pad) {
+  return alo.x > bhi.x + pad || ahi.x < blo.x - pad || alo.y > bhi.y + pad || ahi.y < blo.y - pad ||
+         alo.z > bhi.z + pad || ahi.z < blo.z - pad;
+}
+
+}  // namespace
+
+bool within(const Tri& P, const std::vector<const Tri*>& feats, double e2, int depth,
+            const std::function<bool(const Tri&)>* relevant) {
+  if (relevant && !(*relevant)(P)) return true;
+  double upper = INFINITY, dmin[3] = {INFINITY, INFINITY, INFINITY};
+  size_t best = 0;
+  for (size_t j = 0; j < feats.size(); ++j) {
+    double m = 0;
+    for (int i = 0; i < 3; ++i) {
+      const double d = point_triangle_dist2(P[size_t(i)], *feats[j]);
+      m = std::max(m, d);
+      dmin[i] = std::min(dmin[i], d);
+    }
+    if (m < upper) {
+      upper = m;
+      best = j;
+    }
+    if (upper <= e2) return true;
+  }
+  if ((!relevant && std::max({dmin[0], dmin[1], dmin[2]}) > e2) || depth == 0) return false;
+  tc_d3 lo, hi;
+  box_of(P, lo, hi);
+  const double e = std::sqrt(e2);
+  // the features within reach of the piece, the one nearest to certifying it first (the
+  // likeliest to certify its parts)
+  std::vector<const Tri*> near;
+  near.reserve(feats.size());
+  if (!feats.empty()) near.push_back(feats[best]);
+  for (size_t j = 0; j < feats.size(); ++j) {
+    if (j == best) continue;
+    tc_d3 tl, th;
+    box_of(*feats[j], tl, th);
+    if (!boxes_apart(tl, th, lo, hi, e)) near.push_back(feats[j]);
+  }
+  const tc_d3 m01 = (P[0] + P[1]) * 0.5, m12 = (P[1] + P[2]) * 0.5, m20 = (P[2] + P[0]) * 0.5;
+  const Tri kids[4] = {{P[0], m01, m20}, {m01, P[1], m12}, {m20, m12, P[2]}, {m01, m12, m20}};
+  for (const Tri& k : kids)
+    if (!within(k, near, e2, depth - 1, relevant)) return false;
+  return true;
+}
+
+namespace {
+int64_t cell_key(int64_t i, int64_t j, int64_t k) { return (i * 2097152 + j) * 2097152 + k; }
+}  // namespace
+
+ReferenceSurface::ReferenceSurface(const std::vector<double>& triangles) {
+  tris_.resize(triangles.size() / 9);
+  double total = 0;
+  for (size_t i = 0; i < tris_.size(); ++i) {
+    for (size_t k = 0; k < 3; ++k)
+      tris_[i][k] = {triangles[9 * i + 3 * k], triangles[9 * i + 3 * k + 1], triangles[9 * i + 3 * k + 2]};
+    total += geo::length(tris_[i][1] - tris_[i][0]);
+  }
+  if (tris_.empty()) return;
+  cell_ = 2 * total / double(tris_.size());
+  if (!(cell_ > 0)) cell_ = 1;
+  origin_ = tris_[0][0];
+  seen_.assign(tris_.size(), 0);
+  const auto c = [&](double x, double o) { return int64_t(std::floor((x - o) / cell_)); };
+  for (int32_t i = 0; i < int32_t(tris_.size()); ++i) {
+    tc_d3 lo, hi;
+    box_of(tris_[size_t(i)], lo, hi);
+    for (int64_t a = c(lo.x, origin_.x); a <= c(hi.x, origin_.x); ++a)
+      for (int64_t b = c(lo.y, origin_.y); b <= c(hi.y, origin_.y); ++b)
+        for (int64_t d = c(lo.z, origin_.z); d <= c(hi.z, origin_.z); ++d) cells_[cell_key(a, b, d)].push_back(i);
+  }
+}
+
+void ReferenceSurface::query(tc_d3 lo, tc_d3 hi, std::vector<int32_t>& out) const {
+  out.clear();
+  if (tris_.empty()) return;
+  if (++stamp_ == 0) {
+    std::fill(seen_.begin(), seen_.end(), 0);
+    stamp_ = 1;
+  }
+  const auto c = [&](double x, double o) { return int64_t(std::floor((x - o) / cell_)); };
+  for (int64_t a = c(lo.x, origin_.x); a <= c(hi.x, origin_.x); ++a)
+    for (int64_t b = c(lo.y, origin_.y); b <= c(hi.y, origin_.y); ++b)
+      for (int64_t d = c(lo.z, origin_.z); d <= c(hi.z, origin_.z); ++d) {
+        const auto it = cells_.find(cell_key(a, b, d));
+        if (it == cells_.end()) continue;
+        for (int32_t i : it->second) {
+          if (seen_[size_t(i)] == stamp_) continue;
+          seen_[size_t(i)] = stamp_;
+          tc_d3 tl, th;
+          box_of(tris_[size_t(i)], tl, th);
+          if (!boxes_apart(tl, th, lo, hi, 0)) out.push_back(i);
+        }
+      }
+}
+
+bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector<Tri>& news,
+                                 const std::vector<Tri>& around, double e, double reach) const {
+  if (olds.empty() && news.empty()) return true;
+  // (a margin for the rounding of the distances, far below any bound asked for)
+  e *= 1 - 1e-9;
+  const double e2 = e * e;
+  std::vector<int32_t> ids;
+  std::vector<const Tri*> feats;
+  // every point of a new triangle within e of this surface (the triangles in its box grown
+  // by e are all that can be that near); first a quick look at a few points of each, which
+  // finds most refusals
+  std::vector<std::vector<const Tri*>> near(news.size());
+  for (size_t j = 0; j < news.size(); ++j) {
+    const Tri& t = news[j];
+    tc_d3 lo, hi;
+    box_of(t, lo, hi);
+    query(lo - tc_d3{e, e, e}, hi + tc_d3{e, e, e}, ids);
+    for (int32_t i : ids) near[j].push_back(&tris_[size_t(i)]);
+    const tc_d3 probes[4] = {t[0], (t[0] + t[1] + t[2]) * (1.0 / 3), (t[0] + t[1]) * 0.5, (t[0] + t[2]) * 0.5};
+    for (const tc_d3& q : probes) {
+      double d2 = INFINITY;
+      for (const Tri* f : near[j]) d2 = std::min(d2, point_triangle_dist2(q, *f));
+      if (d2 > e2) return false;
+    }
+  }
+  for (size_t j = 0; j < news.size(); ++j)
+    if (!within(news[j], near[j], e2, kDepth)) return false;
+  // every point of this surface within reach of an old triangle within e of the new S: the
+  // pieces farther from every old triangle keep the S point they were within reach of
+  tc_d3 lo, hi;
+  box_of(olds.empty() ? news[0] : olds[0], lo, hi);
+  for (const auto* set : {&olds, &news})
+    for (const Tri& t : *set) {
+      tc_d3 l, h;
+      box_of(t, l, h);
+      lo = {std::min(lo.x, l.x), std::min(lo.y, l.y), std::min(lo.z, l.z)};
+      hi = {std::max(hi.x, h.x), std::max(hi.y, h.y), std::max(hi.z, h.z)};
+    }
+  query(lo - tc_d3{reach, reach, reach}, hi + tc_d3{reach, reach, reach}, ids);
+  const std::function<bool(const Tri&)> relevant = [&](const Tri& p) {
+    const tc_d3 c = (p[0] + p[1] + p[2]) * (1.0 / 3);
+    double r = 0, d2 = INFINITY;
+    for (const tc_d3& v : p) r = std::max(r, geo::length(v - c));
+    for (const Tri& t : olds) d2 = std::min(d2, point_triangle_dist2(c, t));
+    return std::sqrt(d2) - r <= reach;
+  };
+  for (int32_t i : ids) {
+    const Tri& t = tris_[size_t(i)];
+    tc_d3 l, h;
+    box_of(t, l, h);
+    feats.clear();
+    for (const auto* set : {&news, &around})
+      for (const Tri& f : *set) {
+        tc_d3 fl, fh;
+        box_of(f, fl, fh);
+        if (!boxes_apart(fl, fh, l, h, e)) feats.push_back(&f);
+      }
+    if (!within(t, feats, e2, kDepth, &relevant)) return false;
+  }
+  return true;
+}
+
+}  // namespace tc::surface_distance

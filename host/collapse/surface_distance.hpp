@@ -1,0 +1,64 @@
+// The boundary error bound measured (CollapseOptions::boundary_reference): where the bound
+// carried per vertex refuses a change of S, the change is measured against the input's S
+// itself. A certified upper bound of a directed Hausdorff distance by branch and bound: the
+// distance to one triangle is convex, so over a piece of a triangle it is largest at the
+// piece's corners; the smallest such largest value over the triangles near the piece bounds the
+// distance to their union from above, the largest distance of a corner to them from below, and
+// a piece between the two is split in four. No library does this check (CGAL's
+// Polygon_mesh_processing::bounded_error_Hausdorff_distance answers for whole meshes, not for
+// one local change tested thousands of times), hence our own.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <unordered_map>
+#include <vector>
+
+#include "geometry.h"
+
+namespace tc::surface_distance {
+
+using geo::tc_d3;
+using Tri = std::array<tc_d3, 3>;
+
+double point_triangle_dist2(tc_d3 p, const Tri& t);
+void box_of(const Tri& t, tc_d3& lo, tc_d3& hi);
+
+// Whether every point of `piece` lies within sqrt(e2) of the union of `features` (certified:
+// false also when `depth` splits run out). With `relevant`, a piece it declines needs no check,
+// and the features need not be all the surface near the piece, so a corner beyond them is no
+// proof of a failure: the piece is split instead.
+bool within(const Tri& piece, const std::vector<const Tri*>& features, double e2, int depth,
+            const std::function<bool(const Tri&)>* relevant = nullptr);
+
+// The input's S (triangles, 9 coordinates each) in a uniform grid of cells of twice its mean
+// edge length.
+class ReferenceSurface {
+ public:
+  explicit ReferenceSurface(const std::vector<double>& triangles);
+  size_t size() const { return tris_.size(); }
+  const Tri& tri(int32_t i) const { return tris_[size_t(i)]; }
+  // The triangles whose boxes meet [lo, hi], into out.
+  void query(tc_d3 lo, tc_d3 hi, std::vector<int32_t>& out) const;
+
+  // Whether S, changed from `olds` to `news` (the S triangles around them, `around`, staying),
+  // stays within e of this surface both ways, when every point of this surface was within
+  // `reach` (>= e) of S before: every point of the new triangles within e of this surface, and
+  // every point of this surface within `reach` of the old triangles (the only points whose
+  // nearest S may be gone) within e of the new ones or those around. Conservative: false
+  // when it cannot tell.
+  bool change_ok(const std::vector<Tri>& olds, const std::vector<Tri>& news, const std::vector<Tri>& around, double e,
+                 double reach) const;
+
+ private:
+  static constexpr int kDepth = 8;  // splits of a piece: 4^8 pieces at most
+  std::vector<Tri> tris_;
+  std::unordered_map<int64_t, std::vector<int32_t>> cells_;
+  double cell_ = 1;
+  tc_d3 origin_{0, 0, 0};
+  mutable std::vector<uint32_t> seen_;
+  mutable uint32_t stamp_ = 0;
+};
+
+}  // namespace tc::surface_distance

@@ -1,0 +1,154 @@
+// The boundary error bound measured against the reference surface
+// (collapse/surface_distance.hpp, CollapseOptions::boundary_reference): the distance pieces on
+// shapes built for them, then whole runs, measured by the checker's two-sided distance.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "collapse/surface_distance.hpp"
+#include "test_support.hpp"
+#include "tetcollapse/check.hpp"
+#include "tetcollapse/coarsen.hpp"
+#include "tetcollapse/collapse.hpp"
+
+namespace tc {
+namespace {
+
+using geo::tc_d3;
+using surface_distance::Tri;
+
+TEST(SurfaceDistance, PointTriangleDistanceIsTheSmallestOverTheTriangle) {
+  std::mt19937 g(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int it = 0; it < 300; ++it) {
+    const Tri t{tc_d3{u(g), u(g), u(g)}, tc_d3{u(g), u(g), u(g)}, tc_d3{u(g), u(g), u(g)}};
+    const tc_d3 p{2 * u(g), 2 * u(g), 2 * u(g)};
+    const double d = surface_distance::point_triangle_dist2(p, t);
+    double sampled = INFINITY;
+    const int n = 200;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j) {
+        const tc_d3 q = t[0] + (t[1] - t[0]) * (double(i) / n) + (t[2] - t[0]) * (double(j) / n);
+        sampled = std::min(sampled, geo::dot(p - q, p - q));
+      }
+    EXPECT_LE(d, sampled + 1e-12) << it;
+    EXPECT_GE(std::sqrt(d), std::sqrt(sampled) - 0.02) << it << ": no smaller than a point of it";
+  }
+}
+
+// The unit square in z = 0 as two triangles, and a triangle over its diagonal at height h.
+std::vector<double> square() { return {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 0, 0, 1, 1, 0, 0, 1, 0}; }
+
+TEST(SurfaceDistance, ATriangleIsWithinWhatItsHeightSays) {
+  const surface_distance::ReferenceSurface ref(square());
+  std::vector<const Tri*> feats;
+  for (size_t i = 0; i < ref.size(); ++i) feats.push_back(&ref.tri(int32_t(i)));
+  const double e = 0.01;
+  for (double h : {0.0, 0.5 * e, 0.9 * e, 1.01 * e, 2 * e}) {
+    // across the square's diagonal: no single triangle of the square holds it, so it is split
+    // (near the diagonal into pieces small against e - h)
+    const Tri t{tc_d3{0.1, 0.2, h}, tc_d3{0.9, 0.3, h}, tc_d3{0.4, 0.8, h}};
+    EXPECT_EQ(surface_distance::within(t, feats, e * e, 8), h <= 0.9 * e) << h;
+  }
+  // beyond the square's edge by more than e: farther than e, whatever the height
+  const Tri out{tc_d3{0.5, 0.5, 0}, tc_d3{1.02, 0.5, 0}, tc_d3{0.5, 0.9, 0}};
+  EXPECT_FALSE(surface_distance::within(out, feats, e * e, 8));
+}
+
+// A tent of height h over the unit square's centre (four triangles) as the reference and as S;
+// the collapse of the apex onto a corner flattens it (two triangles).
+struct Tent {
+  std::vector<double> reference;
+  std::vector<Tri> olds, news;
+};
+Tent tent(double h) {
+  const tc_d3 c{0.5, 0.5, h}, p[4] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  Tent t;
+  for (int i = 0; i < 4; ++i) {
+    const Tri f{p[i], p[(i + 1) % 4], c};
+    t.olds.push_back(f);
+    for (const tc_d3& v : f) t.reference.insert(t.reference.end(), {v.x, v.y, v.z});
+  }
+  t.news = {Tri{p[0], p[1], p[2]}, Tri{p[0], p[2], p[3]}};
+  return t;
+}
+
+TEST(SurfaceDistance, FlatteningATentIsMadeOnlyWithinTheBound) {
+  const double e = 0.01;
+  for (double h : {0.5 * e, 0.9 * e, 1.2 * e, 3 * e}) {
+    const Tent t = tent(h);
+    const surface_distance::ReferenceSurface ref(t.reference);
+    EXPECT_EQ(ref.change_ok(t.olds, t.news, {}, e, e), h <= 0.9 * e) << h;
+  }
+}
+
+// Direction from the reference: a new S far from the old one fails through the reference
+// points the old S stood for, even when the new triangles lie on the reference (a tent's base
+// collapsed away from its apex: the base lies on nothing of a raised reference).
+TEST(SurfaceDistance, TheReferenceTheOldTrianglesStoodForMustStayNear) {
+  const double e = 0.01;
+  const Tent t = tent(0.5);  // a steep tent: the flat base is far from the apex
+  const surface_distance::ReferenceSurface ref(t.reference);
+  // the new triangles: the tent's own two faces through the apex, which cover only half of it
+  const std::vector<Tri> half = {t.olds[0], t.olds[1]};
+  EXPECT_FALSE(ref.change_ok(t.olds, half, {}, e, e)) << "the other half of the tent is left far";
+  EXPECT_TRUE(ref.change_ok(t.olds, half, {t.olds[2], t.olds[3]}, e, e)) << "unless it stays around";
+  EXPECT_TRUE(ref.change_ok(t.olds, t.olds, {}, e, e)) << "nothing changed";
+  // and from the new triangles: one reaching beyond the reference fails although every
+  // reference point keeps a new triangle over it
+  std::vector<Tri> wider = t.olds;
+  wider.push_back(Tri{tc_d3{1, 0, 0}, tc_d3{1.5, 0, 0}, tc_d3{1, 1, 0}});
+  EXPECT_FALSE(ref.change_ok(t.olds, wider, {}, e, e)) << "a new triangle off the reference";
+}
+
+double hausdorff_rel(const Mesh& out, const Mesh& in) {
+  CheckOptions co;
+  co.hausdorff = true;
+  const CheckReport r = check_mesh(out, co, &in);
+  EXPECT_TRUE(r.valid) << check_report_text(r);
+  EXPECT_FALSE(r.reference.topology_changed);
+  return r.reference.hausdorff_rel;
+}
+
+// Whole runs on curved shapes: measured where the carried bound refuses, the curved faces
+// coarsen further, and the checker's distance stays within the bound; both methods, and the
+// coarsening with its improvement phase and later cycles, which go on from the reference.
+TEST(SurfaceDistanceRun, MeasuredChangesCoarsenFurtherWithinTheBound) {
+  Context ctx;
+  const double e = 0.004;
+  for (const auto& [name, in] : {std::pair<std::string, Mesh>{"torus", test::torus(6, 24)},
+                                 {"filleted cylinder", test::filleted_cylinder(10, 0.3)}}) {
+    for (int how = 0; how < 3; ++how) {
+      const std::string what = name + (how == 0 ? ", sequential" : how == 1 ? ", parallel" : ", coarsen");
+      int64_t tets[2];
+      for (bool measure : {false, true}) {
+        CollapseOptions o;
+        o.target_factor = 2;
+        o.max_boundary_error = e;
+        o.tuning.remeasure_boundary_error = measure;
+        Mesh m = in;
+        if (how == 0) {
+          o.method = CollapseOptions::Sequential;
+          const CollapseReport r = collapse_sequential(m, o);
+          EXPECT_EQ(r.boundary_reference != nullptr, measure) << what;
+        } else if (how == 1) {
+          const CollapseReport r = collapse(m, o, ctx);
+          EXPECT_EQ(r.boundary_reference != nullptr, measure) << what;
+        } else {
+          CoarsenOptions co;
+          co.collapse = o;
+          const CoarsenReport r = coarsen(m, co, &ctx);
+          EXPECT_TRUE(r.improved) << what;
+          EXPECT_FALSE(r.later_cycles.empty()) << what;
+        }
+        EXPECT_LE(hausdorff_rel(m, in), e) << what << (measure ? ", measured" : ", carried");
+        tets[measure] = m.num_tets();
+      }
+      EXPECT_LT(tets[1], tets[0]) << what << ": the measured bound lets more of S coarsen";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace tc
