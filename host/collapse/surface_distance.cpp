@@ -63,36 +63,38 @@ bool boxes_apart(tc_d3 alo, tc_d3 ahi, tc_d3 blo, tc_d3 bhi, double pad) {
 
 bool within(const Tri& P, const std::vector<const Tri*>& feats, double e2, int depth,
             const std::function<bool(const Tri&)>* relevant) {
-  if (relevant && !(*relevant)(P)) return true;
+  // The features nearest the piece first: the one that certifies it is then found at once.
+  const tc_d3 c = (P[0] + P[1] + P[2]) * (1.0 / 3);
+  std::vector<std::pair<double, const Tri*>> order;
+  order.reserve(feats.size());
+  for (const Tri* t : feats) {
+    const tc_d3 d = c - ((*t)[0] + (*t)[1] + (*t)[2]) * (1.0 / 3);
+    order.push_back({dot(d, d), t});
+  }
+  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   double upper = INFINITY, dmin[3] = {INFINITY, INFINITY, INFINITY};
-  size_t best = 0;
-  for (size_t j = 0; j < feats.size(); ++j) {
+  for (const auto& [key, t] : order) {
     double m = 0;
     for (int i = 0; i < 3; ++i) {
-      const double d = point_triangle_dist2(P[size_t(i)], *feats[j]);
+      const double d = point_triangle_dist2(P[size_t(i)], *t);
       m = std::max(m, d);
       dmin[i] = std::min(dmin[i], d);
     }
-    if (m < upper) {
-      upper = m;
-      best = j;
-    }
+    upper = std::min(upper, m);
     if (upper <= e2) return true;
   }
+  // (whether the piece matters at all only now: most pieces are certified before)
+  if (relevant && !(*relevant)(P)) return true;
   if ((!relevant && std::max({dmin[0], dmin[1], dmin[2]}) > e2) || depth == 0) return false;
   tc_d3 lo, hi;
   box_of(P, lo, hi);
   const double e = std::sqrt(e2);
-  // the features within reach of the piece, the one nearest to certifying it first (the
-  // likeliest to certify its parts)
-  std::vector<const Tri*> near;
-  near.reserve(feats.size());
-  if (!feats.empty()) near.push_back(feats[best]);
-  for (size_t j = 0; j < feats.size(); ++j) {
-    if (j == best) continue;
+  std::vector<const Tri*> near;  // the features within reach of the piece, nearest first
+  near.reserve(order.size());
+  for (const auto& [key, t] : order) {
     tc_d3 tl, th;
-    box_of(*feats[j], tl, th);
-    if (!boxes_apart(tl, th, lo, hi, e)) near.push_back(feats[j]);
+    box_of(*t, tl, th);
+    if (!boxes_apart(tl, th, lo, hi, e)) near.push_back(t);
   }
   const tc_d3 m01 = (P[0] + P[1]) * 0.5, m12 = (P[1] + P[2]) * 0.5, m20 = (P[2] + P[0]) * 0.5;
   const Tri kids[4] = {{P[0], m01, m20}, {m01, P[1], m12}, {m20, m12, P[2]}, {m01, m12, m20}};
