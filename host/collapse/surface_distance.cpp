@@ -8,8 +8,28 @@ namespace tc::surface_distance {
 
 using geo::dot;
 
-// The closest point of a triangle (Ericson, Real-Time Collision Detection, 5.1.5).
+namespace {
+
+double point_segment_dist2(tc_d3 p, tc_d3 a, tc_d3 b) {
+  const tc_d3 ab = b - a;
+  const double l2 = dot(ab, ab);
+  const double s = l2 > 0 ? std::clamp(dot(p - a, ab) / l2, 0.0, 1.0) : 0.0;
+  const tc_d3 d = p - (a + ab * s);
+  return dot(d, d);
+}
+
+}  // namespace
+
+// The closest point of a triangle (Ericson, Real-Time Collision Detection, 5.1.5); a triangle of
+// no area (its divisions 0 / 0) is the union of its edges.
 double point_triangle_dist2(tc_d3 p, const Tri& t) {
+  const double d = point_triangle_dist2_ericson(p, t);
+  if (std::isfinite(d)) return d;
+  return std::min({point_segment_dist2(p, t[0], t[1]), point_segment_dist2(p, t[1], t[2]),
+                   point_segment_dist2(p, t[2], t[0])});
+}
+
+double point_triangle_dist2_ericson(tc_d3 p, const Tri& t) {
   const tc_d3 a = t[0], b = t[1], c = t[2];
   const tc_d3 ab = b - a, ac = c - a, ap = p - a;
   const double d1 = dot(ab, ap), d2 = dot(ac, ap);
@@ -23,7 +43,7 @@ double point_triangle_dist2(tc_d3 p, const Tri& t) {
     if (d3 >= 0 && d4 <= d3) {
       q = b;
     } else if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-      q = a + ab * (d1 / (d1 - d3));
+      q = a + ab * std::clamp(d1 / (d1 - d3), 0.0, 1.0);
     } else {
       const tc_d3 cp = p - c;
       const double d5 = dot(ab, cp), d6 = dot(ac, cp);
@@ -31,12 +51,19 @@ double point_triangle_dist2(tc_d3 p, const Tri& t) {
       if (d6 >= 0 && d5 <= d6) {
         q = c;
       } else if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-        q = a + ac * (d2 / (d2 - d6));
+        q = a + ac * std::clamp(d2 / (d2 - d6), 0.0, 1.0);
       } else if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-        q = b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+        q = b + (c - b) * std::clamp((d4 - d3) / ((d4 - d3) + (d5 - d6)), 0.0, 1.0);
       } else {
+        // (clamped into the triangle: a point of it, so never nearer than the triangle is)
         const double den = 1 / (va + vb + vc);
-        q = a + ab * (vb * den) + ac * (vc * den);
+        double v = std::max(0.0, vb * den), w = std::max(0.0, vc * den);
+        if (v + w > 1) {
+          const double sum = v + w;
+          v /= sum;
+          w /= sum;
+        }
+        q = a + ab * v + ac * w;
       }
     }
   }

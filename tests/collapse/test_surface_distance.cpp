@@ -37,6 +37,17 @@ TEST(SurfaceDistance, PointTriangleDistanceIsTheSmallestOverTheTriangle) {
   }
 }
 
+// A triangle of no area (a repeated corner, or three points on a line) is its edges.
+TEST(SurfaceDistance, ATriangleOfNoAreaIsItsEdges) {
+  const tc_d3 p{0.5, 1, 0};
+  for (const Tri& t : {Tri{tc_d3{0, 0, 0}, tc_d3{0, 0, 0}, tc_d3{1, 0, 0}},
+                       Tri{tc_d3{0, 0, 0}, tc_d3{0.5, 0, 0}, tc_d3{1, 0, 0}}, Tri{tc_d3{1, 0, 0}, tc_d3{1, 0, 0}, tc_d3{1, 0, 0}}}) {
+    const double d = surface_distance::point_triangle_dist2(p, t);
+    const double expected = t[0].x == 1 ? 0.25 + 1 : 1;
+    EXPECT_DOUBLE_EQ(d, expected);
+  }
+}
+
 // The unit square in z = 0 as two triangles, and a triangle over its diagonal at height h.
 std::vector<double> square() { return {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 0, 0, 1, 1, 0, 0, 1, 0}; }
 
