@@ -3,6 +3,7 @@
 // shapes built for them, then whole runs, measured by the checker's two-sided distance.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -11,6 +12,7 @@
 #include "tetcollapse/check.hpp"
 #include "tetcollapse/coarsen.hpp"
 #include "tetcollapse/collapse.hpp"
+#include "tetcollapse/topology.hpp"
 
 namespace tc {
 namespace {
@@ -111,6 +113,36 @@ TEST(SurfaceDistance, TheReferenceTheOldTrianglesStoodForMustStayNear) {
   std::vector<Tri> wider = t.olds;
   wider.push_back(Tri{tc_d3{1, 0, 0}, tc_d3{1.5, 0, 0}, tc_d3{1, 1, 0}});
   EXPECT_FALSE(ref.change_ok(t.olds, wider, {}, e, e)) << "a new triangle off the reference";
+}
+
+// The reference surface of a mesh (tc::feature_surface_triangles) is its S as the topology
+// lists it: the boundary, and the interface between labels unless they are ignored.
+TEST(SurfaceDistance, TheFeatureSurfaceIsTheTopologysS) {
+  for (const auto& [name, m] : {std::pair<std::string, Mesh>{"ball", test::ball(4)}, {"two materials", test::two_materials(4)}})
+    for (bool labels : {true, false}) {
+      TopologyOptions to;
+      to.use_labels = labels;
+      const Topology topo = build_topology(m, to);
+      std::vector<std::array<double, 9>> expected, got;
+      const auto key = [](const double* p) {  // a triangle by its sorted corners
+        std::array<std::array<double, 3>, 3> c{{{p[0], p[1], p[2]}, {p[3], p[4], p[5]}, {p[6], p[7], p[8]}}};
+        std::sort(c.begin(), c.end());
+        return std::array<double, 9>{c[0][0], c[0][1], c[0][2], c[1][0], c[1][1], c[1][2], c[2][0], c[2][1], c[2][2]};
+      };
+      for (size_t f = 0; f < topo.sfaces.size(); f += 3) {
+        double p[9];
+        for (int k = 0; k < 3; ++k)
+          for (int d = 0; d < 3; ++d) p[3 * k + d] = m.points[3 * size_t(topo.sfaces[f + size_t(k)]) + size_t(d)];
+        expected.push_back(key(p));
+      }
+      const std::vector<double> tris = feature_surface_triangles(m, labels);
+      ASSERT_EQ(tris.size() % 9, 0u);
+      for (size_t i = 0; i < tris.size(); i += 9) got.push_back(key(&tris[i]));
+      std::sort(expected.begin(), expected.end());
+      std::sort(got.begin(), got.end());
+      EXPECT_EQ(got, expected) << name << (labels ? "" : ", labels ignored");
+      EXPECT_FALSE(got.empty()) << name;
+    }
 }
 
 double hausdorff_rel(const Mesh& out, const Mesh& in) {
