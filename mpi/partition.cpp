@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "topology/faces_at_vertices.hpp"
+
 namespace tc::mpi {
 
 namespace {
@@ -17,70 +19,23 @@ struct DualGraph {
   std::vector<idx_t> xadj, adjncy, adjwgt;
 };
 
-// Tets around each vertex (CSR), to find the tet across each face without a table of all faces
-// (16 bytes per face to sort, 33 MB on W1).
-struct Incidence {
-  std::vector<int64_t> offset;
-  std::vector<int32_t> tets;
-};
-
-Incidence incidence(const Mesh& mesh) {
-  const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
-  Incidence inc;
-  inc.offset.assign(size_t(nv + 1), 0);
-  for (int32_t v : mesh.tets) ++inc.offset[size_t(v) + 1];
-  for (int64_t v = 0; v < nv; ++v) inc.offset[size_t(v + 1)] += inc.offset[size_t(v)];
-  inc.tets.resize(mesh.tets.size());
-  std::vector<int64_t> fill(inc.offset.begin(), inc.offset.end() - 1);
-  for (int64_t t = 0; t < nt; ++t)
-    for (int k = 0; k < 4; ++k) inc.tets[size_t(fill[size_t(mesh.tets[size_t(4 * t + k)])]++)] = int32_t(t);
-  return inc;
-}
-
-// Each face is matched among the tets around its smallest vertex: every tet is read once per
-// vertex (on W1's randomly numbered input, looking each face up around one of its vertices read
-// 20 times as many tets, out of cache: 0.9 s).
 // The graph METIS cuts: with `cluster` empty, the dual graph; else its contraction, one node per
 // cluster (cluster[t] of tet t, `nodes` of them), weighted by its tets, and one edge per pair of
 // clusters sharing faces, weighted by the faces' weights.
 DualGraph dual_graph(const Mesh& mesh, const std::vector<uint8_t>& avoid, int avoid_weight,
                      const std::vector<int32_t>& cluster, int64_t nodes) {
-  const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
-  const Incidence inc = incidence(mesh);
-  struct Side {
-    int32_t a, b, tet;  // the face's two other vertices (a < b), and a tet that has it
-    bool operator<(const Side& o) const { return a < o.a || (a == o.a && (b < o.b || (b == o.b && tet < o.tet))); }
-  };
-  std::vector<Side> sides;
+  const int64_t nt = mesh.num_tets();
   std::vector<std::array<int32_t, 3>> pairs;  // tet, tet, weight
-  for (int64_t v = 0; v < nv; ++v) {
-    sides.clear();
-    for (int64_t i = inc.offset[size_t(v)]; i < inc.offset[size_t(v) + 1]; ++i) {
-      const int32_t t = inc.tets[size_t(i)];
-      const int32_t* q = &mesh.tets[size_t(4 * t)];
-      // the other three vertices; the faces through v are v and two of them
-      int32_t o[3], n = 0;
-      for (int k = 0; k < 4; ++k)
-        if (q[k] != v) o[n++] = q[k];
-      for (int k = 0; k < 3; ++k) {
-        const int32_t x = o[k], y = o[(k + 1) % 3];
-        if (x > v && y > v) sides.push_back({std::min(x, y), std::max(x, y), t});
-      }
+  topology_detail::each_face_at_smallest_vertex(mesh, [&](int32_t v, const topology_detail::FaceSide* s, size_t n) {
+    if (n < 2) return;  // (a face in more than two tets, a defective input, links its first two only)
+    const bool near = !avoid.empty() && (avoid[size_t(v)] || avoid[size_t(s[0].a)] || avoid[size_t(s[0].b)]);
+    if (cluster.empty()) {
+      pairs.push_back({s[0].tet, s[1].tet, near ? avoid_weight : 1});
+    } else {
+      const int32_t c0 = cluster[size_t(s[0].tet)], c1 = cluster[size_t(s[1].tet)];
+      if (c0 != c1) pairs.push_back({std::min(c0, c1), std::max(c0, c1), near ? avoid_weight : 1});
     }
-    std::sort(sides.begin(), sides.end());
-    for (size_t i = 0; i + 1 < sides.size(); ++i) {
-      if (sides[i].a != sides[i + 1].a || sides[i].b != sides[i + 1].b) continue;
-      const bool near = !avoid.empty() && (avoid[size_t(v)] || avoid[size_t(sides[i].a)] || avoid[size_t(sides[i].b)]);
-      if (cluster.empty()) {
-        pairs.push_back({sides[i].tet, sides[i + 1].tet, near ? avoid_weight : 1});
-      } else {
-        const int32_t c0 = cluster[size_t(sides[i].tet)], c1 = cluster[size_t(sides[i + 1].tet)];
-        if (c0 != c1) pairs.push_back({std::min(c0, c1), std::max(c0, c1), near ? avoid_weight : 1});
-      }
-      // a face in more than two tets (a defective input) links its first two only
-      while (i + 1 < sides.size() && sides[i + 1].a == sides[i].a && sides[i + 1].b == sides[i].b) ++i;
-    }
-  }
+  });
   const int64_t n = cluster.empty() ? nt : nodes;
   if (!cluster.empty()) {  // one edge per pair of clusters, the faces' weights summed
     std::sort(pairs.begin(), pairs.end());

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "tetcollapse/error.hpp"
+#include "topology/faces_at_vertices.hpp"
 
 namespace tc::collapse_detail {
 
@@ -109,52 +110,16 @@ void check_options(const CollapseOptions& o, const Context& ctx) {
 namespace tc {
 
 std::vector<double> feature_surface_triangles(const Mesh& mesh, bool use_labels) {
-  // Each face found once, among the tets around its smallest vertex (a vertex -> tets list, not
-  // a table of every face: on a large mesh the whole topology or a sorted face table holds
-  // tens of bytes per tet more, which the MPI tool's rank 0 pays on top of the input).
-  const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
   const std::vector<int32_t>* labels =
       use_labels && !mesh.tet_labels.empty() ? &mesh.tet_labels[0].values : nullptr;
-  std::vector<int64_t> off(size_t(nv + 1), 0);
-  for (int32_t v : mesh.tets) ++off[size_t(v) + 1];
-  for (int64_t v = 0; v < nv; ++v) off[size_t(v + 1)] += off[size_t(v)];
-  std::vector<int32_t> around(mesh.tets.size());
-  {
-    std::vector<int64_t> fill(off.begin(), off.end() - 1);
-    for (int64_t t = 0; t < nt; ++t)
-      for (int k = 0; k < 4; ++k) around[size_t(fill[size_t(mesh.tets[size_t(4 * t + k)])]++)] = int32_t(t);
-  }
-  struct Side {
-    int32_t a, b, tet;  // the face's other two vertices (a < b) and a tet that has it
-  };
-  std::vector<Side> sides;
   std::vector<double> out;
   const auto point = [&](int32_t v) { return &mesh.points[3 * size_t(v)]; };
-  for (int32_t v = 0; v < int32_t(nv); ++v) {
-    sides.clear();
-    for (int64_t i = off[size_t(v)]; i < off[size_t(v) + 1]; ++i) {
-      const int32_t t = around[size_t(i)];
-      const int32_t* q = &mesh.tets[size_t(4 * t)];
-      int32_t o[3], n = 0;
-      for (int k = 0; k < 4; ++k)
-        if (q[k] != v) o[n++] = q[k];
-      for (int k = 0; k < 3; ++k) {
-        const int32_t x = o[k], y = o[(k + 1) % 3];
-        if (x > v && y > v) sides.push_back({std::min(x, y), std::max(x, y), t});
-      }
-    }
-    std::sort(sides.begin(), sides.end(),
-              [](const Side& p, const Side& q) { return p.a < q.a || (p.a == q.a && p.b < q.b); });
-    for (size_t i = 0, j; i < sides.size(); i = j) {
-      for (j = i + 1; j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b; ++j) {
-      }
-      // one tet: the boundary; two of different labels: an interface; more (a defective input):
-      // the boundary for each, as the collapse reads it
-      const bool on_s = j - i != 2 || (labels && (*labels)[size_t(sides[i].tet)] != (*labels)[size_t(sides[i + 1].tet)]);
-      if (!on_s) continue;
-      for (int32_t w : {v, sides[i].a, sides[i].b}) out.insert(out.end(), point(w), point(w) + 3);
-    }
-  }
+  topology_detail::each_face_at_smallest_vertex(mesh, [&](int32_t v, const topology_detail::FaceSide* s, size_t n) {
+    // one tet: the boundary; two of different labels: an interface; more (a defective input):
+    // the boundary for each, as the collapse reads it
+    if (n == 2 && !(labels && (*labels)[size_t(s[0].tet)] != (*labels)[size_t(s[1].tet)])) return;
+    for (int32_t w : {v, s[0].a, s[0].b}) out.insert(out.end(), point(w), point(w) + 3);
+  });
   return out;
 }
 
