@@ -13,43 +13,38 @@ namespace tc::sequential_detail {
 
 using geo::tc_d3;
 
-double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base) {
-  *base = 0;
+SeqMesh::CollapseEnds SeqMesh::collapse_ends(int32_t a, int32_t b, uint8_t dir) const {
   if (a > b) std::swap(a, b);
   const bool remove_b = (dir & TCC_DIR_REMOVE_V1) != 0;
   const int32_t x = remove_b ? b : a, y = remove_b ? a : b;
   const tc_d3 p = placement(a, b, dir), py = point(y);
-  const bool moves_y = !(py.x == p.x && py.y == p.y && py.z == p.z);
+  return {x, y, p, !(py.x == p.x && py.y == p.y && py.z == p.z)};
+}
+
+double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base) {
+  *base = 0;
+  const auto [x, y, p, moves_y] = collapse_ends(a, b, dir);
   if (!vflags_[x] && !(moves_y && vflags_[y])) return 0;  // S is not touched
   tc_d3 olds[3 * TCC_MAX_FAN], news[3 * TCC_MAX_FAN];
   int oid[3 * TCC_MAX_FAN], nid[3 * TCC_MAX_FAN];
   int no = 0, nn = 0;
   const int32_t pid = moves_y ? -1 : y;  // the survivor's name in the new fan
-  // the owned S faces through x, those of the tets the collapse removes, and through y when it
-  // moves (each once: a tet through x is seen from ring(x))
-  for (int side = 0; side < (moves_y ? 2 : 1); ++side) {
-    const int32_t z = side == 0 ? x : y;
-    const int32_t* rz = ring(z);
-    for (uint32_t i = 0; i < rlen_[z]; ++i) {
-      const int32_t t = rz[i];
-      const int32_t* q = tet(t);
-      if (side == 1 && has(q, x)) continue;
-      const bool removed = side == 0 && has(q, y);
-      for (int f = 0; f < 4; ++f) {
-        if ((q[f] == z && !removed) || !owned_sface(t, f)) continue;
-        if (no == TCC_MAX_FAN) return INFINITY;
-        for (int k = 0; k < 3; ++k) {
-          const int32_t v = q[geo::TC_TET_FACES[f][k]];
-          olds[3 * no + k] = point(v);
-          oid[3 * no + k] = v;
-          *base = std::max(*base, eps[size_t(v)]);
-        }
-        ++no;
-      }
-    }
-  }
-  // the new S faces (as guard_ok finds them), on the owner's side
   bool fits = true;
+  each_old_sface(x, y, moves_y, [&](int32_t, const int32_t* q, int f) {
+    if (no == TCC_MAX_FAN) {
+      fits = false;
+      return;
+    }
+    for (int k = 0; k < 3; ++k) {
+      const int32_t v = q[geo::TC_TET_FACES[f][k]];
+      olds[3 * no + k] = point(v);
+      oid[3 * no + k] = v;
+      *base = std::max(*base, eps[size_t(v)]);
+    }
+    ++no;
+  });
+  if (!fits) return INFINITY;
+  // the new S faces (as guard_ok finds them), on the owner's side
   each_new_sface(x, y, moves_y, [&](int32_t t, const int32_t* q, int f, int32_t other) {
     if (!(other < 0 || (labels_ && label(t) < label(other)))) return;
     if (nn == TCC_MAX_FAN) {

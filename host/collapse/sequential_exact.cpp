@@ -30,29 +30,13 @@ void SeqMesh::collapse_fans(int32_t a, int32_t b, uint8_t dir, std::vector<Tri>&
   news.clear();
   around.clear();
   corners.clear();
-  if (a > b) std::swap(a, b);
-  const bool remove_b = (dir & TCC_DIR_REMOVE_V1) != 0;
-  const int32_t x = remove_b ? b : a, y = remove_b ? a : b;
-  const tc_d3 p = placement(a, b, dir), py = point(y);
-  const bool moves_y = !(py.x == p.x && py.y == p.y && py.z == p.z);
+  const auto [x, y, p, moves_y] = collapse_ends(a, b, dir);
   const auto tri = [&](const int32_t* q, int f) {
     return Tri{point(q[geo::TC_TET_FACES[f][0]]), point(q[geo::TC_TET_FACES[f][1]]), point(q[geo::TC_TET_FACES[f][2]])};
   };
-  // as surface_change gathers them: the S faces through x, those of the tets the collapse
-  // removes, and through y when it moves
-  for (int side = 0; side < (moves_y ? 2 : 1); ++side) {
-    const int32_t z = side == 0 ? x : y;
-    const int32_t* rz = ring(z);
-    for (uint32_t i = 0; i < rlen_[z]; ++i) {
-      const int32_t* q = tet(rz[i]);
-      if (side == 1 && has(q, x)) continue;
-      const bool removed = side == 0 && has(q, y);
-      for (int f = 0; f < 4; ++f)
-        if (!((q[f] == z && !removed) || !owned_sface(rz[i], f))) olds.push_back(tri(q, f));
-    }
-  }
+  each_old_sface(x, y, moves_y, [&](int32_t, const int32_t* q, int f) { olds.push_back(tri(q, f)); });
   each_new_sface(x, y, moves_y, [&](int32_t t, const int32_t* q, int f, int32_t other) {
-    if (!(other < 0 || (labels_ && label(t) != label(other)))) return;
+    if (!(other < 0 || (labels_ && label(t) < label(other)))) return;  // (on the owner's side)
     Tri n;
     for (int k = 0; k < 3; ++k) {
       const int32_t v = q[geo::TC_TET_FACES[f][k]];

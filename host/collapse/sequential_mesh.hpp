@@ -219,6 +219,31 @@ class SeqMesh {
     }
   }
   int32_t label(int32_t t) const { return labels_ ? (*labels_)[t] : 0; }
+  // The collapse of (a, b) in direction dir: x goes, y survives at p (moves_y: p is not y's place).
+  struct CollapseEnds {
+    int32_t x, y;
+    geo::tc_d3 p;
+    bool moves_y;
+  };
+  CollapseEnds collapse_ends(int32_t a, int32_t b, uint8_t dir) const;
+  // fn(t, q, f) for every S face a tet t = q owns that the collapse of x onto y replaces: those
+  // through x, those of the tets it removes, and through y when it moves (each once: a tet
+  // through x is seen from ring(x)).
+  template <class Fn>
+  void each_old_sface(int32_t x, int32_t y, bool moves_y, Fn&& fn) const {
+    for (int side = 0; side < (moves_y ? 2 : 1); ++side) {
+      const int32_t z = side == 0 ? x : y;
+      const int32_t* rz = ring(z);
+      for (uint32_t i = 0; i < rlen_[z]; ++i) {
+        const int32_t t = rz[i];
+        const int32_t* q = tet(t);
+        if (side == 1 && has(q, x)) continue;
+        const bool removed = side == 0 && has(q, y);
+        for (int f = 0; f < 4; ++f)
+          if (!(q[f] == z && !removed) && owned_sface(t, f)) fn(t, q, f);
+      }
+    }
+  }
   // fn(t, q, f, other) for every face f of a tet t = q that the collapse of x onto y keeps
   // (through x, and through y when it moves) and that is on S after it, or may be:
   // tcc_sg_new_tri's choice before its label test. other: the tet across the face after the
