@@ -315,9 +315,10 @@ bool SequentialRun::step() {
     bool measured = false;
     if (bound_ > 0) {
       // the carried bound, else the change measured against the reference
-      measured = !(base + change <= bound_) && reference_ && sm_.keeps_shape(e.a, e.b, dir, kMeasuredMinQuality) &&
+      const bool carried = base + change <= bound_;
+      measured = !carried && reference_ && sm_.keeps_shape(e.a, e.b, dir, kMeasuredMinQuality) &&
                  measured_ok(e.a, e.b, dir);
-      if (!(base + change <= bound_) && !measured) {
+      if (!carried && !measured) {
         ++s.refused_by_bound;
         continue;  // (the verdict depends on the star alone: no retest unless it changes)
       }

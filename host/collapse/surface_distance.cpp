@@ -18,17 +18,8 @@ double point_segment_dist2(tc_d3 p, tc_d3 a, tc_d3 b) {
   return dot(d, d);
 }
 
-}  // namespace
-
-// The closest point of a triangle (Ericson, Real-Time Collision Detection, 5.1.5); a triangle of
-// no area (its divisions 0 / 0) is the union of its edges.
-double point_triangle_dist2(tc_d3 p, const Tri& t) {
-  const double d = point_triangle_dist2_ericson(p, t);
-  if (std::isfinite(d)) return d;
-  return std::min({point_segment_dist2(p, t[0], t[1]), point_segment_dist2(p, t[1], t[2]),
-                   point_segment_dist2(p, t[2], t[0])});
-}
-
+// The closest point of a triangle (Ericson, Real-Time Collision Detection, 5.1.5); NaN for a
+// triangle of no area (its divisions 0 / 0).
 double point_triangle_dist2_ericson(tc_d3 p, const Tri& t) {
   const tc_d3 a = t[0], b = t[1], c = t[2];
   const tc_d3 ab = b - a, ac = c - a, ap = p - a;
@@ -69,6 +60,16 @@ double point_triangle_dist2_ericson(tc_d3 p, const Tri& t) {
   }
   const tc_d3 d = p - q;
   return dot(d, d);
+}
+
+}  // namespace
+
+// A triangle of no area is the union of its edges.
+double point_triangle_dist2(tc_d3 p, const Tri& t) {
+  const double d = point_triangle_dist2_ericson(p, t);
+  if (std::isfinite(d)) return d;
+  return std::min({point_segment_dist2(p, t[0], t[1]), point_segment_dist2(p, t[1], t[2]),
+                   point_segment_dist2(p, t[2], t[0])});
 }
 
 void box_of(const Tri& t, tc_d3& lo, tc_d3& hi) {

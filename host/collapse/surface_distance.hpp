@@ -23,7 +23,6 @@ using geo::tc_d3;
 using Tri = std::array<tc_d3, 3>;
 
 double point_triangle_dist2(tc_d3 p, const Tri& t);
-double point_triangle_dist2_ericson(tc_d3 p, const Tri& t);  // (NaN for a triangle of no area)
 void box_of(const Tri& t, tc_d3& lo, tc_d3& hi);
 
 // Whether every point of `piece` lies within sqrt(e2) of the union of `features` (certified:
