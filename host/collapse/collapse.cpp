@@ -77,9 +77,9 @@ CollapseReport collapse_bounded(Mesh& mesh, const CollapseOptions& options, Cont
   const auto drop_added = [&] { mesh.vertex_fields.resize(mesh.vertex_fields.size() - added); };
   // the reference surface: the one given, else the input's own S on a first run
   std::shared_ptr<const std::vector<double>> reference = options.boundary_reference;
-  const bool remeasure = options.tuning.remeasure_boundary_error && !options.has_user_functions() &&
-                         options.tuning.host_tail != 0 &&
-                         (reference || first_bounded_run(options));
+  // (on the host, in the tail: not with user functions, nor with the tail off)
+  const bool remeasure =
+      measures_boundary_error(options) && !options.has_user_functions() && options.tuning.host_tail != 0;
   CollapseReport report;
   try {
     report = collapse_on_device(mesh, o, ctx, remeasure ? &reference : nullptr);

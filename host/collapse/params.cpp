@@ -26,8 +26,10 @@ void check_boundary_error_options(const CollapseOptions& o) {
     throw std::invalid_argument("vertex_boundary_error needs a boundary error bound (max_boundary_error)");
 }
 
-bool first_bounded_run(const CollapseOptions& o) {
-  return std::all_of(o.vertex_boundary_error.begin(), o.vertex_boundary_error.end(), [](double e) { return e == 0; });
+bool measures_boundary_error(const CollapseOptions& o) {
+  return o.tuning.remeasure_boundary_error &&
+         (o.boundary_reference ||
+          std::all_of(o.vertex_boundary_error.begin(), o.vertex_boundary_error.end(), [](double e) { return e == 0; }));
 }
 
 std::vector<double> initial_boundary_error(const Mesh& mesh, const CollapseOptions& o) {

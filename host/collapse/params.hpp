@@ -85,9 +85,10 @@ void check_bound_mode(bool bounded, CollapseOptions::Boundary mode, const char* 
 // The bound per vertex at the start of a run: CollapseOptions::vertex_boundary_error, checked
 // against the mesh (std::invalid_argument), or zeros.
 std::vector<double> initial_boundary_error(const Mesh& mesh, const CollapseOptions& o);
-// No bound spent before the run (vertex_boundary_error empty or zeros): the mesh's own S is the
-// reference surface of the bound when none is given (CollapseOptions::boundary_reference).
-bool first_bounded_run(const CollapseOptions& o);
+// Whether a run under a bound measures the changes of S the carried bound refuses: asked to
+// (CollapseTuning::remeasure_boundary_error) and with a reference surface, the one given or, when
+// no bound was spent before the run (vertex_boundary_error empty or zeros), the mesh's own S.
+bool measures_boundary_error(const CollapseOptions& o);
 StageParams params_from(const CollapseOptions& o);
 // The options the parallel method refuses (std::invalid_argument), or this device cannot run
 // (tc::DeviceError).

@@ -80,8 +80,7 @@ SequentialRun::SequentialRun(Mesh& mesh, const CollapseOptions& options, const T
   mask_ = options.vertex_mask;
   bound_ = boundary_error_bound(mesh, options);
   if (bound_ > 0) eps_ = collapse_detail::initial_boundary_error(mesh, options);
-  if (bound_ > 0 && options.tuning.remeasure_boundary_error &&
-      (options.boundary_reference || collapse_detail::first_bounded_run(options))) {
+  if (bound_ > 0 && collapse_detail::measures_boundary_error(options)) {
     reference_triangles_ = options.boundary_reference;
     if (!reference_triangles_) {
       auto own = std::make_shared<std::vector<double>>();
