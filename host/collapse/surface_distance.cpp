@@ -89,46 +89,110 @@ bool boxes_apart(tc_d3 alo, tc_d3 ahi, tc_d3 blo, tc_d3 bhi, double pad) {
 
 }  // namespace
 
+namespace {
+
+// The branch and bound of within(), each point's distance to each feature computed once: a
+// piece shares its corners with its parent and its siblings, and a feature that fails at one
+// corner needs no other.
+class Pieces {
+ public:
+  void reset(const std::vector<const Tri*>& feats, double e2, const std::function<bool(const Tri&)>* relevant) {
+    feats_ = &feats;
+    e2_ = e2;
+    e_ = std::sqrt(e2);
+    relevant_ = relevant;
+    centroids_.resize(feats.size());
+    lo_.resize(feats.size());
+    hi_.resize(feats.size());
+    for (size_t f = 0; f < feats.size(); ++f) {
+      const Tri& t = *feats[f];
+      centroids_[f] = (t[0] + t[1] + t[2]) * (1.0 / 3);
+      box_of(t, lo_[f], hi_[f]);
+    }
+  }
+
+  bool within(const Tri& P, int depth) {
+    pts_.clear();
+    dist_.clear();
+    const std::array<int32_t, 3> c = {add(P[0]), add(P[1]), add(P[2])};
+    if (levels_.size() < size_t(depth) + 1) levels_.resize(size_t(depth) + 1);
+    std::vector<int32_t>& all = levels_[size_t(depth)].all;
+    all.resize(feats_->size());
+    for (size_t f = 0; f < all.size(); ++f) all[f] = int32_t(f);
+    return piece(c, all, depth);
+  }
+
+ private:
+  struct Level {
+    std::vector<std::pair<double, int32_t>> order;
+    std::vector<int32_t> near, all;
+  };
+
+  int32_t add(tc_d3 p) {
+    pts_.push_back(p);
+    dist_.resize(dist_.size() + feats_->size(), -1.0);
+    return int32_t(pts_.size() - 1);
+  }
+  double d2(int32_t p, int32_t f) {
+    double& d = dist_[size_t(p) * feats_->size() + size_t(f)];
+    if (d < 0) d = point_triangle_dist2(pts_[size_t(p)], *(*feats_)[size_t(f)]);
+    return d;
+  }
+
+  bool piece(std::array<int32_t, 3> c, const std::vector<int32_t>& feats, int depth) {
+    const Tri P = {pts_[size_t(c[0])], pts_[size_t(c[1])], pts_[size_t(c[2])]};
+    Level& L = levels_[size_t(depth)];
+    // the features nearest the piece first: the one that certifies it is then found at once
+    const tc_d3 m = (P[0] + P[1] + P[2]) * (1.0 / 3);
+    L.order.clear();
+    for (int32_t f : feats) {
+      const tc_d3 d = m - centroids_[size_t(f)];
+      L.order.push_back({dot(d, d), f});
+    }
+    std::sort(L.order.begin(), L.order.end());
+    for (const auto& [key, f] : L.order)
+      if (d2(c[0], f) <= e2_ && d2(c[1], f) <= e2_ && d2(c[2], f) <= e2_) return true;
+    // (whether the piece matters at all only now: most pieces are certified before)
+    if (relevant_ && !(*relevant_)(P)) return true;
+    if (depth == 0) return false;
+    if (!relevant_)  // a corner farther than e from every feature: no split can help
+      for (int32_t k : c) {
+        double dmin = INFINITY;
+        for (int32_t f : feats) dmin = std::min(dmin, d2(k, f));
+        if (dmin > e2_) return false;
+      }
+    tc_d3 lo, hi;
+    box_of(P, lo, hi);
+    L.near.clear();  // the features within reach of the piece, nearest first
+    for (const auto& [key, f] : L.order)
+      if (!boxes_apart(lo_[size_t(f)], hi_[size_t(f)], lo, hi, e_)) L.near.push_back(f);
+    const size_t keep = pts_.size();
+    const int32_t m01 = add((P[0] + P[1]) * 0.5), m12 = add((P[1] + P[2]) * 0.5), m20 = add((P[2] + P[0]) * 0.5);
+    const std::array<int32_t, 3> kids[4] = {{c[0], m01, m20}, {m01, c[1], m12}, {m20, m12, c[2]}, {m01, m12, m20}};
+    bool ok = true;
+    for (const auto& k : kids)
+      if (!(ok = piece(k, L.near, depth - 1))) break;
+    pts_.resize(keep);
+    dist_.resize(keep * feats_->size());
+    return ok;
+  }
+
+  const std::vector<const Tri*>* feats_ = nullptr;
+  double e2_ = 0, e_ = 0;
+  const std::function<bool(const Tri&)>* relevant_ = nullptr;
+  std::vector<tc_d3> centroids_, lo_, hi_;  // per feature
+  std::vector<tc_d3> pts_;                  // the corners of the pieces on the way down
+  std::vector<double> dist_;                // per point and feature, -1 until computed
+  std::vector<Level> levels_;               // per depth, scratch
+};
+
+}  // namespace
+
 bool within(const Tri& P, const std::vector<const Tri*>& feats, double e2, int depth,
             const std::function<bool(const Tri&)>* relevant) {
-  // The features nearest the piece first: the one that certifies it is then found at once.
-  const tc_d3 c = (P[0] + P[1] + P[2]) * (1.0 / 3);
-  std::vector<std::pair<double, const Tri*>> order;
-  order.reserve(feats.size());
-  for (const Tri* t : feats) {
-    const tc_d3 d = c - ((*t)[0] + (*t)[1] + (*t)[2]) * (1.0 / 3);
-    order.push_back({dot(d, d), t});
-  }
-  std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  double upper = INFINITY, dmin[3] = {INFINITY, INFINITY, INFINITY};
-  for (const auto& [key, t] : order) {
-    double m = 0;
-    for (int i = 0; i < 3; ++i) {
-      const double d = point_triangle_dist2(P[size_t(i)], *t);
-      m = std::max(m, d);
-      dmin[i] = std::min(dmin[i], d);
-    }
-    upper = std::min(upper, m);
-    if (upper <= e2) return true;
-  }
-  // (whether the piece matters at all only now: most pieces are certified before)
-  if (relevant && !(*relevant)(P)) return true;
-  if ((!relevant && std::max({dmin[0], dmin[1], dmin[2]}) > e2) || depth == 0) return false;
-  tc_d3 lo, hi;
-  box_of(P, lo, hi);
-  const double e = std::sqrt(e2);
-  std::vector<const Tri*> near;  // the features within reach of the piece, nearest first
-  near.reserve(order.size());
-  for (const auto& [key, t] : order) {
-    tc_d3 tl, th;
-    box_of(*t, tl, th);
-    if (!boxes_apart(tl, th, lo, hi, e)) near.push_back(t);
-  }
-  const tc_d3 m01 = (P[0] + P[1]) * 0.5, m12 = (P[1] + P[2]) * 0.5, m20 = (P[2] + P[0]) * 0.5;
-  const Tri kids[4] = {{P[0], m01, m20}, {m01, P[1], m12}, {m20, m12, P[2]}, {m01, m12, m20}};
-  for (const Tri& k : kids)
-    if (!within(k, near, e2, depth - 1, relevant)) return false;
-  return true;
+  Pieces pieces;
+  pieces.reset(feats, e2, relevant);
+  return pieces.within(P, depth);
 }
 
 namespace {
@@ -206,8 +270,11 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
       if (d2 > e2) return false;
     }
   }
-  for (size_t j = 0; j < news.size(); ++j)
-    if (!within(news[j], near[j], e2, kDepth)) return false;
+  Pieces pieces;
+  for (size_t j = 0; j < news.size(); ++j) {
+    pieces.reset(near[j], e2, nullptr);
+    if (!pieces.within(news[j], kDepth)) return false;
+  }
   // every point of this surface within reach of an old triangle within e of the new S: the
   // pieces farther from every old triangle keep the S point they were within reach of
   tc_d3 lo, hi;
@@ -238,7 +305,8 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
         box_of(f, fl, fh);
         if (!boxes_apart(fl, fh, l, h, e)) feats.push_back(&f);
       }
-    if (!within(t, feats, e2, kDepth, &relevant)) return false;
+    pieces.reset(feats, e2, &relevant);
+    if (!pieces.within(t, kDepth)) return false;
   }
   return true;
 }
