@@ -152,6 +152,7 @@ class Pieces {
     std::sort(L.order.begin(), L.order.end());
     for (const auto& [key, f] : L.order)
       if (d2(c[0], f) <= e2_ && d2(c[1], f) <= e2_ && d2(c[2], f) <= e2_) return true;
+    if (two_cover(c, L.order)) return true;
     // (whether the piece matters at all only now: most pieces are certified before)
     if (relevant_ && !(*relevant_)(P)) return true;
     if (depth == 0) return false;
@@ -175,6 +176,77 @@ class Pieces {
     pts_.resize(keep);
     dist_.resize(keep * feats_->size());
     return ok;
+  }
+
+  // Whether two features with a common edge hold the piece between them: cut by the plane
+  // through that edge that bisects their angle, each part (convex) lies within e of its own
+  // feature where its corners do. A piece across an edge of the features is then certified
+  // whole instead of being split down to the edge. (Any plane would do for the proof; rounding
+  // moves the cut points by far less than the margin of change_ok.)
+  bool two_cover(const std::array<int32_t, 3>& c, const std::vector<std::pair<double, int32_t>>& order) {
+    constexpr size_t kNearest = 6;  // the features tried, nearest first
+    int32_t f[kNearest];
+    int mask[kNearest];
+    size_t n = 0;
+    for (size_t i = 0; i < order.size() && i < kNearest; ++i) {
+      const int32_t g = order[i].second;
+      int m = 0;
+      for (int k = 0; k < 3; ++k)
+        if (d2(c[size_t(k)], g) <= e2_) m |= 1 << k;
+      if (m) {
+        f[n] = g;
+        mask[n++] = m;
+      }
+    }
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = i + 1; j < n; ++j)
+        if ((mask[i] | mask[j]) == 7 && cut_holds(c, f[i], f[j])) return true;
+    return false;
+  }
+
+  bool cut_holds(const std::array<int32_t, 3>& c, int32_t f1, int32_t f2) {
+    const Tri &t1 = *(*feats_)[size_t(f1)], &t2 = *(*feats_)[size_t(f2)];
+    int s1[2], s2[2], shared = 0;  // the common corners' places in t1 and t2
+    for (int a = 0; a < 3 && shared < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        if (t1[size_t(a)].x == t2[size_t(b)].x && t1[size_t(a)].y == t2[size_t(b)].y &&
+            t1[size_t(a)].z == t2[size_t(b)].z) {
+          if (shared < 2) {
+            s1[shared] = a;
+            s2[shared] = b;
+          }
+          ++shared;
+          break;
+        }
+    if (shared != 2) return false;
+    const tc_d3 a = t1[size_t(s1[0])], b = t1[size_t(s1[1])];
+    const tc_d3 o1 = t1[size_t(3 - s1[0] - s1[1])], o2 = t2[size_t(3 - s2[0] - s2[1])];
+    const tc_d3 d = b - a;
+    const double dd = dot(d, d);
+    if (!(dd > 0)) return false;
+    auto across = [&](tc_d3 o) {  // the unit direction from the edge to o, across the edge
+      const tc_d3 w = (o - a) - d * (dot(o - a, d) / dd);
+      const double l = std::sqrt(dot(w, w));
+      return l > 0 ? w * (1 / l) : tc_d3{0, 0, 0};
+    };
+    const tc_d3 nrm = across(o1) - across(o2);  // t1's side positive
+    if (!(dot(nrm, nrm) > 1e-12)) return false;
+    tc_d3 p[3];
+    double h[3];
+    for (int k = 0; k < 3; ++k) {
+      p[k] = pts_[size_t(c[size_t(k)])];
+      h[k] = dot(nrm, p[k] - a);
+      if (h[k] >= 0 && d2(c[size_t(k)], f1) > e2_) return false;
+      if (h[k] <= 0 && d2(c[size_t(k)], f2) > e2_) return false;
+    }
+    const Tri &T1 = t1, &T2 = t2;
+    for (int k = 0; k < 3; ++k) {  // the cut points, in both parts
+      const int l = (k + 1) % 3;
+      if (!((h[k] > 0 && h[l] < 0) || (h[k] < 0 && h[l] > 0))) continue;
+      const tc_d3 x = p[k] + (p[l] - p[k]) * (h[k] / (h[k] - h[l]));
+      if (point_triangle_dist2(x, T1) > e2_ || point_triangle_dist2(x, T2) > e2_) return false;
+    }
+    return true;
   }
 
   const std::vector<const Tri*>* feats_ = nullptr;

@@ -69,6 +69,53 @@ TEST(SurfaceDistance, ATriangleIsWithinWhatItsHeightSays) {
   EXPECT_FALSE(surface_distance::within(out, feats, e * e, 8));
 }
 
+// Across the edge two features share, the plane that bisects their angle cuts a piece into two
+// parts, each within e of its own feature: certified whole, without a split (depth 0).
+TEST(SurfaceDistance, APieceAcrossACommonEdgeIsHeldByBothFeatures) {
+  const surface_distance::ReferenceSurface ref(square());
+  std::vector<const Tri*> feats;
+  for (size_t i = 0; i < ref.size(); ++i) feats.push_back(&ref.tri(int32_t(i)));
+  const double e = 0.01;
+  const Tri across{tc_d3{0.4, 0.5, 0.5 * e}, tc_d3{0.6, 0.45, 0.5 * e}, tc_d3{0.52, 0.6, 0.5 * e}};
+  EXPECT_TRUE(surface_distance::within(across, feats, e * e, 0));
+  const Tri high{tc_d3{0.4, 0.5, 1.1 * e}, tc_d3{0.6, 0.45, 1.1 * e}, tc_d3{0.52, 0.6, 1.1 * e}};
+  EXPECT_FALSE(surface_distance::within(high, feats, e * e, 0));
+  // one feature alone holds no piece across the edge: without the other, refused
+  const std::vector<const Tri*> one = {feats[0]};
+  EXPECT_FALSE(surface_distance::within(across, one, e * e, 0));
+}
+
+// Sound on folded pairs: whatever within() certifies (any depth), every point of the piece,
+// densely sampled, lies within e of the two triangles.
+TEST(SurfaceDistance, WhatTheCutCertifiesIsWithinTheBound) {
+  std::mt19937 g(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int certified = 0;
+  for (int it = 0; it < 400; ++it) {
+    // two triangles on the edge (0,0,0)-(1,0,0), folded by a random angle
+    const double fold = 0.2 + 1.4 * (u(g) + 1), e = 0.02 + 0.05 * (u(g) + 1);
+    const Tri t1{tc_d3{0, 0, 0}, tc_d3{1, 0, 0}, tc_d3{0.5 + 0.3 * u(g), 1, 0}};
+    const Tri t2{tc_d3{1, 0, 0}, tc_d3{0, 0, 0}, tc_d3{0.5 + 0.3 * u(g), -std::cos(fold), std::sin(fold)}};
+    const std::vector<const Tri*> feats = {&t1, &t2};
+    const tc_d3 c{0.5 + 0.2 * u(g), 0.1 * u(g), 0.1 * u(g)};
+    const double r = 0.05 + 0.1 * (u(g) + 1);
+    const Tri piece{c + tc_d3{r * u(g), r * u(g), r * u(g)}, c + tc_d3{r * u(g), r * u(g), r * u(g)},
+                    c + tc_d3{r * u(g), r * u(g), r * u(g)}};
+    if (!surface_distance::within(piece, feats, e * e, it % 3)) continue;
+    ++certified;
+    double worst = 0;
+    const int n = 60;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j) {
+        const tc_d3 q = piece[0] + (piece[1] - piece[0]) * (double(i) / n) + (piece[2] - piece[0]) * (double(j) / n);
+        worst = std::max(worst, std::min(surface_distance::point_triangle_dist2(q, t1),
+                                         surface_distance::point_triangle_dist2(q, t2)));
+      }
+    EXPECT_LE(std::sqrt(worst), e * (1 + 1e-12)) << it;
+  }
+  EXPECT_GT(certified, 40) << "the random pieces test something";
+}
+
 // A tent of height h over the unit square's centre (four triangles) as the reference and as S;
 // the collapse of the apex onto a corner flattens it (two triangles).
 struct Tent {
