@@ -2,7 +2,11 @@
 #include "collapse/surface_distance.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
 
 namespace tc::surface_distance {
 
@@ -96,6 +100,9 @@ namespace {
 // corner needs no other.
 class Pieces {
  public:
+  // set by another thread when the verdict is known: every piece then fails at once
+  const std::atomic<bool>* stop = nullptr;
+
   void reset(const std::vector<const Tri*>& feats, double e2, const std::function<bool(const Tri&)>* relevant) {
     feats_ = &feats;
     e2_ = e2;
@@ -140,6 +147,7 @@ class Pieces {
   }
 
   bool piece(std::array<int32_t, 3> c, const std::vector<int32_t>& feats, int depth) {
+    if (stop && stop->load(std::memory_order_relaxed)) return false;
     const Tri P = {pts_[size_t(c[0])], pts_[size_t(c[1])], pts_[size_t(c[2])]};
     Level& L = levels_[size_t(depth)];
     // the features nearest the piece first: the one that certifies it is then found at once
@@ -317,6 +325,59 @@ void ReferenceSurface::query(tc_d3 lo, tc_d3 hi, std::vector<int32_t>& out) cons
       }
 }
 
+// A second thread for change_ok's pieces, woken per check: a check measures a few thousand
+// distances, too few for a thread of its own each time, and the collapse's host tail, which
+// makes these checks one after another, leaves the other core idle.
+class ReferenceSurface::Helper {
+ public:
+  Helper() : thread_([this] { loop(); }) {}
+  ~Helper() {
+    {
+      std::lock_guard<std::mutex> l(m_);
+      quit_ = true;
+    }
+    cv_.notify_all();
+    thread_.join();
+  }
+  // f on the helper and on the caller's thread; returns when both are done
+  void both(const std::function<void()>& f) {
+    {
+      std::lock_guard<std::mutex> l(m_);
+      task_ = &f;
+      ++posted_;
+    }
+    cv_.notify_all();
+    f();
+    std::unique_lock<std::mutex> l(m_);
+    cv_.wait(l, [&] { return finished_ == posted_; });
+  }
+
+ private:
+  void loop() {
+    uint64_t seen = 0;
+    std::unique_lock<std::mutex> l(m_);
+    for (;;) {
+      cv_.wait(l, [&] { return quit_ || posted_ != seen; });
+      if (quit_) return;
+      seen = posted_;
+      const std::function<void()>* f = task_;
+      l.unlock();
+      (*f)();
+      l.lock();
+      finished_ = seen;
+      cv_.notify_all();
+    }
+  }
+  std::mutex m_;
+  std::condition_variable cv_;
+  const std::function<void()>* task_ = nullptr;
+  uint64_t posted_ = 0, finished_ = 0;
+  bool quit_ = false;
+  std::thread thread_;  // (last: started once the members above exist)
+};
+
+ReferenceSurface::~ReferenceSurface() = default;
+
 bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector<Tri>& news,
                                  const std::vector<Tri>& around, double e, double reach) const {
   if (olds.empty() && news.empty()) return true;
@@ -324,7 +385,6 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
   e *= 1 - 1e-9;
   const double e2 = e * e;
   std::vector<int32_t> ids;
-  std::vector<const Tri*> feats;
   // every point of a new triangle within e of this surface (the triangles in its box grown
   // by e are all that can be that near); first a quick look at a few points of each, which
   // finds most refusals
@@ -341,11 +401,6 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
       for (const Tri* f : near[j]) d2 = std::min(d2, point_triangle_dist2(q, *f));
       if (d2 > e2) return false;
     }
-  }
-  Pieces pieces;
-  for (size_t j = 0; j < news.size(); ++j) {
-    pieces.reset(near[j], e2, nullptr);
-    if (!pieces.within(news[j], kDepth)) return false;
   }
   // every point of this surface within reach of an old triangle within e of the new S: the
   // pieces farther from every old triangle keep the S point they were within reach of
@@ -366,21 +421,44 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
     for (const Tri& t : olds) d2 = std::min(d2, point_triangle_dist2(c, t));
     return std::sqrt(d2) - r <= reach;
   };
-  for (int32_t i : ids) {
-    const Tri& t = tris_[size_t(i)];
-    tc_d3 l, h;
-    box_of(t, l, h);
-    feats.clear();
-    for (const auto* set : {&news, &around})
-      for (const Tri& f : *set) {
-        tc_d3 fl, fh;
-        box_of(f, fl, fh);
-        if (!boxes_apart(fl, fh, l, h, e)) feats.push_back(&f);
+  // The pieces, the new triangles' first, taken in turn by each thread: the verdict is that
+  // all hold, whichever thread measures which.
+  const size_t jobs = news.size() + ids.size();
+  std::atomic<size_t> next{0};
+  std::atomic<bool> failed{false};
+  const std::function<void()> work = [&] {
+    Pieces pieces;
+    pieces.stop = &failed;
+    std::vector<const Tri*> feats;
+    for (size_t k = next++; k < jobs && !failed.load(std::memory_order_relaxed); k = next++) {
+      bool ok;
+      if (k < news.size()) {
+        pieces.reset(near[k], e2, nullptr);
+        ok = pieces.within(news[k], kDepth);
+      } else {
+        const Tri& t = tris_[size_t(ids[k - news.size()])];
+        tc_d3 l, h;
+        box_of(t, l, h);
+        feats.clear();
+        for (const auto* set : {&news, &around})
+          for (const Tri& f : *set) {
+            tc_d3 fl, fh;
+            box_of(f, fl, fh);
+            if (!boxes_apart(fl, fh, l, h, e)) feats.push_back(&f);
+          }
+        pieces.reset(feats, e2, &relevant);
+        ok = pieces.within(t, kDepth);
       }
-    pieces.reset(feats, e2, &relevant);
-    if (!pieces.within(t, kDepth)) return false;
+      if (!ok) failed = true;
+    }
+  };
+  if (jobs >= kTwoThreadJobs && std::thread::hardware_concurrency() > 1) {
+    if (!helper_) helper_ = std::make_unique<Helper>();
+    helper_->both(work);
+  } else {
+    work();
   }
-  return true;
+  return !failed;
 }
 
 }  // namespace tc::surface_distance

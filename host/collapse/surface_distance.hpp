@@ -12,6 +12,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <unordered_map>
 #include <vector>
 
@@ -37,6 +38,7 @@ bool within(const Tri& piece, const std::vector<const Tri*>& features, double e2
 class ReferenceSurface {
  public:
   explicit ReferenceSurface(const std::vector<double>& triangles);
+  ~ReferenceSurface();
   size_t size() const { return tris_.size(); }
   const Tri& tri(int32_t i) const { return tris_[size_t(i)]; }
   // The triangles whose boxes meet [lo, hi], into out.
@@ -47,18 +49,21 @@ class ReferenceSurface {
   // `reach` (>= e) of S before: every point of the new triangles within e of this surface, and
   // every point of this surface within `reach` of the old triangles (the only points whose
   // nearest S may be gone) within e of the new ones or those around. Conservative: false
-  // when it cannot tell.
+  // when it cannot tell. One check at a time; a large one measures on two threads.
   bool change_ok(const std::vector<Tri>& olds, const std::vector<Tri>& news, const std::vector<Tri>& around, double e,
                  double reach) const;
 
  private:
-  static constexpr int kDepth = 8;  // splits of a piece: 4^8 pieces at most
+  class Helper;
+  static constexpr int kDepth = 8;          // splits of a piece: 4^8 pieces at most
+  static constexpr size_t kTwoThreadJobs = 8;  // triangles measured from which a check takes two threads
   std::vector<Tri> tris_;
   std::unordered_map<int64_t, std::vector<int32_t>> cells_;
   double cell_ = 1;
   tc_d3 origin_{0, 0, 0};
   mutable std::vector<uint32_t> seen_;
   mutable uint32_t stamp_ = 0;
+  mutable std::unique_ptr<Helper> helper_;  // the second thread, from the first check that takes it
 };
 
 }  // namespace tc::surface_distance
