@@ -255,7 +255,7 @@ bool SequentialRun::step() {
     if (!marked(e.a, e.b, e.cost)) continue;
     ++s.marked;
     uint8_t fe = 0;
-    const int dir = sm_.predicate(e.a, e.b, fe);
+    const int dir = predicate(e.a, e.b, fe);
     if (dir < 0) continue;
     ++s.candidates;
     if (reuse && touched_[e.a] != prev && touched_[e.b] != prev) continue;  // refused then, refused now
@@ -295,12 +295,13 @@ bool SequentialRun::step() {
         continue;
       }
       uint8_t fe = 0;
-      const int d = sm_.predicate(e.a, e.b, fe);
+      const int d = predicate(e.a, e.b, fe);
       if (d < 0 || !sm_.admissible(e.a, e.b, fe, d)) continue;
       dir = uint8_t(d);
     }
     double base = 0, change = 0;  // (the bound's, for dir)
-    if (bound_ > 0) dir = sm_.closest_placement(e.a, e.b, dir, eps_, &base, &change);
+    const bool merge = merges_feature(e.a, e.b);  // (measured alone, onto its end point)
+    if (bound_ > 0 && !merge) dir = sm_.closest_placement(e.a, e.b, dir, eps_, &base, &change);
     if (!sm_.guard_ok(e.a, e.b, dir)) {
       // refused by the surface guard, which looks beyond the star: its end points count as
       // touched, so the edge is tested again next iteration (S nearby may have moved away)
@@ -314,7 +315,7 @@ bool SequentialRun::step() {
     bool measured = false;
     if (bound_ > 0) {
       // the carried bound, else the change measured against the reference
-      const bool carried = base + change <= bound_;
+      const bool carried = !merge && base + change <= bound_;
       measured = !carried && reference_ && sm_.keeps_shape(e.a, e.b, dir, kMeasuredMinQuality) &&
                  measured_ok(e.a, e.b, dir);
       if (!carried && !measured) {
@@ -434,6 +435,26 @@ void SequentialRun::seed_boundary_error(std::vector<double> eps) {
   }
   if (reference_)
     for (double e : eps_) reach_ = std::max(reach_, e);
+}
+
+int SequentialRun::predicate(int32_t a, int32_t b, uint8_t& fe) {
+  const int dir = sm_.predicate(a, b, fe);
+  if (dir >= 0 || !merges_feature(a, b)) return dir;
+  // onto the end of the higher class (the lower index at a tie), else the other, else the
+  // midpoint: the first the volume and quality tests admit
+  const int first = sm_.vclass(a) >= sm_.vclass(b) ? int(TCC_DIR_REMOVE_V1) : 0;
+  for (int d : {first, first ^ int(TCC_DIR_REMOVE_V1), int(TCC_DIR_MIDPOINT | TCC_DIR_REMOVE_V1)})
+    if (sm_.link_and_volume(a, b, fe, d) == collapse_detail::kOk) return d;
+  return first;
+}
+
+bool SequentialRun::merges_feature(int32_t a, int32_t b) {
+  if (!reference_ || !o_.tuning.merge_features_within_bound) return false;
+  // an edge of the boundary alone: an interface's details are a material's, which stay
+  const uint8_t fa = sm_.vflags(a), fb = sm_.vflags(b);
+  if (!(fa & fb & TCC_BOUNDARY) || ((fa | fb) & TCC_INTERFACE) || !(sm_.length(a, b) <= bound_)) return false;
+  uint8_t fe = 0;
+  return sm_.predicate(a, b, fe) < 0 && (fe & TCC_BOUNDARY) && !(fe & TCC_INTERFACE);
 }
 
 bool SequentialRun::measured_ok(int32_t a, int32_t b, uint8_t dir) {

@@ -179,6 +179,10 @@ class SequentialRun {
   // Whether the collapse of (a, b) in direction dir keeps S within the bound of the reference,
   // measured; its corners (collapse_fans) in corners_.
   bool measured_ok(int32_t a, int32_t b, uint8_t dir);
+  // The predicate (SeqMesh::predicate), and under the measured bound the merge of a detail
+  // smaller than it (CollapseTuning::merge_features_within_bound): whether (a, b) is such a merge.
+  int predicate(int32_t a, int32_t b, uint8_t& fe);
+  bool merges_feature(int32_t a, int32_t b);
   std::vector<int32_t> tmap_;
   std::vector<int32_t> origin_;    // input vertex -> current vertex (only with tris or edges)
   std::vector<int32_t> source_;    // current vertex -> input vertex (keep_origin)

@@ -162,6 +162,12 @@ struct CollapseTuning {
   // then always ends with its host tail, which measures the collapses of S the device refused
   // (not with host_tail 0: all on the device, the carried bound alone).
   bool remeasure_boundary_error = true;
+  // Under a measured boundary error bound: a detail of the boundary smaller than the bound may
+  // go, as MMG's -hausd removes it. An edge of the boundary (not of an interface) no longer than
+  // the bound, which the predicate refuses for its end points' classes (two corners; ridge
+  // vertices across, or off, their ridges), collapses onto its end of the higher class when the
+  // measured distance stays within the bound. False: features stay whatever their size.
+  bool merge_features_within_bound = true;
 };
 
 struct CollapseOptions {

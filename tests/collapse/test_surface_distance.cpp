@@ -219,6 +219,49 @@ double hausdorff_rel(const Mesh& out, const Mesh& in) {
   return r.reference.hausdorff_rel;
 }
 
+// A detail of the boundary smaller than the bound goes: a cube with a notch of an eighth of its
+// side at a corner (three concave ridges, corners), under a bound larger than the notch, loses
+// more tets with the merge of features than without, and stays within the bound; under a bound
+// smaller than every boundary edge nothing merges.
+TEST(SurfaceDistanceRun, DetailsSmallerThanTheBoundMerge) {
+  const Mesh cube = test::cube_tets(8);
+  const Mesh notched = test::sub_mesh(cube, [&](int64_t t) {
+    double c[3] = {0, 0, 0};
+    for (int k = 0; k < 4; ++k)
+      for (int d = 0; d < 3; ++d) c[d] += cube.points[3 * size_t(cube.tets[4 * size_t(t) + size_t(k)]) + size_t(d)] / 4;
+    return !(c[0] > 0.875 && c[1] > 0.875 && c[2] > 0.875);
+  });
+  Context ctx;
+  for (bool parallel : {false, true})
+    for (double e : {0.08, 1e-4}) {
+      int64_t tets[2];
+      std::vector<double> points[2];
+      for (bool merge : {false, true}) {
+        CollapseOptions o;
+        o.target_factor = 2;
+        o.max_boundary_error = e;
+        o.tuning.merge_features_within_bound = merge;
+        Mesh m = notched;
+        if (parallel) {
+          collapse(m, o, ctx);
+        } else {
+          o.method = CollapseOptions::Sequential;
+          collapse_sequential(m, o);
+        }
+        if (merge && e > 0.01) {
+          EXPECT_LE(hausdorff_rel(m, notched), e) << (parallel ? "parallel" : "sequential");
+        }
+        tets[merge] = m.num_tets();
+        points[merge] = m.points;
+      }
+      if (e > 0.01) {
+        EXPECT_LT(tets[1], tets[0]) << (parallel ? "parallel" : "sequential") << ": the notch merges";
+      } else {
+        EXPECT_EQ(points[1], points[0]) << (parallel ? "parallel" : "sequential") << ": no edge is that short";
+      }
+    }
+}
+
 // Whole runs on curved shapes: measured where the carried bound refuses, the curved faces
 // coarsen further, and the checker's distance stays within the bound; both methods, and the
 // coarsening with its improvement phase and later cycles, which go on from the reference.
