@@ -292,9 +292,12 @@ ReferenceSurface::ReferenceSurface(const std::vector<double>& triangles) {
   if (!(cell_ > 0)) cell_ = 1;
   origin_ = tris_[0][0];
   seen_.assign(tris_.size(), 0);
+  lo_.resize(tris_.size());
+  hi_.resize(tris_.size());
   const auto c = [&](double x, double o) { return int64_t(std::floor((x - o) / cell_)); };
   for (int32_t i = 0; i < int32_t(tris_.size()); ++i) {
-    tc_d3 lo, hi;
+    tc_d3& lo = lo_[size_t(i)];
+    tc_d3& hi = hi_[size_t(i)];
     box_of(tris_[size_t(i)], lo, hi);
     for (int64_t a = c(lo.x, origin_.x); a <= c(hi.x, origin_.x); ++a)
       for (int64_t b = c(lo.y, origin_.y); b <= c(hi.y, origin_.y); ++b)
@@ -318,9 +321,7 @@ void ReferenceSurface::query(tc_d3 lo, tc_d3 hi, std::vector<int32_t>& out) cons
         for (int32_t i : it->second) {
           if (seen_[size_t(i)] == stamp_) continue;
           seen_[size_t(i)] = stamp_;
-          tc_d3 tl, th;
-          box_of(tris_[size_t(i)], tl, th);
-          if (!boxes_apart(tl, th, lo, hi, 0)) out.push_back(i);
+          if (!boxes_apart(lo_[size_t(i)], hi_[size_t(i)], lo, hi, 0)) out.push_back(i);
         }
       }
 }
@@ -423,6 +424,16 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
   };
   // The pieces, the new triangles' first, taken in turn by each thread: the verdict is that
   // all hold, whichever thread measures which.
+  std::vector<const Tri*> sides;  // the new triangles and those around, with their boxes
+  std::vector<tc_d3> side_lo, side_hi;
+  for (const auto* set : {&news, &around})
+    for (const Tri& f : *set) {
+      tc_d3 fl, fh;
+      box_of(f, fl, fh);
+      sides.push_back(&f);
+      side_lo.push_back(fl);
+      side_hi.push_back(fh);
+    }
   const size_t jobs = news.size() + ids.size();
   std::atomic<size_t> next{0};
   std::atomic<bool> failed{false};
@@ -436,16 +447,11 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
         pieces.reset(near[k], e2, nullptr);
         ok = pieces.within(news[k], kDepth);
       } else {
-        const Tri& t = tris_[size_t(ids[k - news.size()])];
-        tc_d3 l, h;
-        box_of(t, l, h);
+        const size_t r = size_t(ids[k - news.size()]);
+        const Tri& t = tris_[r];
         feats.clear();
-        for (const auto* set : {&news, &around})
-          for (const Tri& f : *set) {
-            tc_d3 fl, fh;
-            box_of(f, fl, fh);
-            if (!boxes_apart(fl, fh, l, h, e)) feats.push_back(&f);
-          }
+        for (size_t f = 0; f < sides.size(); ++f)
+          if (!boxes_apart(side_lo[f], side_hi[f], lo_[r], hi_[r], e)) feats.push_back(sides[f]);
         pieces.reset(feats, e2, &relevant);
         ok = pieces.within(t, kDepth);
       }

@@ -58,6 +58,7 @@ class ReferenceSurface {
   static constexpr int kDepth = 8;          // splits of a piece: 4^8 pieces at most
   static constexpr size_t kTwoThreadJobs = 8;  // triangles measured from which a check takes two threads
   std::vector<Tri> tris_;
+  std::vector<tc_d3> lo_, hi_;  // per triangle: its box
   std::unordered_map<int64_t, std::vector<int32_t>> cells_;
   double cell_ = 1;
   tc_d3 origin_{0, 0, 0};
