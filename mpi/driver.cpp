@@ -49,6 +49,7 @@ Settings make_settings(Options& o) {
   c.method = cli::method_mode(o.method);
   if (o.priority_levels >= 0) c.tuning.priority_levels = o.priority_levels;
   c.tuning.spatial_order = !o.no_spatial_order;
+  c.tuning.merge_features_within_bound = !o.no_merge_features;
   if (o.host_tail >= 0) c.tuning.host_tail = o.host_tail;
   s.region = o.region, s.labels = o.labels;
   ImproveOptions& i = s.improve;

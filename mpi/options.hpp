@@ -21,7 +21,7 @@ struct Options {
   double max_boundary_error = -1, max_boundary_error_abs = 0;
   int64_t eps_c = 0;
   int max_iterations = 1000;
-  bool paper_boundary_rule = false, no_spatial_order = false;
+  bool paper_boundary_rule = false, no_spatial_order = false, no_merge_features = false;
   std::string conflicts = "matching", method = "parallel";
   std::string preserve_field;  // the paper's field cost on this vertex field (--field-tolerance)
   std::string sizing_field, cost_cl, placement_cl, predicate_cl;

@@ -29,7 +29,7 @@ struct CollapseCli {
   std::string boundary = "features", method = "parallel", conflicts = "matching";
   std::string region, sizing_field, labels, cost_cl, placement_cl, predicate_cl, device, stats;
   bool check = false, quiet = false, no_labels = false, no_spatial_order = false, no_improve = false,
-       average_fields = false;
+       average_fields = false, no_merge_features = false;
   std::string preserve_field;
   double field_tolerance = 0.02;
   CLI::Option* field_tolerance_option = nullptr;
@@ -165,6 +165,10 @@ void register_collapse(CLI::App& app, int& exit_code) {
       app.add_option("--max-boundary-error-abs", c->opt.max_boundary_error_abs,
                      "The same bound in mesh units (used instead of --max-boundary-error when > 0)")
           ->check(CLI::NonNegativeNumber);
+  app.add_flag("--no-merge-features", c->no_merge_features,
+               "Under --max-boundary-error, keep every ridge and corner whatever its size (default: a detail of\n"
+               "the boundary smaller than the bound, an edge no longer than it that the ridge and corner rules\n"
+               "refuse, may collapse where the measured distance stays within the bound, as MMG's -hausd)");
   app.add_option("--eps-v", c->opt.eps_v, "Refuse collapses leaving a tet with volume below this (paper: 2e-12)")
       ->capture_default_str();
   app.add_option("--min-quality", c->opt.min_quality,
@@ -287,6 +291,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
     opt.boundary = boundary_mode(c->boundary);
     opt.use_labels = !c->no_labels;
     opt.tuning.spatial_order = !c->no_spatial_order;
+    opt.tuning.merge_features_within_bound = !c->no_merge_features;
     opt.method = method_mode(c->method);
     opt.conflicts = conflicts_mode(c->conflicts);
     if (c->priority_levels >= 0) {

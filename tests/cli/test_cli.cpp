@@ -238,6 +238,32 @@ TEST(Cli, MaxBoundaryErrorHoldsAndIsRefusedWhereItCannot) {
   EXPECT_NE(out.find("--boundary features"), std::string::npos) << out;
 }
 
+// --no-merge-features: a notch an eighth of a cube's side, under a bound larger than it, merges by
+// default and stays with the flag (tetcollapse and tetcollapse-mpi take the same flag).
+TEST(Cli, NoMergeFeaturesKeepsADetailSmallerThanTheBound) {
+  tc::test::TempDir dir;
+  const tc::Mesh cube = tc::test::cube_tets(8);
+  tc::write_mesh(dir.file("in.vtu"), tc::test::sub_mesh(cube, [&](int64_t t) {
+                   double c[3] = {0, 0, 0};
+                   for (int k = 0; k < 4; ++k)
+                     for (int d = 0; d < 3; ++d)
+                       c[d] += cube.points[3 * size_t(cube.tets[4 * size_t(t) + size_t(k)]) + size_t(d)] / 4;
+                   return !(c[0] > 0.875 && c[1] > 0.875 && c[2] > 0.875);
+                 }));
+  std::string out;
+  int64_t tets[2];
+  for (bool keep : {false, true}) {
+    ASSERT_EQ(run_command(cli() + " " + q(dir.file("in.vtu")) + " " + q(dir.file("o.vtu")) +
+                              " --target-factor 2 --no-improve --max-boundary-error 0.08 -q" +
+                              (keep ? " --no-merge-features" : ""),
+                          &out),
+              0)
+        << out;
+    tets[keep] = tc::read_mesh(dir.file("o.vtu")).num_tets();
+  }
+  EXPECT_LT(tets[0], tets[1]) << "the notch merges unless --no-merge-features";
+}
+
 // --region and --labels: the tets with no vertex in the region (or of the labels left out) come
 // out as they went in, bit for bit, improvement phase included; the rest coarsens. A bad region
 // or labels on a mesh without any: exit 2, naming the option.
