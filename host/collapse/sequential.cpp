@@ -439,7 +439,7 @@ void SequentialRun::seed_boundary_error(std::vector<double> eps) {
 
 int SequentialRun::predicate(int32_t a, int32_t b, uint8_t& fe) {
   const int dir = sm_.predicate(a, b, fe);
-  if (dir >= 0 || !merges_feature(a, b)) return dir;
+  if (dir >= 0 || !merges_feature(a, b, &fe)) return dir;
   // onto the end of the higher class (the lower index at a tie), else the other, else the
   // midpoint: the first the volume and quality tests admit
   const int first = sm_.vclass(a) >= sm_.vclass(b) ? int(TCC_DIR_REMOVE_V1) : 0;
@@ -448,13 +448,15 @@ int SequentialRun::predicate(int32_t a, int32_t b, uint8_t& fe) {
   return first;
 }
 
-bool SequentialRun::merges_feature(int32_t a, int32_t b) {
+bool SequentialRun::merges_feature(int32_t a, int32_t b, const uint8_t* refused_fe) {
   if (!reference_ || !o_.tuning.merge_features_within_bound) return false;
   // an edge of the boundary alone: an interface's details are a material's, which stay
   const uint8_t fa = sm_.vflags(a), fb = sm_.vflags(b);
   if (!(fa & fb & TCC_BOUNDARY) || ((fa | fb) & TCC_INTERFACE) || !(sm_.length(a, b) <= bound_)) return false;
   uint8_t fe = 0;
-  return sm_.predicate(a, b, fe) < 0 && (fe & TCC_BOUNDARY) && !(fe & TCC_INTERFACE);
+  if (refused_fe) fe = *refused_fe;
+  else if (sm_.predicate(a, b, fe) >= 0) return false;
+  return (fe & TCC_BOUNDARY) && !(fe & TCC_INTERFACE);
 }
 
 bool SequentialRun::measured_ok(int32_t a, int32_t b, uint8_t dir) {

@@ -180,9 +180,10 @@ class SequentialRun {
   // measured; its corners (collapse_fans) in corners_.
   bool measured_ok(int32_t a, int32_t b, uint8_t dir);
   // The predicate (SeqMesh::predicate), and under the measured bound the merge of a detail
-  // smaller than it (CollapseTuning::merge_features_within_bound): whether (a, b) is such a merge.
+  // smaller than it (CollapseTuning::merge_features_within_bound): whether (a, b) is such a merge
+  // (refused_fe: the S flags of an edge the predicate refused, which it then need not ask again).
   int predicate(int32_t a, int32_t b, uint8_t& fe);
-  bool merges_feature(int32_t a, int32_t b);
+  bool merges_feature(int32_t a, int32_t b, const uint8_t* refused_fe = nullptr);
   std::vector<int32_t> tmap_;
   std::vector<int32_t> origin_;    // input vertex -> current vertex (only with tris or edges)
   std::vector<int32_t> source_;    // current vertex -> input vertex (keep_origin)

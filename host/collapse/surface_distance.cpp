@@ -247,12 +247,11 @@ class Pieces {
       if (h[k] >= 0 && d2(c[size_t(k)], f1) > e2_) return false;
       if (h[k] <= 0 && d2(c[size_t(k)], f2) > e2_) return false;
     }
-    const Tri &T1 = t1, &T2 = t2;
     for (int k = 0; k < 3; ++k) {  // the cut points, in both parts
       const int l = (k + 1) % 3;
       if (!((h[k] > 0 && h[l] < 0) || (h[k] < 0 && h[l] > 0))) continue;
       const tc_d3 x = p[k] + (p[l] - p[k]) * (h[k] / (h[k] - h[l]));
-      if (point_triangle_dist2(x, T1) > e2_ || point_triangle_dist2(x, T2) > e2_) return false;
+      if (point_triangle_dist2(x, t1) > e2_ || point_triangle_dist2(x, t2) > e2_) return false;
     }
     return true;
   }
@@ -458,7 +457,9 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
       if (!ok) failed = true;
     }
   };
-  if (jobs >= kTwoThreadJobs && std::thread::hardware_concurrency() > 1) {
+  // (the core count once: the library reads it from the system at each call)
+  static const bool two_cores = std::thread::hardware_concurrency() > 1;
+  if (jobs >= kTwoThreadJobs && two_cores) {
     if (!helper_) helper_ = std::make_unique<Helper>();
     helper_->both(work);
   } else {
