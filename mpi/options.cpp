@@ -40,10 +40,7 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--max-boundary-error-abs", o.max_boundary_error_abs,
                  "The same bound in mesh units (used instead of --max-boundary-error when > 0)")
       ->check(CLI::NonNegativeNumber);
-  app.add_flag("--no-merge-features", o.no_merge_features,
-               "Under --max-boundary-error, keep every ridge and corner whatever its size (default: a detail of\n"
-               "the boundary smaller than the bound, an edge no longer than it that the ridge and corner rules\n"
-               "refuse, may collapse where the measured distance stays within the bound, as MMG's -hausd)");
+  app.add_flag("--no-merge-features", o.no_merge_features, cli::kNoMergeFeaturesHelp);
   app.add_flag("--no-improve", o.no_improve,
                "Coarsen only (default: each rank improves its part after coarsening it, the interface\n"
                "frozen)");

@@ -165,10 +165,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
       app.add_option("--max-boundary-error-abs", c->opt.max_boundary_error_abs,
                      "The same bound in mesh units (used instead of --max-boundary-error when > 0)")
           ->check(CLI::NonNegativeNumber);
-  app.add_flag("--no-merge-features", c->no_merge_features,
-               "Under --max-boundary-error, keep every ridge and corner whatever its size (default: a detail of\n"
-               "the boundary smaller than the bound, an edge no longer than it that the ridge and corner rules\n"
-               "refuse, may collapse where the measured distance stays within the bound, as MMG's -hausd)");
+  app.add_flag("--no-merge-features", c->no_merge_features, kNoMergeFeaturesHelp);
   app.add_option("--eps-v", c->opt.eps_v, "Refuse collapses leaving a tet with volume below this (paper: 2e-12)")
       ->capture_default_str();
   app.add_option("--min-quality", c->opt.min_quality,

@@ -67,6 +67,11 @@ inline constexpr const char* kMethodHelp =
     "parallel (default): the OpenCL pipeline; sequential: the CPU priority-queue baseline\n"
     "with the same checks (no OpenCL device needed)";
 CollapseOptions::Method method_mode(const std::string& name);
+// --no-merge-features (CollapseTuning::merge_features_within_bound off): its help.
+inline constexpr const char* kNoMergeFeaturesHelp =
+    "Under --max-boundary-error, keep every ridge and corner whatever its size (default: a detail of\n"
+    "the boundary smaller than the bound, an edge no longer than it that the ridge and corner rules\n"
+    "refuse, may collapse where the measured distance stays within the bound, as MMG's -hausd)";
 void check_method(const std::string& method, const std::string& device,
                   const std::vector<std::pair<const char*, const std::string*>>& needs_parallel);
 
