@@ -242,14 +242,7 @@ TEST(Cli, MaxBoundaryErrorHoldsAndIsRefusedWhereItCannot) {
 // default and stays with the flag (tetcollapse and tetcollapse-mpi take the same flag).
 TEST(Cli, NoMergeFeaturesKeepsADetailSmallerThanTheBound) {
   tc::test::TempDir dir;
-  const tc::Mesh cube = tc::test::cube_tets(8);
-  tc::write_mesh(dir.file("in.vtu"), tc::test::sub_mesh(cube, [&](int64_t t) {
-                   double c[3] = {0, 0, 0};
-                   for (int k = 0; k < 4; ++k)
-                     for (int d = 0; d < 3; ++d)
-                       c[d] += cube.points[3 * size_t(cube.tets[4 * size_t(t) + size_t(k)]) + size_t(d)] / 4;
-                   return !(c[0] > 0.875 && c[1] > 0.875 && c[2] > 0.875);
-                 }));
+  tc::write_mesh(dir.file("in.vtu"), tc::test::notched_cube(8));
   std::string out;
   int64_t tets[2];
   for (bool keep : {false, true}) {

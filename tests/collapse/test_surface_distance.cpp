@@ -219,18 +219,19 @@ double hausdorff_rel(const Mesh& out, const Mesh& in) {
   return r.reference.hausdorff_rel;
 }
 
+// A collapse of m by the sequential or the parallel method.
+CollapseReport collapse_by(bool sequential, Mesh& m, CollapseOptions o, Context& ctx) {
+  if (!sequential) return collapse(m, o, ctx);
+  o.method = CollapseOptions::Sequential;
+  return collapse_sequential(m, o);
+}
+
 // A detail of the boundary smaller than the bound goes: a cube with a notch of an eighth of its
 // side at a corner (three concave ridges, corners), under a bound larger than the notch, loses
 // more tets with the merge of features than without, and stays within the bound; under a bound
 // smaller than every boundary edge nothing merges.
 TEST(SurfaceDistanceRun, DetailsSmallerThanTheBoundMerge) {
-  const Mesh cube = test::cube_tets(8);
-  const Mesh notched = test::sub_mesh(cube, [&](int64_t t) {
-    double c[3] = {0, 0, 0};
-    for (int k = 0; k < 4; ++k)
-      for (int d = 0; d < 3; ++d) c[d] += cube.points[3 * size_t(cube.tets[4 * size_t(t) + size_t(k)]) + size_t(d)] / 4;
-    return !(c[0] > 0.875 && c[1] > 0.875 && c[2] > 0.875);
-  });
+  const Mesh notched = test::notched_cube(8);
   Context ctx;
   for (bool parallel : {false, true})
     for (double e : {0.08, 1e-4}) {
@@ -242,12 +243,7 @@ TEST(SurfaceDistanceRun, DetailsSmallerThanTheBoundMerge) {
         o.max_boundary_error = e;
         o.tuning.merge_features_within_bound = merge;
         Mesh m = notched;
-        if (parallel) {
-          collapse(m, o, ctx);
-        } else {
-          o.method = CollapseOptions::Sequential;
-          collapse_sequential(m, o);
-        }
+        collapse_by(!parallel, m, o, ctx);
         if (merge && e > 0.01) {
           EXPECT_LE(hausdorff_rel(m, notched), e) << (parallel ? "parallel" : "sequential");
         }
@@ -279,12 +275,8 @@ TEST(SurfaceDistanceRun, MeasuredChangesCoarsenFurtherWithinTheBound) {
         o.max_boundary_error = e;
         o.tuning.remeasure_boundary_error = measure;
         Mesh m = in;
-        if (how == 0) {
-          o.method = CollapseOptions::Sequential;
-          const CollapseReport r = collapse_sequential(m, o);
-          EXPECT_EQ(r.boundary_reference != nullptr, measure) << what;
-        } else if (how == 1) {
-          const CollapseReport r = collapse(m, o, ctx);
+        if (how < 2) {
+          const CollapseReport r = collapse_by(how == 0, m, o, ctx);
           EXPECT_EQ(r.boundary_reference != nullptr, measure) << what;
         } else {
           CoarsenOptions co;

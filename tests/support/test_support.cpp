@@ -133,6 +133,17 @@ Mesh split_materials(int n, int axis, int32_t below, int32_t above) {
 
 Mesh two_materials(int n) { return split_materials(n, 2, 1, 2); }
 
+Mesh notched_cube(int n) {
+  const Mesh cube = cube_tets(n);
+  const double from = 1 - 1.0 / n;
+  return sub_mesh(cube, [&](int64_t t) {
+    double c[3] = {0, 0, 0};
+    for (int k = 0; k < 4; ++k)
+      for (int d = 0; d < 3; ++d) c[d] += cube.points[3 * size_t(cube.tets[4 * size_t(t) + size_t(k)]) + size_t(d)] / 4;
+    return !(c[0] > from && c[1] > from && c[2] > from);
+  });
+}
+
 Mesh sub_mesh(const Mesh& m, const std::function<bool(int64_t)>& keep) {
   Mesh out;
   std::vector<int32_t> map(size_t(m.num_vertices()), -1);

@@ -76,6 +76,9 @@ Mesh torus(int n, int ring);
 Mesh split_materials(int n, int axis, int32_t below, int32_t above);
 // The tets t of m with keep(t), in order, with only their vertices (renumbered in order of use).
 Mesh sub_mesh(const Mesh& m, const std::function<bool(int64_t)>& keep);
+// cube_tets(n) notched at its corner (1, 1, 1): the tets whose centroid lies in [1 - 1/n, 1]^3
+// taken out (a detail of the boundary an n-th of the side, three concave ridges, corners).
+Mesh notched_cube(int n);
 // m closed by a cone: a new last vertex at (x, y, z) joined by a tet to every boundary face (each
 // tet made positively oriented, whatever it overlaps; labelled as the tet it closes; m's fields,
 // triangles and edges are dropped). No boundary is left: the new vertex plays the virtual vertex
