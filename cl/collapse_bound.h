@@ -10,13 +10,14 @@
 
 /* The bound the S triangles at the survivor get from the collapse of x onto y (y at p): the
  * largest bound of the old fan's vertices in *base, plus the returned fan distance (0 when S does
- * not change, INFINITY when it cannot be bounded). The old fan: the owned S faces through x (and
- * those of the tets the collapse removes), and through y when it moves; the new one: the faces
- * after the collapse, on the owner's side. */
+ * not change, INFINITY when it cannot be bounded, or when *base + it would pass `limit`). The old
+ * fan: the owned S faces through x (and those of the tets the collapse removes), and through y
+ * when it moves; the new one: the faces after the collapse, on the owner's side. */
 inline double tcc_bound_change(int x, int y, int moves_y, double3 p, __global const int* tets,
                                __global const uint* vt_off, __global const int* vt, __global const int* tet_nbr,
                                __global const int* labels, int use_labels, __global const double* pts,
-                               __global const double* vfield, uint vfield_stride, uint eps_col, double* base) {
+                               __global const double* vfield, uint vfield_stride, uint eps_col, double limit,
+                               double* base) {
   tc_d3 olds[3 * TCC_MAX_FAN], news[3 * TCC_MAX_FAN];
   int oid[3 * TCC_MAX_FAN], nid[3 * TCC_MAX_FAN];
   int no = 0, nn = 0;
@@ -72,23 +73,24 @@ inline double tcc_bound_change(int x, int y, int moves_y, double3 p, __global co
     }
   }
   if (no == 0 && nn == 0) return 0.0;
-  return tcc_fan_distance(olds, oid, no, news, nid, nn);
+  return tcc_fan_distance_within(olds, oid, no, news, nid, nn, tcc_fan_budget(limit, *base));
 }
 
 /* The bound the survivor of the collapse of e = (a, b) in direction dir would take (the bound
  * per vertex in component eps_col of the vertex fields): -1 when S is not touched, INFINITY when
- * the change cannot be bounded; the collapse keeps the bound when this is at most the bound. */
+ * the change cannot be bounded or the bound would pass `limit`; the collapse keeps the bound when
+ * this is at most the bound. */
 inline double tcc_bound_after(int a, int b, int dir, __global const int* tets, __global const uint* vt_off,
                               __global const int* vt, __global const int* tet_nbr, __global const int* labels,
                               int use_labels, __global const double* pts, __global const double* vfield,
-                              uint vfield_stride, __global const uchar* vflags, uint eps_col) {
+                              uint vfield_stride, __global const uchar* vflags, uint eps_col, double limit) {
   int x = (dir & TCC_DIR_REMOVE_V1) ? b : a, y = x == a ? b : a;
   double3 p = tcc_placement(pts, vfield, vfield_stride, a, b, (uint)dir), py = tc_point(pts, y);
   int moves_y = !(py.x == p.x && py.y == p.y && py.z == p.z);
   if (!vflags[x] && !(moves_y && vflags[y])) return -1.0; /* S is not touched */
   double base;
   double change = tcc_bound_change(x, y, moves_y, p, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, vfield,
-                                   vfield_stride, eps_col, &base);
+                                   vfield_stride, eps_col, limit, &base);
   return change == 0.0 ? -1.0 : base + change; /* (NaN: refused by the caller's <=) */
 }
 

@@ -279,8 +279,9 @@ inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* edg
    * the bounds of the fan's vertices may grow while the rings stay (a refusal stays one); the
    * survivor's new bound of a collapse taken, for bound_apply (collapse_bound.cl) */
   if (r == TCC_OK) {
+    /* (measured only as far as the verdict needs: past the bound, or past the best so far) */
     double after = tcc_bound_after(a, b, dir, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, vfield,
-                                   vfield_stride, vflags, eps_col);
+                                   vfield_stride, vflags, eps_col, bound);
     /* beyond the paper: a collapse of S to the midpoint may keep either end point instead, where
      * that changes S least and the tets keep their shape (TCC_END_POINT_MIN_QUALITY) */
     if ((dir & TCC_DIR_MIDPOINT) && !(dir & TCC_DIR_USER) && after > 0.0)
@@ -289,7 +290,7 @@ inline int tcc_lazy_decide(int e, __global const int* edges, __global uchar* edg
                             fmax(q_min, TCC_END_POINT_MIN_QUALITY), field_eps, tets2quality, 0, TCC_NO_DEAD) != TCC_OK)
           continue;
         const double other = tcc_bound_after(a, b, d, tets, vt_off, vt, tet_nbr, labels, use_labels, pts, vfield,
-                                             vfield_stride, vflags, eps_col);
+                                             vfield_stride, vflags, eps_col, fmin(after, bound));
         if (other < after) {
           after = other;
           dir = d;

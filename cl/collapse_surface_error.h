@@ -52,8 +52,10 @@ TC_FN double tcc_fan_height(const double* pu, const double* pv, const double* ph
  * each in order, consistently oriented) and the new fan (nn) over the same boundary loop, or
  * INFINITY when it cannot be bounded this way (see the top). oid and nid name each corner: one
  * name, one point (the mesh's vertex ids, and for a point that moved a name no corner of the
- * other fan has, e.g. -1). */
-TC_FN double tcc_fan_distance(const tc_d3* olds, const int* oid, int no, const tc_d3* news, const int* nid, int nn) {
+ * other fan has, e.g. -1). INFINITY too as soon as a gap above `budget` is found: a caller that
+ * only asks whether the bound is at most that need not measure the rest. */
+TC_FN double tcc_fan_distance_within(const tc_d3* olds, const int* oid, int no, const tc_d3* news, const int* nid,
+                                     int nn, double budget) {
   if (no < 1 || nn < 1 || no > TCC_MAX_FAN || nn > TCC_MAX_FAN) return INFINITY;
   /* the mean plane: the sum of the old triangles' area vectors */
   tc_d3 nsum = TC_D3(0, 0, 0), o = olds[0];
@@ -137,6 +139,7 @@ TC_FN double tcc_fan_distance(const tc_d3* olds, const int* oid, int no, const t
                            : tcc_fan_height(ou, ov, oh, no, pu[j], pv[j], tol);
       double g = fabs(h - ph[j]);
       gap = g > gap ? g : gap;
+      if (gap + 1e-12 * scale > budget) return INFINITY;
     }
   }
   /* the crossings of the edges */
@@ -156,10 +159,20 @@ TC_FN double tcc_fan_distance(const tc_d3* olds, const int* oid, int no, const t
       double g = fabs((oh[i] + s * (oh[i2] - oh[i])) - (nh[j] + r * (nh[j2] - nh[j])));
       gap = g > gap ? g : gap;
     }
+    if (gap + 1e-12 * scale > budget) return INFINITY;
   }
   /* rounding: the heights are differences of coordinates of size `scale` */
   return gap + 1e-12 * scale;
 }
+
+TC_FN double tcc_fan_distance(const tc_d3* olds, const int* oid, int no, const tc_d3* news, const int* nid, int nn) {
+  return tcc_fan_distance_within(olds, oid, no, news, nid, nn, INFINITY);
+}
+
+/* The budget of tcc_fan_distance_within for a caller that keeps a change when base + the
+ * distance is at most `limit`: a little above limit - base, so that a distance cut short is
+ * beyond the limit after rounding as well (the cut then changes no verdict). */
+TC_FN double tcc_fan_budget(double limit, double base) { return limit - base + 1e-9 * fabs(limit); }
 
 #ifndef __OPENCL_C_VERSION__
 }  // namespace tc::geo

@@ -21,7 +21,8 @@ SeqMesh::CollapseEnds SeqMesh::collapse_ends(int32_t a, int32_t b, uint8_t dir) 
   return {x, y, p, !(py.x == p.x && py.y == p.y && py.z == p.z)};
 }
 
-double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base) {
+double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base,
+                               double limit) {
   *base = 0;
   const auto [x, y, p, moves_y] = collapse_ends(a, b, dir);
   if (!vflags_[x] && !(moves_y && vflags_[y])) return 0;  // S is not touched
@@ -59,7 +60,7 @@ double SeqMesh::surface_change(int32_t a, int32_t b, uint8_t dir, const std::vec
     ++nn;
   });
   if (!fits) return INFINITY;
-  return geo::tcc_fan_distance(olds, oid, no, news, nid, nn);
+  return geo::tcc_fan_distance_within(olds, oid, no, news, nid, nn, geo::tcc_fan_budget(limit, *base));
 }
 
 // On a curved face the midpoint lies on the chord and an end point on the surface: keeping the
@@ -73,7 +74,7 @@ uint8_t SeqMesh::closest_placement(int32_t a, int32_t b, uint8_t dir, const std:
   for (const uint8_t d : {uint8_t(TCC_DIR_REMOVE_V1), uint8_t(0)}) {
     if (!keeps_shape(a, b, d, TCC_END_POINT_MIN_QUALITY)) continue;
     double b2 = 0;
-    const double c = surface_change(a, b, d, eps, &b2);
+    const double c = surface_change(a, b, d, eps, &b2, *base + *change);  // (measured only while it may win)
     if (b2 + c < *base + *change) {
       *base = b2;
       *change = c;

@@ -30,6 +30,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -132,9 +133,11 @@ class SeqMesh {
   // The boundary error bound (CollapseOptions::max_boundary_error): a bound on the two-sided
   // Hausdorff distance between S before and after the collapse of (a, b) in direction dir
   // (cl/collapse_surface_error.h; 0 when S does not change, infinity when it cannot be bounded),
-  // and in *base the largest of eps over the vertices of the S faces it replaces. The run
-  // carries eps per vertex: the survivor's becomes *base + the bound.
-  double surface_change(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base);
+  // and in *base the largest of eps over the vertices of the S faces it replaces (infinity too
+  // once *base + the bound would pass `limit`). The run carries eps per vertex: the survivor's
+  // becomes *base + the bound.
+  double surface_change(int32_t a, int32_t b, uint8_t dir, const std::vector<double>& eps, double* base,
+                        double limit = INFINITY);
   // Beyond the paper, under the bound: for a collapse of S to the edge's midpoint (dir), the
   // direction among the midpoint and either end point kept that gives the smallest bound, an
   // end point only where the reshaped tets keep TCC_END_POINT_MIN_QUALITY (or what they had);

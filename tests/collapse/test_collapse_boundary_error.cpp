@@ -52,7 +52,7 @@ std::vector<tc_d3> fan_from_corner(int n) {
 
 // tcc_fan_distance of two fans given as points, each point named by its coordinates (one point,
 // one vertex).
-double fan_distance(const std::vector<tc_d3>& olds, const std::vector<tc_d3>& news) {
+double fan_distance(const std::vector<tc_d3>& olds, const std::vector<tc_d3>& news, double budget = INFINITY) {
   std::map<std::array<double, 3>, int> names;
   const auto ids = [&](const std::vector<tc_d3>& t) {
     std::vector<int> id;
@@ -60,8 +60,8 @@ double fan_distance(const std::vector<tc_d3>& olds, const std::vector<tc_d3>& ne
     return id;
   };
   const std::vector<int> oid = ids(olds), nid = ids(news);
-  return geo::tcc_fan_distance(olds.data(), oid.data(), int(olds.size() / 3), news.data(), nid.data(),
-                               int(news.size() / 3));
+  return geo::tcc_fan_distance_within(olds.data(), oid.data(), int(olds.size() / 3), news.data(), nid.data(),
+                                      int(news.size() / 3), budget);
 }
 
 TEST(BoundaryErrorFan, FlatPatchRetriangulatedMovesNothing) {
@@ -77,6 +77,30 @@ TEST(BoundaryErrorFan, ATentFlattenedMovesByItsHeight) {
     EXPECT_NEAR(d, h, 1e-9 + 0.05 * h) << h;
     EXPECT_GE(d, h * std::cos(std::atan(h / 0.9))) << "no less than the apex's distance to the plane";
   }
+}
+
+// A budget cuts the measure short only where the distance is above it: below, the same value.
+TEST(BoundaryErrorFan, ABudgetChangesNoVerdict) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> U(-0.3, 0.3);
+  int cut = 0;
+  for (int it = 0; it < 200; ++it) {
+    const auto olds = fan({U(rng), U(rng), U(rng)}, 5 + it % 6), news = fan_from_corner(5 + it % 6);
+    const double d = fan_distance(olds, news);
+    if (!std::isfinite(d)) continue;
+    const double budget = U(rng) + 0.3;  // [0, 0.6)
+    const double within = fan_distance(olds, news, budget);
+    if (d <= budget) {
+      EXPECT_EQ(within, d) << it;
+    } else {
+      EXPECT_TRUE(std::isinf(within)) << it;  // (above the budget either way)
+      ++cut;
+    }
+    // the budget callers give: base + distance against a limit, the verdict as without it
+    const double base = 0.1, limit = 0.1 + budget;
+    EXPECT_EQ(base + fan_distance(olds, news, geo::tcc_fan_budget(limit, base)) <= limit, base + d <= limit) << it;
+  }
+  EXPECT_GT(cut, 20);
 }
 
 TEST(BoundaryErrorFan, FoldedFanGetsNoBound) {
