@@ -146,6 +146,10 @@ class Pieces {
     return d;
   }
 
+  bool holds(const std::array<int32_t, 3>& c, int32_t f) {
+    return d2(c[0], f) <= e2_ && d2(c[1], f) <= e2_ && d2(c[2], f) <= e2_;
+  }
+
   bool piece(std::array<int32_t, 3> c, const std::vector<int32_t>& feats, int depth) {
     if (stop && stop->load(std::memory_order_relaxed)) return false;
     const Tri P = {pts_[size_t(c[0])], pts_[size_t(c[1])], pts_[size_t(c[2])]};
@@ -157,9 +161,11 @@ class Pieces {
       const tc_d3 d = m - centroids_[size_t(f)];
       L.order.push_back({dot(d, d), f});
     }
+    // most pieces are certified by the nearest: the order of the others only when it fails
+    if (!L.order.empty() && holds(c, std::min_element(L.order.begin(), L.order.end())->second)) return true;
     std::sort(L.order.begin(), L.order.end());
     for (const auto& [key, f] : L.order)
-      if (d2(c[0], f) <= e2_ && d2(c[1], f) <= e2_ && d2(c[2], f) <= e2_) return true;
+      if (holds(c, f)) return true;
     if (two_cover(c, L.order)) return true;
     // (whether the piece matters at all only now: most pieces are certified before)
     if (relevant_ && !(*relevant_)(P)) return true;
