@@ -156,13 +156,64 @@ void ImpMesh::grid_insert(int32_t f) {
   each_cell(box, [&](int64_t c) { grid_[c].push_back(f); });
 }
 
+std::vector<uint8_t> ImpMesh::surface_slots() const {
+  // Each face met once, at its smallest vertex: the faces of that vertex's tets that it is the
+  // smallest of, sorted by their other two vertices, pair up (one pass over the tets instead of
+  // a search of a vertex's tets per face, as on_surface makes).
+  std::vector<uint8_t> surface(4 * size_t(num_tet_slots()), 0);
+  std::vector<std::pair<uint64_t, int32_t>> faces;  // (b << 32 | c, 4 t + f)
+  for (int32_t v = 0; v < num_vertices(); ++v) {
+    faces.clear();
+    for (int32_t t : vtets_[size_t(v)]) {
+      const Tet& q = tets_[size_t(t)];
+      for (int f = 0; f < 4; ++f) {
+        if (q[size_t(f)] == v) continue;  // (the face opposite v)
+        const auto& F = geo::TC_TET_FACES[f];
+        int32_t b = -1, c = -1;  // the face's other two vertices, both above v
+        for (int k = 0; k < 3; ++k) {
+          const int32_t w = q[size_t(F[k])];
+          if (w == v) continue;
+          if (w < v) b = c = -2;
+          else if (b == -1) b = w;
+          else if (c == -1) c = w;
+        }
+        if (b < 0 || c < 0) continue;
+        if (b > c) std::swap(b, c);
+        faces.push_back({uint64_t(uint32_t(b)) << 32 | uint32_t(c), 4 * t + f});
+      }
+    }
+    std::sort(faces.begin(), faces.end());
+    for (size_t i = 0; i < faces.size();) {
+      size_t j = i + 1;
+      while (j < faces.size() && faces[j].first == faces[i].first) ++j;
+      const int32_t s0 = faces[i].second, s1 = faces[i + 1 < j ? i + 1 : i].second;
+      if (j - i == 1) {
+        surface[size_t(s0)] = 1;
+      } else if (j - i == 2) {
+        surface[size_t(s0)] = surface[size_t(s1)] = label_[size_t(s0 / 4)] != label_[size_t(s1 / 4)];
+      } else {  // (not a manifold: as on_surface decides it)
+        for (size_t k = i; k < j; ++k) {
+          const int32_t t = faces[k].second / 4;
+          const auto& F = geo::TC_TET_FACES[faces[k].second % 4];
+          const Tet& q = tets_[size_t(t)];
+          surface[size_t(faces[k].second)] = on_surface(t, q[size_t(F[0])], q[size_t(F[1])], q[size_t(F[2])]);
+        }
+      }
+      i = j;
+    }
+  }
+  return surface;
+}
+
 void ImpMesh::build_surface_grid() {
   double total = 0;
+  const std::vector<uint8_t> surface = surface_slots();
   for (int32_t t = 0; t < num_tet_slots(); ++t) {
     const Tet& q = tets_[size_t(t)];
-    for (const auto& F : geo::TC_TET_FACES) {
+    for (int f = 0; f < 4; ++f) {
+      const auto& F = geo::TC_TET_FACES[f];
       const int32_t a = q[size_t(F[0])], b = q[size_t(F[1])], c = q[size_t(F[2])];
-      if (!on_surface(t, a, b, c)) continue;
+      if (!surface[4 * size_t(t) + size_t(f)]) continue;
       const FaceKey k = face_key(a, b, c);
       if (sface_index_.emplace(k, int32_t(sfaces_.size())).second) {
         sfaces_.push_back(k);

@@ -167,6 +167,8 @@ class ImpMesh {
   double cell_ = 0;
   tc_d3 grid_origin_{0, 0, 0};
   void build_surface_grid();
+  // Per tet slot and face (4 t + f): whether the face is on the surface (on_surface), all at once.
+  std::vector<uint8_t> surface_slots() const;
   void grid_insert(int32_t f);
   using CellBox = std::array<int64_t, 6>;  // lowest and highest cell indices
   std::vector<CellBox> sface_cells_;       // per surface triangle: the cells it is listed in
