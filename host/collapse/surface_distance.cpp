@@ -140,9 +140,17 @@ class Pieces {
     dist_.resize(dist_.size() + feats_->size(), -1.0);
     return int32_t(pts_.size() - 1);
   }
+  // The squared distance of point p to feature f, or, when the feature's box is farther than e,
+  // that box's: every use compares it with e2, and both are then above it.
   double d2(int32_t p, int32_t f) {
     double& d = dist_[size_t(p) * feats_->size() + size_t(f)];
-    if (d < 0) d = point_triangle_dist2(pts_[size_t(p)], *(*feats_)[size_t(f)]);
+    if (d < 0) {
+      const tc_d3 q = pts_[size_t(p)], lo = lo_[size_t(f)], hi = hi_[size_t(f)];
+      const double dx = std::max({lo.x - q.x, 0.0, q.x - hi.x}), dy = std::max({lo.y - q.y, 0.0, q.y - hi.y}),
+                   dz = std::max({lo.z - q.z, 0.0, q.z - hi.z});
+      const double box = dx * dx + dy * dy + dz * dz;
+      d = box > e2_ ? box : point_triangle_dist2(q, *(*feats_)[size_t(f)]);
+    }
     return d;
   }
 
