@@ -116,7 +116,7 @@ TC_FN double tcc_fan_distance_within(const tc_d3* olds, const int* oid, int no, 
       const int j2 = j % 3 == 2 ? j - 2 : j + 1, a = pid[j], b = pid[j2];
       int own_v = 1, own_e = 1;
       /* by triangles (two distinct corners of one are an edge of it, one way or the other) */
-      for (int t = 0; t < m && own_e; ++t) {
+      for (int t = 0; t < m && (own_v || own_e); ++t) {
         const int c0 = qid[3 * t], c1 = qid[3 * t + 1], c2 = qid[3 * t + 2];
         const int has_a = c0 == a || c1 == a || c2 == a, has_b = c0 == b || c1 == b || c2 == b;
         own_v &= !has_a;
@@ -125,12 +125,10 @@ TC_FN double tcc_fan_distance_within(const tc_d3* olds, const int* oid, int no, 
         else
           own_e &= !(has_a && has_b);
       }
-      for (int t = 0; t < m && own_v; ++t) /* (the rest of the vertex's test, once the edge's ended) */
-        own_v &= qid[3 * t] != a && qid[3 * t + 1] != a && qid[3 * t + 2] != a;
       /* the same edge, the other way, earlier in this fan */
       for (int t = 0; 3 * t < j && own_e; ++t) {
         const int p0 = pid[3 * t], p1 = pid[3 * t + 1], p2 = pid[3 * t + 2];
-        own_e = !((p0 == b && p1 == a && 3 * t < j) || (p1 == b && p2 == a && 3 * t + 1 < j) ||
+        own_e = !((p0 == b && p1 == a) || (p1 == b && p2 == a && 3 * t + 1 < j) ||
                   (p2 == b && p0 == a && 3 * t + 2 < j));
       }
       v_own[side][j] = (unsigned char)own_v;
