@@ -86,6 +86,13 @@ void box_of(const Tri& t, tc_d3& lo, tc_d3& hi) {
 
 namespace {
 
+// The squared distance from p to the box [lo, hi]: at most p's to anything in the box.
+double box_dist2(tc_d3 p, tc_d3 lo, tc_d3 hi) {
+  const double dx = std::max({lo.x - p.x, 0.0, p.x - hi.x}), dy = std::max({lo.y - p.y, 0.0, p.y - hi.y}),
+               dz = std::max({lo.z - p.z, 0.0, p.z - hi.z});
+  return dx * dx + dy * dy + dz * dz;
+}
+
 bool boxes_apart(tc_d3 alo, tc_d3 ahi, tc_d3 blo, tc_d3 bhi, double pad) {
   return alo.x > bhi.x + pad || ahi.x < blo.x - pad || alo.y > bhi.y + pad || ahi.y < blo.y - pad ||
          alo.z > bhi.z + pad || ahi.z < blo.z - pad;
@@ -145,10 +152,8 @@ class Pieces {
   double d2(int32_t p, int32_t f) {
     double& d = dist_[size_t(p) * feats_->size() + size_t(f)];
     if (d < 0) {
-      const tc_d3 q = pts_[size_t(p)], lo = lo_[size_t(f)], hi = hi_[size_t(f)];
-      const double dx = std::max({lo.x - q.x, 0.0, q.x - hi.x}), dy = std::max({lo.y - q.y, 0.0, q.y - hi.y}),
-                   dz = std::max({lo.z - q.z, 0.0, q.z - hi.z});
-      const double box = dx * dx + dy * dy + dz * dz;
+      const tc_d3 q = pts_[size_t(p)];
+      const double box = box_dist2(q, lo_[size_t(f)], hi_[size_t(f)]);
       d = box > e2_ ? box : point_triangle_dist2(q, *(*feats_)[size_t(f)]);
     }
     return d;
