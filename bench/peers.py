@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Peers a user would pick instead of tetcollapse, on the same input and target (issue 6).
+"""Peers a user would pick instead of tetcollapse, on the same input and target.
 
     bench/peers.py --mesh M --target-length L [--tetcollapse PATH] [--reps N] --out-json F
                    [--cgal-peer PATH] [--mmg3d PATH] [--tetgen PATH] [--peers a,b,...]

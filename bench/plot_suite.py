@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Plots and markdown tables of a bench/run_suite.py result (issue 6).
+"""Plots and markdown tables of a bench/run_suite.py result.
 
     bench/plot_suite.py [RESULT.json] [--out-dir DIR] [--markdown FILE] [--no-plots] [--parts fig7,fig8,table2,fig9]
 
@@ -9,7 +9,7 @@ RESULT.json defaults to bench/results/suite.json. Writes, with Debian's matplotl
                         logarithmic time axis (paper Fig. 8)
   DIR/fig9.png          run time and tets left against eps_c, ours (paper Fig. 9)
 DIR defaults to bench/plots, or bench/plots/smoke for a result labelled "smoke".
-Prints markdown tables (Fig. 7 iterations and the goals of issue 6, Fig. 8, Table 2, Fig. 9,
+Prints markdown tables (Fig. 7 iterations and the suite's goals, Fig. 8, Table 2, Fig. 9,
 failures) on stdout, and into --markdown FILE when given. --parts limits both to those parts (e.g. to
 redraw only fig8 from a result whose other parts newer files supersede). The tables of bench/README.md
 are written by bench/make_tables.py, which takes each part from the newest result holding it.

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Benchmark suite of issue 6: the paper's Fig. 7, Fig. 8, Table 2 and Fig. 9 with the tetcollapse CLI.
+"""The benchmark suite: the paper's Fig. 7, Fig. 8, Table 2 and Fig. 9 with the tetcollapse CLI.
 
     bench/run_suite.py [--cli PATH] [--meshes DIR] [--out FILE] [--parts fig7,fig8,table2,fig9]
                        [--reps N] [--seq-reps N] [--method-reps M=N,...] [--quick [--quick-mesh M]]
@@ -28,7 +28,7 @@ with the last line of its error output, and the suite goes on with the others.
 
 Parts (paper section 4):
   fig7    collapses per iteration below the median edge length (--target-factor 1, eps_c 0) on
-          Block 250k and featuretype 497k; the goals of issue 6: ours needs <= 1.5 x the iterations
+          Block 250k and featuretype 497k; the goals: ours needs <= 1.5 x the iterations
           of sequential and >= 50% fewer than atomic-min (printed PASS / FAIL / UNKNOWN).
   fig8    run time against the threshold, K thresholds from the minimum to the median edge length
           (from `tetcollapse info --json`), on Block 250k, featuretype 497k and fusee 88k:
@@ -451,7 +451,7 @@ def fmt(x, digits=3):
 
 
 def fig7_goals(entries):
-    """Issue 6: ours <= 1.5 x the iterations of sequential; ours >= 50% fewer than atomic-min.
+    """The goals: ours <= 1.5 x the iterations of sequential; ours >= 50% fewer than atomic-min.
     Iterations = iterations that collapsed at least one edge (the final empty iteration that every
     method runs to detect convergence is not counted); compared per device."""
     seq = next((e for e in entries if e["method"] == "sequential"), None)
@@ -603,7 +603,7 @@ def main():
         a.methods = [m for m in a.methods if m not in DEVICE_METHODS]
 
     result = {
-        "suite": "tetcollapse benchmark suite, issue 6 (paper section 4: Fig. 7, Fig. 8, Table 2, Fig. 9)",
+        "suite": "tetcollapse benchmark suite (paper section 4: Fig. 7, Fig. 8, Table 2, Fig. 9)",
         "label": a.label,
         "note": (f"SMOKE RUN: {a.reps} repetition(s), meshes {sorted(set(a.fig7_meshes + a.fig8_meshes + [a.w1_mesh]))}; "
                  "a test of the scripts, not a measurement to quote"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Benchmark suite of issue 6: builds tetcollapse (Release) and runs bench/run_suite.py, then
+# The benchmark suite: builds tetcollapse (Release) and runs bench/run_suite.py, then
 # bench/plot_suite.py (PNGs in bench/plots/, markdown tables in bench/results/<name>.md).
 #   scripts/bench.sh [run_suite.py options]        e.g. scripts/bench.sh --quick
 # BUILD_DIR (default build/) and JOBS (default nproc) as for scripts/build.sh; NO_PEER_BUILD=1 does not build bench_peer_cgal. Needs Debian's

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Generates the robustness corpus: a few hundred varied tetrahedral meshes (issue 6).
+"""Generates the robustness corpus: a few hundred varied tetrahedral meshes.
 
     scripts/make_corpus.py [OUT_DIR] [--jobs N] [--only NAME,...] [--ci-sample] [--list]
 
