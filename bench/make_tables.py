@@ -23,6 +23,7 @@ results files:
     improve_slivers bench/results/improve_slivers.json                  (bench/improve_slivers.py; its table)
     improve_paths   bench/results/improve_paths.json                    (bench/improve_paths.py; its tables)
     volume_rendering bench/results/volume_rendering.json               (bench/volume_rendering.py; its table)
+    field_generality bench/results/field_generality.json               (bench/field_generality.py; its table)
     cold_start      bench/results/cold_start.json                       (bench/cold_start.py; its table)
     mpi_scale       bench/results/mpi_scale.json                        (bench/mpi_scale.py; its table)
     mpi_scale_10m   bench/results/mpi_scale_10m.json                    (the same on the 10.7M-tet mesh)
@@ -375,6 +376,7 @@ BLOCKS = {
     "improve_slivers": lambda: recorded_block("improve_slivers", "improve_slivers"),
     "improve_paths": lambda: recorded_block("improve_paths", "improve_paths"),
     "volume_rendering": lambda: recorded_block("volume_rendering", "volume_rendering"),
+    "field_generality": lambda: recorded_block("field_generality", "field_generality"),
     "cold_start": lambda: recorded_block("cold_start", "cold_start"),
     "python_overhead": lambda: recorded_block("python_overhead", "python_overhead"),
     "mpi_scale": lambda: printed_block("mpi_scale", "mpi_scale"),
