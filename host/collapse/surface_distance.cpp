@@ -5,6 +5,8 @@
 #include <atomic>
 #include <cmath>
 #include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
 #include <mutex>
 #include <thread>
 
@@ -295,6 +297,21 @@ bool within(const Tri& P, const std::vector<const Tri*>& feats, double e2, int d
 
 namespace {
 int64_t cell_key(int64_t i, int64_t j, int64_t k) { return (i * 2097152 + j) * 2097152 + k; }
+
+// TETCOLLAPSE_RECORD_CHECKS=FILE: the process's first reference surface and every change_ok
+// against it are written to FILE (kRecordMagic, the triangles, then per check olds, news, around,
+// e and reach), which bench/bench_measured_check replays: the check timed alone, without the
+// rest of a run's noise. Only the first surface: a later one (a second cycle) is the same.
+std::FILE* g_record = nullptr;
+std::atomic<const ReferenceSurface*> g_recorded{nullptr};
+bool g_record_taken = false;  // (once per process)
+std::mutex g_record_mutex;
+
+void record_tris(std::FILE* f, const std::vector<Tri>& t) {
+  const uint64_t n = t.size();
+  std::fwrite(&n, sizeof n, 1, f);
+  std::fwrite(t.data(), sizeof(Tri), t.size(), f);
+}
 }  // namespace
 
 ReferenceSurface::ReferenceSurface(const std::vector<double>& triangles) {
@@ -320,6 +337,15 @@ ReferenceSurface::ReferenceSurface(const std::vector<double>& triangles) {
     for (int64_t a = c(lo.x, origin_.x); a <= c(hi.x, origin_.x); ++a)
       for (int64_t b = c(lo.y, origin_.y); b <= c(hi.y, origin_.y); ++b)
         for (int64_t d = c(lo.z, origin_.z); d <= c(hi.z, origin_.z); ++d) cells_[cell_key(a, b, d)].push_back(i);
+  }
+  if (const char* path = std::getenv("TETCOLLAPSE_RECORD_CHECKS"); path && *path) {
+    std::lock_guard<std::mutex> lock(g_record_mutex);
+    if (!g_record_taken && (g_record = std::fopen(path, "wb"))) {
+      g_record_taken = true;
+      g_recorded = this;
+      std::fwrite(kRecordMagic, 1, sizeof kRecordMagic, g_record);
+      record_tris(g_record, tris_);
+    }
   }
 }
 
@@ -395,10 +421,47 @@ class ReferenceSurface::Helper {
   std::thread thread_;  // (last: started once the members above exist)
 };
 
-ReferenceSurface::~ReferenceSurface() = default;
+bool read_recorded_checks(const char* path, std::vector<double>& reference, std::vector<RecordedCheck>& checks) {
+  std::FILE* f = std::fopen(path, "rb");
+  if (!f) return false;
+  auto tris = [&](std::vector<Tri>& out) {
+    uint64_t n = 0;
+    if (std::fread(&n, sizeof n, 1, f) != 1 || n > (uint64_t(1) << 32)) return false;
+    out.resize(size_t(n));
+    return std::fread(out.data(), sizeof(Tri), out.size(), f) == out.size();
+  };
+  char magic[sizeof kRecordMagic];
+  std::vector<Tri> ref;
+  const bool ok = std::fread(magic, 1, sizeof magic, f) == sizeof magic &&
+                  std::equal(magic, magic + sizeof magic, kRecordMagic) && tris(ref);
+  checks.clear();
+  for (RecordedCheck c; ok && tris(c.olds) && tris(c.news) && tris(c.around) &&
+                        std::fread(&c.e, sizeof c.e, 1, f) == 1 && std::fread(&c.reach, sizeof c.reach, 1, f) == 1;)
+    checks.push_back(c);
+  std::fclose(f);
+  reference.clear();
+  for (const Tri& t : ref)
+    for (const tc_d3& p : t) reference.insert(reference.end(), {p.x, p.y, p.z});
+  return ok;
+}
+
+ReferenceSurface::~ReferenceSurface() {
+  std::lock_guard<std::mutex> lock(g_record_mutex);
+  if (g_recorded == this) {
+    std::fclose(g_record);
+    g_record = nullptr;
+    g_recorded = nullptr;
+  }
+}
 
 bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector<Tri>& news,
                                  const std::vector<Tri>& around, double e, double reach) const {
+  if (g_recorded.load(std::memory_order_relaxed) == this) {
+    std::lock_guard<std::mutex> lock(g_record_mutex);
+    for (const auto* set : {&olds, &news, &around}) record_tris(g_record, *set);
+    std::fwrite(&e, sizeof e, 1, g_record);
+    std::fwrite(&reach, sizeof reach, 1, g_record);
+  }
   if (olds.empty() && news.empty()) return true;
   // (a margin for the rounding of the distances, far below any bound asked for)
   e *= 1 - 1e-9;

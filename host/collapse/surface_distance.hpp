@@ -33,6 +33,18 @@ void box_of(const Tri& t, tc_d3& lo, tc_d3& hi);
 bool within(const Tri& piece, const std::vector<const Tri*>& features, double e2, int depth,
             const std::function<bool(const Tri&)>* relevant = nullptr);
 
+// The first bytes of a file of checks recorded with TETCOLLAPSE_RECORD_CHECKS (surface_distance.cpp).
+inline constexpr char kRecordMagic[8] = {'t', 'c', 'c', 'h', 'e', 'c', 'k', '1'};
+
+// One recorded ReferenceSurface::change_ok: its arguments.
+struct RecordedCheck {
+  std::vector<Tri> olds, news, around;
+  double e = 0, reach = 0;
+};
+// Reads such a file: the reference's triangles (9 coordinates each, as ReferenceSurface takes
+// them) and the checks; false when it is not one.
+bool read_recorded_checks(const char* path, std::vector<double>& reference, std::vector<RecordedCheck>& checks);
+
 // The input's S (triangles, 9 coordinates each) in a uniform grid of cells of twice its mean
 // edge length.
 class ReferenceSurface {

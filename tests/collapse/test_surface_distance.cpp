@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
+#include <string>
 
 #include "collapse/surface_distance.hpp"
 #include "test_support.hpp"
@@ -141,6 +143,41 @@ TEST(SurfaceDistance, FlatteningATentIsMadeOnlyWithinTheBound) {
     const surface_distance::ReferenceSurface ref(t.reference);
     EXPECT_EQ(ref.change_ok(t.olds, t.news, {}, e, e), h <= 0.9 * e) << h;
   }
+}
+
+// TETCOLLAPSE_RECORD_CHECKS records the first reference surface and its checks, which replay
+// (bench/bench_measured_check) to the same verdicts; nothing is written without it.
+TEST(SurfaceDistance, RecordedChecksReplayToTheSameVerdicts) {
+  const test::TempDir dir;
+  const std::string path = dir.file("checks.bin");
+  const Tent t = tent(0.01);  // flattened: within e exactly when e is at least its height
+  const std::vector<double> bounds = {0.005, 0.009, 0.012, 0.03};
+  std::vector<bool> verdicts;
+  {
+    auto record = std::make_unique<const test::EnvVar>("TETCOLLAPSE_RECORD_CHECKS", path);
+    const surface_distance::ReferenceSurface ref(t.reference);
+    record.reset();
+    const surface_distance::ReferenceSurface other(tent(0.02).reference);  // (not recorded)
+    for (double e : bounds) {
+      verdicts.push_back(ref.change_ok(t.olds, t.news, {}, e, e));
+      other.change_ok(t.olds, t.news, {}, e, e);
+    }
+  }
+  EXPECT_EQ(verdicts, (std::vector<bool>{false, false, true, true}));
+  std::vector<double> reference;
+  std::vector<surface_distance::RecordedCheck> checks;
+  ASSERT_TRUE(surface_distance::read_recorded_checks(path.c_str(), reference, checks));
+  EXPECT_EQ(reference, t.reference);
+  ASSERT_EQ(checks.size(), verdicts.size());
+  const surface_distance::ReferenceSurface replay(reference);
+  for (size_t i = 0; i < checks.size(); ++i) {
+    const auto& c = checks[i];
+    EXPECT_EQ(c.e, bounds[i]);
+    EXPECT_EQ(c.news.size(), t.news.size());
+    EXPECT_EQ(replay.change_ok(c.olds, c.news, c.around, c.e, c.reach), verdicts[i]) << i;
+  }
+  std::vector<double> none;
+  EXPECT_FALSE(surface_distance::read_recorded_checks(dir.file("missing.bin").c_str(), none, checks));
 }
 
 // Direction from the reference: a new S far from the old one fails through the reference
