@@ -237,7 +237,10 @@ def robustness_block():
              f"Recorded: `{rel(path)}` (every run: `bench/robustness/README.md`); commit {d['commit']}; {d['machine']}; "
              f"device {d['device']}; {d['jobs']} jobs, {d['wall_seconds']:.0f} s.", "",
              f"**{s['meshes']} meshes, {s['runs']} runs: {s['valid']} valid, {s['invalid']} invalid, {s['error']} errors** "
-             f"(crash, refused input or timeout); {s.get('input_invalid', 0)} runs on inputs the checker finds invalid.",
+             f"(crash, refused input or timeout); {s.get('input_invalid', 0)} runs on inputs the checker finds invalid."
+             + (f" In features mode the largest boundary distance measured is "
+                f"{s['features_hausdorff_over_bound_max']:.3f} x the run's boundary error bound."
+                if s.get("features_hausdorff_over_bound_max") is not None else ""),
              "", "| method | runs | valid | tets in | tets out (features) | tets out (strict) | iterations, median "
              "(features / strict) | CLI seconds, sum |", "|---|---:|---:|---:|---:|---:|---:|---:|"]
     methods = d.get("methods_run") or sorted({r["method"] for r in d["results"]})
