@@ -73,9 +73,7 @@ def main():
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--out-json", default=os.path.join(HERE, "results", "cold_start.json"))
     a = ap.parse_args()
-    tc = os.path.abspath(a.tetcollapse or peers.default_tetcollapse() or "")
-    if not os.access(tc, os.X_OK):
-        sys.exit("cold_start.py: no tetcollapse binary (give --tetcollapse PATH)")
+    tc = peers.tetcollapse_or_exit(a.tetcollapse, "cold_start.py")
     doc = dict(peers.provenance("cold_start.py", tc), rows=[], runs=a.runs)
     if a.baseline:
         doc["baseline"] = a.baseline_label or a.baseline

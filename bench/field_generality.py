@@ -34,7 +34,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 import peers  # noqa: E402
-from volume_rendering import SHARED, with_field  # noqa: E402
+from volume_rendering import SHARED, judged, vtk_or_exit, with_field  # noqa: E402
 
 MESHES = ("gen_tetgen_featuretype_497k.msh", "gen_gmsh_Block_250k.msh", "gen_gmsh_917_fusee_88k.msh")
 
@@ -91,13 +91,8 @@ def main():
     ap.add_argument("--tetcollapse", default=None)
     ap.add_argument("--out-json", default=os.path.join(HERE, "results", "field_generality.json"))
     a = ap.parse_args()
-    tc = os.path.abspath(a.tetcollapse or peers.default_tetcollapse() or "")
-    if not os.access(tc, os.X_OK):
-        sys.exit("field_generality.py: no tetcollapse binary (give --tetcollapse PATH)")
-    try:
-        import vtk
-    except ImportError:
-        sys.exit("field_generality.py: needs VTK's Python module (Debian python3-vtk9; scripts/setup.sh --with-tools)")
+    tc = peers.tetcollapse_or_exit(a.tetcollapse, "field_generality.py")
+    vtk = vtk_or_exit("field_generality.py")
     sys.path.insert(0, os.path.join(ROOT, "scripts"))
     import render_dvr  # noqa: E402
     doc = dict(peers.provenance("field_generality.py", tc), rows=[])
@@ -119,18 +114,10 @@ def main():
                     subprocess.run(cmd, check=True)
                     with open(stats) as f:
                         st = json.load(f)
-                    c = subprocess.run([tc, "check", out, "--reference", vtu, "--json", "-", "-q"],
-                                       capture_output=True, text=True)
-                    ref = json.loads(c.stdout)["reference"]
-                    fe = next(x for x in ref["fields"] if x["name"] == name)
+                    measured, ref = judged(tc, vtu, out, st, name)
                     row = {"data": os.path.splitext(mesh)[0].replace("gen_tetgen_", "").replace("gen_gmsh_", ""),
-                           "field": name, "T": 0.02, "vertices_in": st["vertices_in"],
-                           "vertices_out": st["vertices_out"],
-                           "vertex_reduction": 1 - st["vertices_out"] / st["vertices_in"],
-                           "volume_kept": 1 + ref["volume_change_rel"], "rms_rel": fe["rms_rel"],
-                           "max_rel": fe["max_rel"], "max_vertex_rel": fe["max_vertex_rel"],
-                           "hausdorff_over_bound": ref["hausdorff"] / st["boundary_error_bound"],
-                           "seconds": st["seconds_collapse"]}
+                           "field": name, "T": 0.02, **measured,
+                           "hausdorff_over_bound": ref["hausdorff"] / st["boundary_error_bound"]}
                     if bound:
                         row["E"] = bound
                     row["psnr"] = render_dvr.compare(vtu, out, name, None)["psnr"]

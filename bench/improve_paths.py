@@ -72,9 +72,7 @@ def main():
     ap.add_argument("--reps", type=int, default=5)
     ap.add_argument("--out-json", default=os.path.join(HERE, "results", "improve_paths.json"))
     a = ap.parse_args()
-    tc = os.path.abspath(a.tetcollapse or peers.default_tetcollapse() or "")
-    if not os.access(tc, os.X_OK):
-        sys.exit("improve_paths.py: no tetcollapse binary (give --tetcollapse PATH)")
+    tc = peers.tetcollapse_or_exit(a.tetcollapse, "improve_paths.py")
     mesh = os.path.join(SHARED, a.mesh)
     if not os.path.exists(mesh):
         sys.exit(f"improve_paths.py: {a.mesh} is not in {SHARED}")

@@ -50,9 +50,7 @@ def main():
     ap.add_argument("--reps", type=int, default=1)
     ap.add_argument("--out-json", default=os.path.join(HERE, "results", "improve_slivers.json"))
     a = ap.parse_args()
-    tc = os.path.abspath(a.tetcollapse or peers.default_tetcollapse() or "")
-    if not os.access(tc, os.X_OK):
-        sys.exit("improve_slivers.py: no tetcollapse binary (give --tetcollapse PATH)")
+    tc = peers.tetcollapse_or_exit(a.tetcollapse, "improve_slivers.py")
     doc = dict(peers.provenance("improve_slivers.py", tc), reps=a.reps, rows=[])
     for name in a.meshes.split(","):
         mesh = os.path.join(SHARED, name)

@@ -104,6 +104,15 @@ def default_tetcollapse():
     return shutil.which("tetcollapse")
 
 
+def tetcollapse_or_exit(given, script):
+    """The CLI a bench script runs: `given` (its --tetcollapse), else the build's; exits with a
+    message when there is none."""
+    tc = os.path.abspath(given or default_tetcollapse() or "")
+    if not os.access(tc, os.X_OK):
+        sys.exit(f"{script}: no tetcollapse binary (give --tetcollapse PATH)")
+    return tc
+
+
 def table_asked(table):
     """`SCRIPT --table F.json`: prints the markdown table(s) `table` makes of a results file, and
     says so (the script then stops)."""

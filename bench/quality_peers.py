@@ -73,9 +73,7 @@ def main():
     ap.add_argument("--timeout", type=float, default=600, help="seconds per command (a peer over it is skipped)")
     ap.add_argument("--out-json", default=os.path.join(HERE, "results", "quality_peers.json"))
     a = ap.parse_args()
-    tc = os.path.abspath(a.tetcollapse or peers.default_tetcollapse() or "")
-    if not os.access(tc, os.X_OK):
-        sys.exit("quality_peers.py: no tetcollapse binary (give --tetcollapse PATH)")
+    tc = peers.tetcollapse_or_exit(a.tetcollapse, "quality_peers.py")
     if not os.path.isdir(SHARED):
         sys.exit(f"quality_peers.py: no shared meshes at {SHARED}")
     names = a.meshes.split(",") if a.meshes else sorted(

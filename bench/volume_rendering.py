@@ -104,6 +104,28 @@ def with_field(vtk, src, dst, name, fn):
     w.Write()
 
 
+def vtk_or_exit(script):
+    """VTK's Python module, which writes the fields and renders; exits with a message without it."""
+    try:
+        import vtk
+    except ImportError:
+        sys.exit(f"{script}: needs VTK's Python module (Debian python3-vtk9; scripts/setup.sh --with-tools)")
+    return vtk
+
+
+def judged(tc, vtu, out, stats, field):
+    """What a run with --preserve-field is judged by: its stats (vertices, tets, time) and
+    `tetcollapse check OUT --reference IN` (volume kept, field RMS and max, max at the input's
+    vertices); with the check's reference report, for what a caller adds."""
+    c = subprocess.run([tc, "check", out, "--reference", vtu, "--json", "-", "-q"], capture_output=True, text=True)
+    ref = json.loads(c.stdout)["reference"]
+    fe = next(x for x in ref["fields"] if x["name"] == field)
+    return {"vertices_in": stats["vertices_in"], "vertices_out": stats["vertices_out"],
+            "vertex_reduction": 1 - stats["vertices_out"] / stats["vertices_in"], "tets_out": stats["tets_out"],
+            "volume_kept": 1 + ref["volume_change_rel"], "rms_rel": fe["rms_rel"], "max_rel": fe["max_rel"],
+            "max_vertex_rel": fe["max_vertex_rel"], "seconds": stats["seconds_collapse"]}, ref
+
+
 def main():
     if peers.table_asked(table):
         return
@@ -113,14 +135,8 @@ def main():
     ap.add_argument("--no-render", action="store_true")
     ap.add_argument("--images", default=os.path.join(HERE, "plots", "volume_rendering"))
     a = ap.parse_args()
-    tc = os.path.abspath(a.tetcollapse or peers.default_tetcollapse() or "")
-    if not os.access(tc, os.X_OK):
-        sys.exit("volume_rendering.py: no tetcollapse binary (give --tetcollapse PATH)")
-    try:
-        import vtk  # noqa: F401
-    except ImportError:
-        sys.exit("volume_rendering.py: needs VTK's Python module (Debian python3-vtk9; scripts/setup.sh --with-tools)")
-    import vtk
+    tc = peers.tetcollapse_or_exit(a.tetcollapse, "volume_rendering.py")
+    vtk = vtk_or_exit("volume_rendering.py")
     doc = dict(peers.provenance("volume_rendering.py", tc), rows=[])
     render = None
     if not a.no_render:
@@ -172,17 +188,9 @@ def main():
                 continue
             with open(stats) as f:
                 st = json.load(f)
-            c = subprocess.run([tc, "check", out, "--reference", vtu, "--json", "-", "-q"], capture_output=True,
-                               text=True)
-            rep = json.loads(c.stdout)
-            ref = rep["reference"]
-            fe = next(x for x in ref["fields"] if x["name"] == field)
             row = {"data": os.path.splitext(mesh)[0].replace("gen_tetgen_", ""), "field": field,
-                   "mode": mode + (", " + variant if variant else ""), "T": t, "vertices_in": st["vertices_in"],
-                   "vertices_out": st["vertices_out"], "vertex_reduction": 1 - st["vertices_out"] / st["vertices_in"],
-                   "tets_out": st["tets_out"], "volume_kept": 1 + ref["volume_change_rel"],
-                   "rms_rel": fe["rms_rel"], "max_rel": fe["max_rel"], "max_vertex_rel": fe["max_vertex_rel"],
-                   "seconds": st["seconds_collapse"]}
+                   "mode": mode + (", " + variant if variant else ""), "T": t}
+            row.update(judged(tc, vtu, out, st, field)[0])
             if t is None:
                 row["E"] = BOUND
             if render and (t == 0.02 or t is None):
