@@ -32,7 +32,7 @@ Settings make_settings(Options& o) {
   c.eps_f = o.eps_f;
   c.eps_r = o.eps_r;
   c.eps_v = o.eps_v;
-  c.eps_v_relative = o.eps_v_relative;
+  c.eps_v_scale = cli::volume_scale(o.eps_v_scale);
   c.min_quality = o.min_quality;
   if (o.target_factor > 0) c.target_factor = o.target_factor;
   c.eps_c = o.eps_c;
@@ -120,7 +120,7 @@ int run(Options& o, MPI_Comm comm) {
   double shared[3] = {s.collapse.target_length, s.collapse.eps_v, s.whole_diagonal};
   bcast(shared, 3, comm);
   s.collapse.target_length = shared[0], s.collapse.eps_v = shared[1], s.whole_diagonal = shared[2];
-  s.collapse.eps_v_relative = false;
+  s.collapse.eps_v_scale = CollapseOptions::Absolute;
   stats.target_length = s.collapse.target_length;
   if (field_bound) {
     uint64_t nc = s.field_range.size();

@@ -22,9 +22,7 @@ void add_options(CLI::App& app, Options& o) {
   app.add_option("--labels", o.labels, cli::kLabelsHelp);
   app.add_option("--eps-f", o.eps_f, "Face-vertex threshold on 1 - dot of normals")->capture_default_str();
   app.add_option("--eps-r", o.eps_r, "Ridge-edge threshold on 1 - dot of normals")->capture_default_str();
-  app.add_option("--eps-v", o.eps_v, "Refuse collapses leaving a tet with volume below this")->capture_default_str();
-  app.add_flag("--eps-v-relative", o.eps_v_relative,
-               "Read --eps-v relative to the cube of the whole input's bounding-box diagonal");
+  cli::add_volume_options(app, o.eps_v, o.eps_v_scale);
   app.add_option("--min-quality", o.min_quality,
                  "Quality guard: refuse a collapse that makes the worst reshaped tet's mean ratio fall below\n"
                  "min(its value before, Q); 0 = off")

@@ -16,7 +16,7 @@ namespace tc::mpi {
 struct Options {
   std::string in, out, stats, device, boundary = "features";
   double target_length = 0, target_factor = 0;
-  double eps_f = 0.01, eps_r = 0.1, eps_v = 2e-12, min_quality = 0.1;
+  double eps_f = 0.01, eps_r = 0.1, eps_v = CollapseOptions{}.eps_v, min_quality = 0.1;
   // features mode only (see validate()); max_boundary_error < 0: not given (resolve_defaults)
   double max_boundary_error = -1, max_boundary_error_abs = 0;
   int64_t eps_c = 0;
@@ -32,7 +32,8 @@ struct Options {
   double field_check = CoarsenOptions{}.field_check;  // tetcollapse's --field-check
   double priority_levels = -1, host_tail = -1;  // -1: not given (the library's defaults)
   cli::ImproveCli improve;  // the improvement's options, as tetcollapse's
-  bool eps_v_relative = false, no_labels = false, no_improve = false, quiet = false, check = false,
+  std::string eps_v_scale = "mean-tet";  // tetcollapse's --eps-v-scale
+  bool no_labels = false, no_improve = false, quiet = false, check = false,
        average_fields = false;
   int cycles = CoarsenOptions{}.cycles;  // tetcollapse's --cycles
   int max_rounds = 5;

@@ -26,7 +26,7 @@ struct CollapseCli {
   CollapseOptions opt;
   double target_length = 0, target_factor = 0;
   double priority_levels = -1;  // not given
-  std::string boundary = "features", method = "parallel", conflicts = "matching";
+  std::string boundary = "features", method = "parallel", conflicts = "matching", eps_v_scale = "mean-tet";
   std::string region, sizing_field, labels, cost_cl, placement_cl, predicate_cl, device, stats;
   bool check = false, quiet = false, no_labels = false, no_spatial_order = false, no_improve = false,
        average_fields = false, no_merge_features = false;
@@ -166,15 +166,12 @@ void register_collapse(CLI::App& app, int& exit_code) {
                      "The same bound in mesh units (used instead of --max-boundary-error when > 0)")
           ->check(CLI::NonNegativeNumber);
   app.add_flag("--no-merge-features", c->no_merge_features, kNoMergeFeaturesHelp);
-  app.add_option("--eps-v", c->opt.eps_v, "Refuse collapses leaving a tet with volume below this (paper: 2e-12)")
-      ->capture_default_str();
+  add_volume_options(app, c->opt.eps_v, c->eps_v_scale);
   app.add_option("--min-quality", c->opt.min_quality,
                  "Quality guard: refuse a collapse that makes the worst reshaped tet's mean ratio\n"
                  "(1 regular, 0 flat) fall below min(its value before, Q); 0 = off, as the paper")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
-  app.add_flag("--eps-v-relative", c->opt.eps_v_relative,
-               "Read --eps-v relative to the cube of the bounding-box diagonal");
   app.add_option("--region", c->region, kRegionHelp);
   app.add_option("--sizing-field", c->sizing_field,
                  "Per-vertex field of the input giving the wanted edge length: an edge is collapsed\n"
@@ -286,6 +283,7 @@ void register_collapse(CLI::App& app, int& exit_code) {
 
     CollapseOptions& opt = c->opt;
     opt.boundary = boundary_mode(c->boundary);
+    opt.eps_v_scale = volume_scale(c->eps_v_scale);
     opt.use_labels = !c->no_labels;
     opt.tuning.spatial_order = !c->no_spatial_order;
     opt.tuning.merge_features_within_bound = !c->no_merge_features;

@@ -108,6 +108,25 @@ CollapseOptions::Conflicts conflicts_mode(const std::string& name) {
                               : CollapseOptions::Greedy;
 }
 
+void add_volume_options(CLI::App& app, double& eps_v, std::string& scale) {
+  app.add_option("--eps-v", eps_v,
+                 "Refuse collapses leaving a tet with volume below V times the input's mean tet volume\n"
+                 "(--eps-v-scale; the default is the paper's absolute 2e-12 on its W1 robot mesh)")
+      ->capture_default_str();
+  app.add_option("--eps-v-scale", scale,
+                 "What --eps-v multiplies: mean-tet (default: a mesh gives the same result in any unit),\n"
+                 "absolute (1: mesh units, as the paper, e.g. --eps-v 2e-12 --eps-v-scale absolute) or\n"
+                 "diagonal (the cube of the input's bounding-box diagonal)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"mean-tet", "absolute", "diagonal"}));
+}
+
+CollapseOptions::VolumeScale volume_scale(const std::string& name) {
+  return name == "absolute" ? CollapseOptions::Absolute
+         : name == "diagonal" ? CollapseOptions::DiagonalCubed
+                              : CollapseOptions::MeanTetVolume;
+}
+
 CollapseOptions::Method method_mode(const std::string& name) {
   return name == "sequential" ? CollapseOptions::Sequential : CollapseOptions::Parallel;
 }

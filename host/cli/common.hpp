@@ -67,6 +67,10 @@ inline constexpr const char* kMethodHelp =
     "parallel (default): the OpenCL pipeline; sequential: the CPU priority-queue baseline\n"
     "with the same checks (no OpenCL device needed)";
 CollapseOptions::Method method_mode(const std::string& name);
+// --eps-v V and --eps-v-scale mean-tet|absolute|diagonal (CollapseOptions::eps_v and
+// eps_v_scale; the option checks the name), and the name as the options' enum.
+void add_volume_options(CLI::App& app, double& eps_v, std::string& scale);
+CollapseOptions::VolumeScale volume_scale(const std::string& name);
 // --no-merge-features (CollapseTuning::merge_features_within_bound off): its help.
 inline constexpr const char* kNoMergeFeaturesHelp =
     "Under --max-boundary-error, keep every ridge and corner whatever its size (default: a detail of\n"

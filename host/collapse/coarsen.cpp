@@ -163,6 +163,8 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
     c.tets_before = mesh.num_tets();
     CollapseOptions again = co;
     again.target_length = r.collapse.target_length;
+    again.eps_v = r.collapse.eps_v;  // the input's volume threshold, not this coarser mesh's
+    again.eps_v_scale = CollapseOptions::Absolute;
     again.vertex_boundary_error = std::move(spent);
     again.boundary_reference = r.collapse.boundary_reference;  // the input's S, not this mesh's
     again.vertex_mask = options.improve_mask ? options.improve_mask(mesh) : std::vector<uint8_t>();

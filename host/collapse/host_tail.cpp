@@ -81,7 +81,7 @@ void HostTail::finish(Mesh& mesh, const StageParams& p, CollapseReport& report) 
   o.sequential_skip_invalidated = false;  // greedy: every queued edge has a touched end point
   o.target_length = p.target;
   o.eps_v = p.eps_v;
-  o.eps_v_relative = false;
+  o.eps_v_scale = CollapseOptions::Absolute;  // (the device's threshold, in mesh units)
   o.vertex_mask = std::move(mask_);
   o.max_iterations = o_.max_iterations - done;
   o.boundary_reference = reference_;  // (none: the tail's own S is no reference)

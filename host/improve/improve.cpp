@@ -172,6 +172,9 @@ int64_t collapse_bad(Mesh& mesh, ImproveOptions& options, bool harmonic) {
                     : harmonic                  ? 1.0
                                                 : 1.5 * median_edge_length(mesh);
   o.harmonic_cost = harmonic;
+  // the volume threshold of the whole mesh, not of the star mesh the step runs on
+  o.eps_v = volume_threshold(mesh, o);
+  o.eps_v_scale = CollapseOptions::Absolute;
   // A vertex mask follows the renumbering as a vertex field (a survivor of two selected vertices
   // is selected: the mean of two ones); under a bound the step goes on from what was spent at
   // each vertex, which reaches the star mesh and comes back through the splice as the last field.

@@ -270,10 +270,16 @@ struct CollapseOptions {
   // component (empty: over the points' values). Empty points: the mesh's own vertices.
   std::vector<double> field_points, field_point_values, field_range;
   std::vector<int32_t> field_point_tets;
-  // Tets of the collapsed neighbourhood must keep a volume >= eps_v. With eps_v_relative the
-  // threshold is eps_v x (bounding-box diagonal of the input)^3.
-  double eps_v = 2e-12;
-  bool eps_v_relative = false;
+  // Tets of the collapsed neighbourhood must keep a volume >= the volume threshold
+  // (volume_threshold): by default eps_v x the input's mean tet volume, so that a mesh gives the
+  // same result in any unit (the paper's absolute 2e-12 refuses every collapse of a mesh whose
+  // tets are all smaller, a part of a few millimetres in metres, and freezes the neighbourhood
+  // of every smaller tet of a larger one); 2e-10 is the paper's 2e-12 on its W1 robot (mean tet
+  // volume 0.0101). Absolute: eps_v in mesh units, as the paper; DiagonalCubed: eps_v x the cube
+  // of the input's bounding-box diagonal.
+  enum VolumeScale { MeanTetVolume, Absolute, DiagonalCubed };
+  double eps_v = 2e-10;
+  VolumeScale eps_v_scale = MeanTetVolume;
   // Quality guard: a collapse is refused when the worst mean-ratio quality (tc_tet_quality:
   // 1 regular, -> 0 sliver) of the tets it reshapes would fall below min(their worst quality
   // before, min_quality). 0 turns it off (the paper's behaviour: only eps_v is checked).
@@ -358,8 +364,8 @@ CollapseReport collapse_sequential(Mesh& mesh, const CollapseOptions& options);
 // Median edge length of a mesh (unique edges), on the host. 0 for a mesh without tets.
 double median_edge_length(const Mesh& mesh);
 
-// The volume threshold a run uses: options.eps_v, or with eps_v_relative options.eps_v x (the
-// bounding-box diagonal of the mesh)^3.
+// The volume threshold a run uses: options.eps_v times what options.eps_v_scale names (the mean
+// tet volume or the cube of the bounding-box diagonal of `mesh`, or 1).
 double volume_threshold(const Mesh& mesh, const CollapseOptions& options);
 // The feature surface S of `mesh` (its boundary faces and, with labels, the faces between
 // different primary labels) as triangles, 9 coordinates each: a reference surface for

@@ -135,6 +135,38 @@ TEST(Coarsen, LaterCyclesCollapseWhatTheImprovementFreed) {
 // stays below a quarter of what the memory check estimates it needs never needs one. Held here
 // for the whole command (both cycles, the fields' resampling), with and without the boundary
 // error bound, on the CPU's and the GPU's code paths.
+// No threshold in mesh units: the bracket in units 2^30 times smaller or larger (exact in
+// binary) gives the same coarse mesh, scaled, with the defaults (the collapse under the boundary
+// error bound, the improvement, two cycles). With the paper's absolute volume threshold
+// (2e-12) the smaller one, whose tets are all below it, did not coarsen at all.
+TEST(Coarsen, TheSameMeshInAnyUnitGivesTheSameResult) {
+  Context ctx;
+  const Mesh bracket = read_mesh(test::project_mesh("bracket.msh"));
+  CoarsenOptions co;
+  co.collapse.target_factor = 2;
+  Mesh ref = bracket;
+  coarsen(ref, co, &ctx);
+  ASSERT_LT(ref.num_tets(), bracket.num_tets() / 4);
+  for (double scale : {std::ldexp(1.0, -30), std::ldexp(1.0, 30)}) {
+    Mesh m = bracket;
+    for (double& x : m.points) x *= scale;
+    coarsen(m, co, &ctx);
+    EXPECT_EQ(m.tets, ref.tets) << "scale " << scale;
+    ASSERT_EQ(m.points.size(), ref.points.size());
+    size_t differ = 0;
+    for (size_t i = 0; i < m.points.size(); ++i) differ += m.points[i] != ref.points[i] * scale;
+    EXPECT_EQ(differ, 0u) << "scale " << scale;
+  }
+  // the same threshold the paper's way, in mesh units, refuses every collapse of the smaller one
+  Mesh tiny = bracket;
+  for (double& x : tiny.points) x *= std::ldexp(1.0, -30);
+  co.collapse.eps_v = 2e-12;
+  co.collapse.eps_v_scale = CollapseOptions::Absolute;
+  co.improve = false;
+  coarsen(tiny, co, &ctx);
+  EXPECT_EQ(tiny.num_tets(), bracket.num_tets());
+}
+
 TEST(Coarsen, TheLargestBufferIsUnderAQuarterOfTheEstimate) {
   Mesh bracket = read_mesh(test::project_mesh("bracket.msh"));
   bracket.vertex_fields.push_back({"z", 1, {}});
