@@ -314,8 +314,20 @@ void Analysis::orientation() {
   check_detail::exact_orientation(m.points, m.tets, unusable, sign);
   FindingBuilder inv(Severity::Error, "inverted_tet", "tets with negative orientation (exact)", opt.max_offenders);
   FindingBuilder flat(Severity::Error, "flat_tet", "tets with zero volume (exact)", opt.max_offenders);
+  double small_below = opt.eps_volume;
+  if (!opt.eps_volume_absolute) {  // x the mean tet volume, as the collapse's threshold
+    double sum = 0;
+    int64_t n = 0;
+    for (int64_t t = 0; t < nt; ++t) {
+      if (unusable[size_t(t)]) continue;
+      const int32_t* v = &m.tets[4 * t];
+      sum += std::fabs(geo::tc_tet_volume(P(v[0]), P(v[1]), P(v[2]), P(v[3])));
+      ++n;
+    }
+    small_below *= n > 0 ? sum / double(n) : 1.0;
+  }
   FindingBuilder small(opt.small_volume_is_error ? Severity::Error : Severity::Warning, "small_volume",
-                       "positive tets with volume below " + num(opt.eps_volume), opt.max_offenders);
+                       "positive tets with volume below " + num(small_below), opt.max_offenders);
   double total = 0, minv = INFINITY;
   for (int64_t t = 0; t < nt; ++t) {
     if (unusable[size_t(t)]) continue;
@@ -325,7 +337,7 @@ void Analysis::orientation() {
     minv = std::min(minv, vol);
     if (sign[size_t(t)] < 0) inv.add({t}, tets_str(t));
     else if (sign[size_t(t)] == 0) flat.add({t}, tets_str(t));
-    else if (vol < opt.eps_volume) small.add({t}, tets_str(t));
+    else if (vol < small_below) small.add({t}, tets_str(t));
   }
   r.volume = total;
   r.min_volume = std::isfinite(minv) ? minv : NAN;

@@ -8,7 +8,7 @@ namespace tc::cli {
 
 void register_check(CLI::App& app, int& exit_code) {
   struct Opts {
-    std::string path, reference, json;
+    std::string path, reference, json, eps_v_scale = "mean-tet";
     InputOptions input;
     CheckOptions check;
     bool quiet = false;
@@ -23,7 +23,14 @@ void register_check(CLI::App& app, int& exit_code) {
   cmd->add_option("MESH", o->path, "Mesh to check")->required();
   cmd->add_option("--reference", o->reference, "The input the mesh was made from, to compare with");
   cmd->add_option("--json", o->json, "Write the full report as one JSON object to this file ('-' for stdout)");
-  cmd->add_option("--eps-v", o->check.eps_volume, "Count tets with volume below this (the paper's eps_v)")->capture_default_str();
+  cmd->add_option("--eps-v", o->check.eps_volume,
+                  "Count tets with volume below this times the mesh's mean tet volume (the collapse's --eps-v)")
+      ->capture_default_str();
+  cmd->add_option("--eps-v-scale", o->eps_v_scale,
+                  "What --eps-v multiplies: mean-tet (default) or absolute (1: mesh units, e.g. the paper's\n"
+                  "--eps-v 2e-12 --eps-v-scale absolute)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"mean-tet", "absolute"}));
   cmd->add_flag("--small-volume-error", o->check.small_volume_is_error, "Tets below --eps-v make the mesh invalid");
   cmd->add_option("--duplicate-tol", o->check.duplicate_tol,
                   "Vertices closer than this on every axis are duplicates")
@@ -40,6 +47,7 @@ void register_check(CLI::App& app, int& exit_code) {
   cmd->add_flag("-q,--quiet", o->quiet, "Print only the verdict line");
   add_input_options(*cmd, o->input);
   cmd->callback([o, &exit_code] {
+    o->check.eps_volume_absolute = o->eps_v_scale == "absolute";
     check_output_path(o->json, nullptr);
     // Defects are findings (exit 1), not read errors: only an unparsable file is exit 2.
     o->input.as_is = true;

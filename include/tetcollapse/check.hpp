@@ -39,7 +39,10 @@
 namespace tc {
 
 struct CheckOptions {
-  double eps_volume = 2e-12;      // tets with 0 < volume < eps_volume are counted (warning)
+  // Tets with 0 < volume < eps_volume x the mesh's mean tet volume (eps_volume itself when
+  // eps_volume_absolute) are counted (warning): the collapse's default volume threshold.
+  double eps_volume = 2e-10;
+  bool eps_volume_absolute = false;
   bool small_volume_is_error = false;
   double duplicate_tol = 1e-13;   // vertices differing by less than this on every axis
   bool self_intersection = true;  // CGAL PMP self-intersection test of the boundary

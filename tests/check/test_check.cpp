@@ -207,15 +207,29 @@ TEST(Check, FlatTet) {
 }
 
 TEST(Check, NearlyFlatPositiveTetIsSmallVolumeWarning) {
-  Mesh m = mesh_of({0, 0, 0, 1, 0, 0, 0, 1, 0, 0.2, 0.2, 1e-12}, {0, 1, 2, 3});
-  CheckReport r = tc::check_mesh(m);
-  EXPECT_TRUE(r.valid) << tc::check_report_text(r);
-  EXPECT_EQ(offenders(r, "small_volume", tc::Severity::Warning), (std::vector<Tuple>{{0}}));
-  CheckOptions strict;
-  strict.small_volume_is_error = true;
-  CheckReport s = tc::check_mesh(m, strict);
-  EXPECT_FALSE(s.valid);
-  EXPECT_EQ(offenders(s, "small_volume"), (std::vector<Tuple>{{0}}));
+  // A nearly flat tet beside a regular one: small against their mean volume, at any scale.
+  for (double scale : {1.0, 1e-6, 1e6}) {
+    std::vector<double> pts = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0.2, 0.2, 1e-12, 2, 0, 0, 3, 0, 0, 2, 1, 0, 2, 0, 1};
+    for (double& x : pts) x *= scale;
+    Mesh m = mesh_of(pts, {0, 1, 2, 3, 4, 5, 6, 7});
+    CheckReport r = tc::check_mesh(m);
+    EXPECT_TRUE(r.valid) << tc::check_report_text(r);
+    EXPECT_EQ(offenders(r, "small_volume", tc::Severity::Warning), (std::vector<Tuple>{{0}})) << "scale " << scale;
+    CheckOptions strict;
+    strict.small_volume_is_error = true;
+    CheckReport s = tc::check_mesh(m, strict);
+    EXPECT_FALSE(s.valid);
+    EXPECT_EQ(offenders(s, "small_volume"), (std::vector<Tuple>{{0}}));
+    // in mesh units (the paper's 2e-12): at 1e-6 the regular tet is below it as well, at 1e6 neither
+    CheckOptions absolute;
+    absolute.eps_volume = 2e-12;
+    absolute.eps_volume_absolute = true;
+    const CheckReport a = tc::check_mesh(m, absolute);
+    if (scale > 1) EXPECT_EQ(a.find("small_volume"), nullptr);
+    else
+      EXPECT_EQ(offenders(a, "small_volume", tc::Severity::Warning),
+                scale < 1 ? (std::vector<Tuple>{{0}, {1}}) : (std::vector<Tuple>{{0}}));
+  }
 }
 
 TEST(Check, FaceInThreeTets) {
