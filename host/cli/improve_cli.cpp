@@ -24,6 +24,9 @@ void add_improve_options(CLI::App& cmd, ImproveCli& c) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd.add_flag("--no-smoothing", c.no_smoothing, "Improvement: no vertex relocation");
+  cmd.add_flag("--no-splits", c.no_splits,
+               "Improvement: no edge splits (a bad tet whose four vertices lie on the surface has its longest\n"
+               "interior edge split at a new vertex when that raises the worst quality of the edge's tets)");
   cmd.add_flag("--no-harmonic-collapse", c.no_harmonic,
                "Improvement: the collapse step without the paper's part (edges of the bad tets by the drop\n"
                "of the harmonic index, the survivor placed by a line search): the shortest edges only");
@@ -48,15 +51,16 @@ std::string quality_line(const QualitySummary& q) {
 const ImproveOptions& improve_options(ImproveCli& c, bool quiet) {
   c.opt.flips = !c.no_flips;
   c.opt.smoothing = !c.no_smoothing;
+  c.opt.splits = !c.no_splits;
   c.opt.collapse = !c.no_collapse;
   c.opt.harmonic_collapse = !c.no_harmonic;
   if (!quiet)
     c.opt.progress = [](const ImprovePassStats& s) {
       std::fprintf(stderr,
-                   "improve %3d: bad tets %8lld  edge removals %6lld  2-3 flips %6lld  boundary %5lld  moved %7lld  "
+                   "improve %3d: bad tets %8lld  edge removals %6lld  2-3 flips %6lld  boundary %5lld  splits %5lld  moved %7lld  "
                    "collapsed %6lld  min dihedral %6.2f  below 10: %6lld  below 13: %6lld  %.3f s\n",
                    s.iteration + 1, (long long)s.bad_tets, (long long)s.edge_removals, (long long)s.flips23,
-                   (long long)s.boundary_removals,
+                   (long long)s.boundary_removals, (long long)s.splits,
                    (long long)s.relocated, (long long)s.collapsed, s.min_dihedral_deg, (long long)s.below_10_deg,
                    (long long)s.below_13_deg, s.seconds);
     };
@@ -92,6 +96,7 @@ void write_improve(JsonWriter& w, const ImproveReport& r) {
         .field("edge_removals", p.edge_removals)
         .field("flips23", p.flips23)
         .field("boundary_removals", p.boundary_removals)
+        .field("splits", p.splits)
         .field("relocated", p.relocated)
         .field("collapsed", p.collapsed)
         .field("min_dihedral_deg", p.min_dihedral_deg)

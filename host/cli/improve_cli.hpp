@@ -11,7 +11,7 @@ namespace tc::cli {
 
 struct ImproveCli {
   ImproveOptions opt;
-  bool no_flips = false, no_smoothing = false, no_collapse = false, no_harmonic = false;
+  bool no_flips = false, no_smoothing = false, no_splits = false, no_collapse = false, no_harmonic = false;
 };
 void add_improve_options(CLI::App& cmd, ImproveCli& c);
 // The options the flags give, with progress lines on stderr unless quiet.

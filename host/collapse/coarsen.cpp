@@ -134,8 +134,11 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
   };
   // the improvement with the collapse's boundary rules and the whole boundary error bound, from
   // what the collapse spent at each vertex
+  const int64_t tets_in = mesh.num_tets();
   auto improve_now = [&](const std::vector<double>& spent) {
     ImproveOptions io = options.improvement;
+    // (its splits add tets: never past the input's count, which a coarsening only lowers)
+    if (io.max_tets <= 0 || io.max_tets > tets_in) io.max_tets = tets_in;
     io.boundary = co.boundary;
     io.eps_f = co.eps_f;
     io.eps_r = co.eps_r;

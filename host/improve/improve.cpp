@@ -106,6 +106,7 @@ void passes(Mesh& mesh, ImproveOptions& options, Context* ctx, int max_passes, I
       if (ctx && !ctx->cpu_tuning()) flip_pass(m, *ctx, bad, stats);
       else flip_pass(m, bad, stats);
     }
+    if (options.splits) split_pass(m, bad_tets(m, threshold), options.max_tets, stats);
     const double flipped = pass_clock.peek();
     stats.seconds_flips = flipped;
     if (options.smoothing) {
@@ -117,7 +118,7 @@ void passes(Mesh& mesh, ImproveOptions& options, Context* ctx, int max_passes, I
     stats.seconds = pass_clock.peek();
     report.passes.push_back(stats);
     if (options.progress) options.progress(stats);
-    if (stats.edge_removals + stats.flips23 + stats.boundary_removals + stats.relocated == 0) break;
+    if (stats.edge_removals + stats.flips23 + stats.boundary_removals + stats.splits + stats.relocated == 0) break;
     // Later passes make ever smaller gains on the same vertices: stop once a pass leaves the
     // worst angle and the counts below 10 and 13 degrees (nearly) as they were.
     if (it > 0) {
@@ -131,6 +132,8 @@ void passes(Mesh& mesh, ImproveOptions& options, Context* ctx, int max_passes, I
   report.pinned_below_13_after = pinned_below_13(m);
   const Stopwatch write;
   m.write_back();
+  // (a vertex a split added lies inside what the mask selected)
+  if (!options.vertex_mask.empty()) options.vertex_mask.resize(size_t(mesh.num_vertices()), 1);
   if (m.bounded()) options.vertex_boundary_error = m.boundary_errors();
   report.seconds_setup += write.peek();
 }

@@ -551,13 +551,13 @@ void ImpMesh::mark_motion(const ImproveOptions& options) {
     if (!selected(v)) motion_[size_t(v)] = kFixed;
 }
 
-void ImpMesh::move(int32_t v, tc_d3 p) {
+void ImpMesh::interpolate_fields(const std::vector<int32_t>& around, tc_d3 p, int32_t v) {
   if (!mesh_.vertex_fields.empty()) {
-    // The tet of the star (as it is) holding p, by its barycentric coordinates: the one whose
-    // smallest coordinate is largest (p is inside the star, so that one holds it).
+    // The tet of `around` (as it is) holding p, by its barycentric coordinates: the one whose
+    // smallest coordinate is largest (p is inside their union, so that one holds it).
     int32_t best = -1;
     double best_min = -std::numeric_limits<double>::infinity(), bary[4] = {0, 0, 0, 0};
-    for (int32_t t : vtets_[size_t(v)]) {
+    for (int32_t t : around) {
       const Tet& q = tets_[size_t(t)];
       const tc_d3 c[4] = {point(q[0]), point(q[1]), point(q[2]), point(q[3])};
       const double vol = geo::tc_orient3d(c[0], c[1], c[2], c[3]);
@@ -584,6 +584,10 @@ void ImpMesh::move(int32_t v, tc_d3 p) {
         std::copy(value.begin(), value.end(), f.values.begin() + ptrdiff_t(size_t(v) * nc));
       }
   }
+}
+
+void ImpMesh::move(int32_t v, tc_d3 p) {
+  interpolate_fields(vtets_[size_t(v)], p, v);
   points_[3 * size_t(v)] = p.x;
   points_[3 * size_t(v) + 1] = p.y;
   points_[3 * size_t(v) + 2] = p.z;
@@ -593,6 +597,27 @@ void ImpMesh::move(int32_t v, tc_d3 p) {
   }
   ++stamp_;
   touch_star(v);
+}
+
+int32_t ImpMesh::add_vertex(tc_d3 p, const std::vector<int32_t>& around) {
+  const int32_t v = num_vertices();
+  points_.insert(points_.end(), {p.x, p.y, p.z});
+  for (Field& f : mesh_.vertex_fields) f.values.resize(f.values.size() + size_t(f.components), 0.0);
+  interpolate_fields(around, p, v);
+  vtets_.emplace_back();
+  changed_.push_back(stamp_);
+  smooth_failed_at.push_back(0);
+  flip_failed_at.push_back(0);
+  if (!mask_.empty()) mask_.push_back(1);
+  motion_.push_back(kFree);
+  normal_.push_back({0, 0, 0});
+  max_offset_.push_back(std::numeric_limits<double>::infinity());
+  start_.push_back(p);
+  if (bounded_) {  // (inside: no surface at it)
+    err_.push_back(0);
+    err_start_.push_back(0);
+  }
+  return v;
 }
 
 void ImpMesh::touch_star(int32_t v) {

@@ -38,10 +38,14 @@ class ImpMesh {
   const int32_t* tet_data() const { return tets_.empty() ? nullptr : tets_[0].data(); }
   // Moves v to p, a point inside its star, with its vertex field values interpolated there.
   void move(int32_t v, tc_d3 p);
+  // Appends a vertex at p, a point inside the tets `around`, free to move, its vertex field
+  // values interpolated there; it is in no tet yet (replace adds them). Returns its index.
+  int32_t add_vertex(tc_d3 p, const std::vector<int32_t>& around);
   bool selected(int32_t v) const { return mask_.empty() || mask_[size_t(v)] != 0; }
   const Tet& tet(int32_t t) const { return tets_[size_t(t)]; }
   bool alive(int32_t t) const { return !dead_[size_t(t)]; }
   int32_t num_tet_slots() const { return int32_t(tets_.size()); }
+  int64_t live_tets() const { return int64_t(tets_.size()) - int64_t(free_.size()); }
   int32_t num_vertices() const { return int32_t(vtets_.size()); }
   const std::vector<int32_t>& tets_of(int32_t v) const { return vtets_[size_t(v)]; }
   double quality(int32_t t) const { return quality_[size_t(t)]; }
@@ -138,6 +142,8 @@ class ImpMesh {
   };
   void mark_motion(const ImproveOptions& options);
   void touch_star(int32_t v);
+  // v's vertex field values: the input fields interpolated at p in the tet of `around` holding it.
+  void interpolate_fields(const std::vector<int32_t>& around, tc_d3 p, int32_t v);
 
   Mesh& mesh_;
   std::vector<double>& points_;
@@ -214,6 +220,13 @@ bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b, bool open_rings_only = f
 bool try_flip23(ImpMesh& m, int32_t t, int face);
 bool try_smooth(ImpMesh& m, int32_t v);
 bool try_remove_boundary_sliver(ImpMesh& m, int32_t t);
+// Splits the longest interior edge of bad tet t, whose four vertices are on the surface (where
+// relocation cannot reach it), at a free new vertex placed by the relocation's ascent, when that
+// raises the worst quality of the edge's ring (split.cpp).
+bool try_split(ImpMesh& m, int32_t t, int64_t max_tets = 0);
+// try_split on each bad tet in turn (worst first); counts in stats.splits.
+// (a split of an edge of n tets adds n: none that would take the mesh past max_tets, if > 0)
+void split_pass(ImpMesh& m, const std::vector<int32_t>& bad, int64_t max_tets, ImprovePassStats& stats);
 double boundary_quad_height(const ImpMesh& m, int32_t a, int32_t b, int32_t x1, int32_t x2);
 bool flat_quad(const ImpMesh& m, int32_t a, int32_t b, int32_t x1, int32_t x2);
 

@@ -16,6 +16,10 @@
 //                                          and free modes; the boundary moves by at most
 //                                          max_boundary_move)
 //         accepted only if the worst q of the changed tets rises
+//       for t in bad with q < sin(13 degrees) and its four vertices on the surface:
+//         split its longest interior edge at a new free vertex (placed by the smoothing's
+//         ascent over the edge's tets), each tet around the edge in two, when the worst q of
+//         those tets rises and the mesh stays within max_tets   -- split pass
 //       for v in vertices of bad tets:    -- smoothing pass (with a device: in rounds of
 //                                          vertices no two of which share a tet, lowest star
 //                                          quality first; curved surfaces' vertices after, on
@@ -34,8 +38,9 @@
 //     raised the smallest angle or removed a tenth of the tets below 10 or 13 degrees
 //
 // The worst quality of the mesh never falls: each operation is accepted only when the worst
-// quality of what it changes rises. Flips change interior faces of one label only, so the
-// material interfaces are kept (and the vertex numbering, but by the collapse step); the outer
+// quality of what it changes rises. Flips and splits change interior faces of one label only, so
+// the material interfaces are kept (and the vertex numbering, but by the collapse step, and for
+// the vertices a split appends); the outer
 // boundary changes only by the
 // removal of thin boundary tets (within max_boundary_move, tagged triangles following), and in
 // strict mode not at all: no boundary vertex moves, so the boundary stays bit for bit.
@@ -65,6 +70,7 @@ struct ImprovePassStats {
   int64_t edge_removals = 0;  // n -> 2n - 4 (n = 3: the 3-2 flip)
   int64_t flips23 = 0;
   int64_t boundary_removals = 0;  // thin tets with two boundary faces removed
+  int64_t splits = 0;         // interior edges of bad tets split at a new vertex
   int64_t relocated = 0;      // vertices moved
   int64_t collapsed = 0;      // edges collapsed (the collapse step, between two series of passes)
   int64_t bad_tets = 0;       // tets below the threshold at the start of the pass
@@ -97,6 +103,14 @@ struct ImproveOptions {
   // Tets with a dihedral angle below this (or above 180 minus it) are worked on.
   double threshold_deg = 20;
   bool flips = true, smoothing = true;
+  // A bad tet whose four vertices lie on the surface (relocation cannot reach it) may have its
+  // longest interior edge split at a new free vertex, when that raises the worst quality of the
+  // edge's ring (the only operation that adds a vertex).
+  bool splits = true;
+  // Splits stop where the mesh would have more tets than this (0: no limit); the coarsening
+  // command passes its input's count, so that its splits never take the mesh past it (a mesh
+  // that hardly coarsens, all of it thin parts, would otherwise grow).
+  int64_t max_tets = 0;
   // features and free modes: a bad tet with two faces on the outer boundary may be removed
   // (its two other faces become boundary: the boundary quad's diagonal flips) when the
   // boundary moves by at most this share of the bounding-box diagonal; 0: never.

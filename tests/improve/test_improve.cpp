@@ -132,6 +132,44 @@ TEST(ImproveOps, TwoThreeFlipSplitsAFlatPair) {
 
 TEST(ImproveOps, EdgeOfFiveTetsBecomesSix) { expect_edge_removed(5, 3.0, 6); }
 
+// A needle bipyramid: every vertex on the boundary (relocation moves none off its surface), the
+// long edge (0, 1) inside. Its split at a new vertex halves the needles: 8 tets, the same
+// volume, a better worst; the new vertex inside, a linear vertex field exact there.
+TEST(ImproveOps, ASplitHalvesTheNeedlesOfALongInteriorEdge) {
+  Mesh m = edge_ring(4, 10.0);
+  m.vertex_fields.push_back({"f", 1, {}});
+  for (int64_t v = 0; v < m.num_vertices(); ++v) {
+    const double* p = &m.points[3 * size_t(v)];
+    m.vertex_fields[0].values.push_back(1 + p[0] - 2 * p[1] + 3 * p[2]);
+  }
+  const double v0 = volume_of(m), q0 = worst(m);
+  ASSERT_LT(std::asin(q0) * 180 / kPi, 13) << "a bad tet";
+  ImpMesh im(m, {});
+  for (int32_t v = 0; v < 6; ++v) ASSERT_NE(im.motion(v), improve_detail::kFree) << v;
+  EXPECT_TRUE(improve_detail::try_split(im, 0));
+  im.write_back();
+  ASSERT_EQ(m.num_tets(), 8);
+  ASSERT_EQ(m.num_vertices(), 7);
+  EXPECT_NEAR(volume_of(m), v0, 1e-9);
+  EXPECT_GT(worst(m), 2 * q0);
+  const double* p = &m.points[18];
+  EXPECT_NEAR(p[0], 0, 1e-9);
+  EXPECT_NEAR(p[1], 0, 1e-9);
+  EXPECT_LT(std::fabs(p[2]), 10.0);
+  EXPECT_NEAR(m.vertex_fields[0].values[6], 1 + p[0] - 2 * p[1] + 3 * p[2], 1e-9);
+  const CheckReport r = check_mesh(m);
+  EXPECT_TRUE(r.valid) << check_report_text(r);
+}
+
+TEST(ImproveOps, ASplitThatWouldNotImproveIsRefused) {
+  Mesh m = edge_ring(4, 1.0);  // an octahedron of right angles: its halves are no better
+  ImpMesh im(m, {});
+  EXPECT_FALSE(improve_detail::try_split(im, 0));
+  im.write_back();
+  EXPECT_EQ(m.num_tets(), 4);
+  EXPECT_EQ(m.num_vertices(), 6);
+}
+
 TEST(ImproveOps, BoundaryEdgeIsNotRemoved) {
   Mesh m = edge_ring(5, 3.0);
   m.tets.resize(4 * 4);  // drop one tet: the ring opens, the edge lies on the boundary
