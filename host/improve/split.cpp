@@ -62,10 +62,14 @@ bool try_split(ImpMesh& m, int32_t t, int64_t max_tets) {
     ring = std::move(r);
   }
   if (a < 0 || (max_tets > 0 && m.live_tets() + int64_t(ring.size()) > max_tets)) return false;
+  // (the tets below 13 degrees: a split must not leave more of them, though its worst rises)
+  static const double kCos13 = std::cos(13 * 3.14159265358979323846 / 180);
   double old_sine = std::numeric_limits<double>::infinity(), old_cos = -1;
+  int old_bad = 0;
   for (int32_t r : ring) {
     old_sine = std::min(old_sine, m.quality(r));
     old_cos = std::max(old_cos, m.max_cos(r));
+    old_bad += m.max_cos(r) > kCos13;
   }
   // The ring alone, renumbered: its vertices, then the new one (last) at the edge's midpoint;
   // each tet in two, the new vertex in place of b, then of a (both as positive as the tet).
@@ -104,6 +108,7 @@ bool try_split(ImpMesh& m, int32_t t, int64_t max_tets) {
                          std::numeric_limits<double>::infinity(), m.cos_threshold(), {}, &p))
     p = mid;
   double new_sine = std::numeric_limits<double>::infinity(), new_cos = -1;
+  int new_bad = 0;
   for (int i = 0; i < n; ++i) {
     tc_d3 c[4];
     for (int k = 0; k < 4; ++k) {
@@ -112,9 +117,11 @@ bool try_split(ImpMesh& m, int32_t t, int64_t max_tets) {
     }
     if (!(geo::tc_orient3d(c[0], c[1], c[2], c[3]) > 0)) return false;
     new_sine = std::min(new_sine, geo::tc_tet_min_sine(c[0], c[1], c[2], c[3]));
-    new_cos = std::max(new_cos, geo::tc_tet_max_dihedral_cos(c[0], c[1], c[2], c[3]));
+    const double cos_i = geo::tc_tet_max_dihedral_cos(c[0], c[1], c[2], c[3]);
+    new_cos = std::max(new_cos, cos_i);
+    new_bad += cos_i > kCos13;
   }
-  if (!m.improves(old_sine, old_cos, new_sine, new_cos)) return false;
+  if (!m.improves(old_sine, old_cos, new_sine, new_cos) || new_bad > old_bad) return false;
   const int32_t v = m.add_vertex(p, ring);
   for (Tet& g : added)
     for (int32_t& x : g) x = x < 0 ? v : x;
