@@ -148,7 +148,18 @@ CoarsenReport coarsen(Mesh& mesh, const CoarsenOptions& options, Context* ctx, c
       io.vertex_boundary_error = spent;
     }
     if (options.improve_mask) io.vertex_mask = options.improve_mask(mesh);
-    return ctx ? improve(mesh, io, *ctx) : improve(mesh, io);
+    // A mesh that hardly coarsened (a thin plate in strict mode) may end past the input's count
+    // all the same, its flips adding tets after the splits' cap: then the improvement again
+    // without splits (the copy kept only for such a mesh).
+    std::optional<Mesh> before;
+    if (io.splits && 10 * mesh.num_tets() > 9 * tets_in) before = mesh;
+    ImproveReport report = ctx ? improve(mesh, io, *ctx) : improve(mesh, io);
+    if (before && mesh.num_tets() > tets_in) {
+      mesh = std::move(*before);
+      io.splits = false;
+      report = ctx ? improve(mesh, io, *ctx) : improve(mesh, io);
+    }
+    return report;
   };
 
   CoarsenReport r;
