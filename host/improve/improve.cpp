@@ -24,7 +24,7 @@ constexpr double kMinCountGain = 0.05;  // share of the tets below 10 or 13 degr
 // the smallest angle by kMinAngleGain or removed this share of the tets below 10 or 13 degrees.
 constexpr double kMinRoundGain = 0.1;
 // A tet is below 10 (13) degrees when the cosine of its smallest angle is above these.
-const double kCos10 = std::cos(10 / kDeg), kCos13 = std::cos(13 / kDeg);
+const double kCos10 = std::cos(10 / kDeg);  // (kCos13: improve_mesh.hpp)
 // The vertex mask through the collapse step (collapse_bad).
 const char* const kMaskField = "tetcollapse:improve-mask";
 

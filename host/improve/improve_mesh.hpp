@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <unordered_map>
@@ -24,6 +25,11 @@ using Tet = std::array<int32_t, 4>;
 inline bool contains(const Tet& q, int32_t x) { return q[0] == x || q[1] == x || q[2] == x || q[3] == x; }
 
 enum Motion : uint8_t { kFixed = 0, kFree = 1, kInPlane = 2, kAlongLine = 3 };
+
+// The paper's bad tets, below 13 degrees: by the smallest dihedral angle's cosine (the counts the
+// goals state) and by the min-sine (the passes' measure, angles above 167 degrees too).
+inline const double kCos13 = std::cos(13 * 3.14159265358979323846 / 180);
+inline const double kSin13 = std::sin(13 * 3.14159265358979323846 / 180);
 
 class ImpMesh {
  public:

@@ -63,7 +63,6 @@ bool try_split(ImpMesh& m, int32_t t, int64_t max_tets) {
   }
   if (a < 0 || (max_tets > 0 && m.live_tets() + int64_t(ring.size()) > max_tets)) return false;
   // (the tets below 13 degrees: a split must not leave more of them, though its worst rises)
-  static const double kCos13 = std::cos(13 * 3.14159265358979323846 / 180);
   double old_sine = std::numeric_limits<double>::infinity(), old_cos = -1;
   int old_bad = 0;
   for (int32_t r : ring) {
@@ -133,9 +132,8 @@ void split_pass(ImpMesh& m, const std::vector<int32_t>& bad, int64_t max_tets, I
   // A split adds a vertex: only for the tets with an angle below 13 degrees or above 167 (the
   // paper's bad tets, those of the collapse step, by the passes' measure, the min-sine); at the
   // passes' 20 degrees it added several times as many tets (docs/algorithm.md).
-  static const double kSin = std::sin(13 * 3.14159265358979323846 / 180);
   for (int32_t t : bad)  // (a slot a split reused holds a new tet: tried while it is bad)
-    if (m.alive(t) && m.quality(t) < kSin && try_split(m, t, max_tets)) ++stats.splits;
+    if (m.alive(t) && m.quality(t) < kSin13 && try_split(m, t, max_tets)) ++stats.splits;
 }
 
 }  // namespace tc::improve_detail
