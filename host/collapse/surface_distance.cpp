@@ -478,10 +478,13 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
     query(lo - tc_d3{e, e, e}, hi + tc_d3{e, e, e}, ids);
     for (int32_t i : ids) near[j].push_back(&tris_[size_t(i)]);
     const tc_d3 probes[4] = {t[0], (t[0] + t[1] + t[2]) * (1.0 / 3), (t[0] + t[1]) * 0.5, (t[0] + t[2]) * 0.5};
-    for (const tc_d3& q : probes) {
-      double d2 = INFINITY;
-      for (const Tri* f : near[j]) d2 = std::min(d2, point_triangle_dist2(q, *f));
-      if (d2 > e2) return false;
+    for (const tc_d3& q : probes) {  // (a probe needs one triangle within e, nothing nearer)
+      bool found = false;
+      for (size_t i = 0; i < ids.size() && !found; ++i) {
+        const size_t f = size_t(ids[i]);
+        found = box_dist2(q, lo_[f], hi_[f]) <= e2 && point_triangle_dist2(q, tris_[f]) <= e2;
+      }
+      if (!found) return false;
     }
   }
   // every point of this surface within reach of an old triangle within e of the new S: the
@@ -519,9 +522,10 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
   std::atomic<size_t> next{0};
   std::atomic<bool> failed{false};
   const std::function<void()> work = [&] {
-    Pieces pieces;
+    // (each thread's scratch kept from check to check: a check is too small to allocate its own)
+    thread_local Pieces pieces;
+    thread_local std::vector<const Tri*> feats;
     pieces.stop = &failed;
-    std::vector<const Tri*> feats;
     for (size_t k = next++; k < jobs && !failed.load(std::memory_order_relaxed); k = next++) {
       bool ok;
       if (k < news.size()) {
