@@ -102,6 +102,36 @@ bool boxes_apart(tc_d3 alo, tc_d3 ahi, tc_d3 blo, tc_d3 bhi, double pad) {
 
 }  // namespace
 
+// A surface's vertices (triangle corners equal to the bit), the triangles around each, and per
+// vertex, computed when first asked (from any thread), its fan as wedges (Pieces::fan_holds).
+class Fans {
+ public:
+  explicit Fans(const std::vector<Tri>& tris);
+
+  struct Fan {
+    tc_d3 o, n;                     // the vertex, the axis (the fan's mean normal)
+    double radius;                  // of the ball around o that holds the fan
+    const int32_t *tri, *from;      // per wedge, in turn around n: its triangle, its first edge's end
+    int32_t k;                      // wedges; 0: the fan is not one turn around any axis tried
+  };
+  // the fan of v
+  Fan fan(int32_t v) const;
+  const std::array<int32_t, 3>& tri_verts(size_t t) const { return tri_verts_[t]; }
+  tc_d3 vertex(int32_t v) const { return verts_[size_t(v)]; }
+
+ private:
+  bool compute(int32_t v, tc_d3& n, double& radius, int32_t* tri, int32_t* from) const;
+  const std::vector<Tri>& t_;
+  std::vector<tc_d3> verts_;
+  std::vector<std::array<int32_t, 3>> tri_verts_;  // per triangle
+  std::vector<int32_t> off_, tris_;                // per vertex: tris_[off_[v] .. off_[v + 1])
+  // per vertex: 0 not yet computed, 1 being computed, 2 a fan, 3 none
+  std::unique_ptr<std::atomic<uint8_t>[]> state_;
+  mutable std::vector<tc_d3> axis_;
+  mutable std::vector<double> radius_;
+  mutable std::vector<int32_t> wedge_tri_, wedge_from_;  // per fan entry, in turn
+};
+
 namespace {
 
 // The branch and bound of within(), each point's distance to each feature computed once: a
@@ -112,8 +142,12 @@ class Pieces {
   // set by another thread when the verdict is known: every piece then fails at once
   const std::atomic<bool>* stop = nullptr;
 
-  void reset(const std::vector<const Tri*>& feats, double e2, const std::function<bool(const Tri&)>* relevant) {
+  // fans: the fans of the surface the features point into (fan_cover), or null
+  void reset(const std::vector<const Tri*>& feats, double e2, const std::function<bool(const Tri&)>* relevant,
+             const Fans* fans = nullptr, const Tri* fans_base = nullptr) {
     feats_ = &feats;
+    fans_ = fans;
+    fans_base_ = fans_base;
     e2_ = e2;
     e_ = std::sqrt(e2);
     relevant_ = relevant;
@@ -181,7 +215,7 @@ class Pieces {
     std::sort(L.order.begin(), L.order.end());
     for (const auto& [key, f] : L.order)
       if (holds(c, f)) return true;
-    if (two_cover(c, L.order)) return true;
+    if (two_cover(c, L.order) || fan_cover(c, L.order)) return true;
     // (whether the piece matters at all only now: most pieces are certified before)
     if (relevant_ && !(*relevant_)(P)) return true;
     if (depth == 0) return false;
@@ -277,7 +311,58 @@ class Pieces {
     return true;
   }
 
+  // Whether the triangles around a vertex of the nearest feature hold the piece between them,
+  // as two_cover does for two across an edge: the half-planes from the axis through the vertex
+  // along the fan's mean normal to each of its edges cut space into wedges, one per triangle,
+  // each convex (less than half a turn), together all of it; the piece's part in a wedge (a
+  // convex polygon) lies within e of the wedge's triangle where that polygon's corners do. A
+  // piece over a vertex of the features is then certified whole instead of split down to the
+  // size of e around it. Only against a surface whose fans are known (the reference); a fan
+  // that does not wind once around its normal (a sharp corner, a fold) is not tried.
+  bool fan_cover(const std::array<int32_t, 3>& c, const std::vector<std::pair<double, int32_t>>& order) {
+    if (!fans_ || order.empty()) return false;
+    const size_t t = size_t((*feats_)[size_t(order[0].second)] - fans_base_);  // the nearest feature
+    const tc_d3 P[3] = {pts_[size_t(c[0])], pts_[size_t(c[1])], pts_[size_t(c[2])]};
+    for (int32_t v : fans_->tri_verts(t))
+      if (fan_holds(P, fans_->fan(v))) return true;
+    return false;
+  }
+
+  bool fan_holds(const tc_d3 (&P)[3], const Fans::Fan& f) {
+    if (f.k == 0) return false;
+    const double r2 = (f.radius + e_) * (f.radius + e_);  // (a corner beyond: not within e of the fan)
+    for (const tc_d3& p : P)
+      if (dot(p - f.o, p - f.o) > r2) return false;
+    // wedge i: (x - o).(n x (from_i - o)) >= 0 and (x - o).(n x (from_i+1 - o)) <= 0
+    const auto side = [&](int32_t i) { return geo::cross(f.n, fan_vertex(f.from[i % f.k]) - f.o); };
+    tc_d3 next = side(0);
+    for (int32_t i = 0; i < f.k; ++i) {
+      const tc_d3 ms = next;
+      next = side(i + 1);
+      tc_d3 a[5] = {P[0], P[1], P[2]}, r[5];
+      int na = 3;
+      for (const tc_d3& m : {ms, next * -1.0}) {  // Sutherland-Hodgman: the part on m's positive side
+        int nr = 0;
+        for (int j = 0; j < na; ++j) {
+          const tc_d3 p = a[j], q = a[(j + 1) % na];
+          const double hp = dot(p - f.o, m), hq = dot(q - f.o, m);
+          if (hp >= 0) r[nr++] = p;
+          if ((hp > 0 && hq < 0) || (hp < 0 && hq > 0)) r[nr++] = p + (q - p) * (hp / (hp - hq));
+        }
+        na = nr;
+        std::copy(r, r + nr, a);
+      }
+      const Tri& t = fans_base_[f.tri[i]];
+      for (int j = 0; j < na; ++j)
+        if (point_triangle_dist2(a[j], t) > e2_) return false;
+    }
+    return true;
+  }
+  tc_d3 fan_vertex(int32_t u) const { return fans_->vertex(u); }
+
   const std::vector<const Tri*>* feats_ = nullptr;
+  const Fans* fans_ = nullptr;
+  const Tri* fans_base_ = nullptr;
   double e2_ = 0, e_ = 0;
   const std::function<bool(const Tri&)>* relevant_ = nullptr;
   std::vector<tc_d3> centroids_, lo_, hi_;  // per feature
@@ -289,9 +374,10 @@ class Pieces {
 }  // namespace
 
 bool within(const Tri& P, const std::vector<const Tri*>& feats, double e2, int depth,
-            const std::function<bool(const Tri&)>* relevant) {
+            const std::function<bool(const Tri&)>* relevant, const ReferenceSurface* surface) {
   Pieces pieces;
-  pieces.reset(feats, e2, relevant);
+  const bool fans = surface && surface->fans();
+  pieces.reset(feats, e2, relevant, fans ? surface->fans() : nullptr, fans ? &surface->tri(0) : nullptr);
   return pieces.within(P, depth);
 }
 
@@ -314,6 +400,123 @@ void record_tris(std::FILE* f, const std::vector<Tri>& t) {
 }
 }  // namespace
 
+Fans::Fans(const std::vector<Tri>& t) : t_(t) {
+  struct Corner {
+    tc_d3 p;
+    int32_t at;  // 3 x triangle + corner
+  };
+  std::vector<Corner> c(3 * t.size());
+  for (size_t i = 0; i < c.size(); ++i) c[i] = {t[i / 3][i % 3], int32_t(i)};
+  const auto less = [](const Corner& a, const Corner& b) {
+    return a.p.x != b.p.x ? a.p.x < b.p.x : a.p.y != b.p.y ? a.p.y < b.p.y : a.p.z < b.p.z;
+  };
+  std::sort(c.begin(), c.end(), less);
+  tri_verts_.resize(t.size());
+  for (size_t i = 0; i < c.size(); ++i) {
+    if (i == 0 || less(c[i - 1], c[i])) verts_.push_back(c[i].p);
+    tri_verts_[size_t(c[i].at / 3)][size_t(c[i].at % 3)] = int32_t(verts_.size() - 1);
+  }
+  off_.assign(verts_.size() + 1, 0);
+  for (const auto& tv : tri_verts_)
+    for (int32_t v : tv) ++off_[size_t(v) + 1];
+  for (size_t v = 0; v < verts_.size(); ++v) off_[v + 1] += off_[v];
+  tris_.resize(size_t(off_.back()));
+  std::vector<int32_t> fill(off_.begin(), off_.end() - 1);
+  for (size_t i = 0; i < tri_verts_.size(); ++i)
+    for (int32_t v : tri_verts_[i]) tris_[size_t(fill[size_t(v)]++)] = int32_t(i);
+  state_ = std::make_unique<std::atomic<uint8_t>[]>(verts_.size());
+  for (size_t v = 0; v < verts_.size(); ++v) state_[v] = 0;
+  axis_.resize(verts_.size());
+  radius_.resize(verts_.size());
+  wedge_tri_.resize(tris_.size());
+  wedge_from_.resize(tris_.size());
+}
+
+// The first thread to ask computes and keeps the fan; another that asks meanwhile computes its
+// own copy.
+Fans::Fan Fans::fan(int32_t v) const {
+  std::atomic<uint8_t>& s = state_[size_t(v)];
+  uint8_t st = s.load(std::memory_order_acquire);
+  const size_t b = size_t(off_[size_t(v)]), k = size_t(off_[size_t(v) + 1]) - b;
+  if (st == 0 && s.compare_exchange_strong(st, 1, std::memory_order_acq_rel)) {
+    const bool ok = compute(v, axis_[size_t(v)], radius_[size_t(v)], &wedge_tri_[b], &wedge_from_[b]);
+    s.store(ok ? 2 : 3, std::memory_order_release);
+    st = ok ? 2 : 3;
+  }
+  if (st == 2) return {verts_[size_t(v)], axis_[size_t(v)], radius_[size_t(v)], &wedge_tri_[b], &wedge_from_[b], int32_t(k)};
+  Fan f{verts_[size_t(v)], {0, 0, 0}, 0, nullptr, nullptr, 0};
+  if (st == 1) {
+    thread_local std::vector<int32_t> tri, from;
+    tri.resize(k);
+    from.resize(k);
+    if (compute(v, f.n, f.radius, tri.data(), from.data())) {
+      f.tri = tri.data();
+      f.from = from.data();
+      f.k = int32_t(k);
+    }
+  }
+  return f;
+}
+
+// The axis: the mean of the triangles' unit normals, turned to agree with the first; the fan is
+// one turn around it when every triangle spans less than half a turn seen along it, each starts
+// where the one before ends, and the spans add up to one turn.
+bool Fans::compute(int32_t v, tc_d3& n, double& radius, int32_t* tri, int32_t* from) const {
+  constexpr int kMaxFan = 32;
+  const int32_t b = off_[size_t(v)], k = off_[size_t(v) + 1] - b;
+  if (k < 3 || k > kMaxFan) return false;
+  const tc_d3 o = verts_[size_t(v)];
+  n = {0, 0, 0};
+  tc_d3 n0{0, 0, 0};
+  radius = 0;
+  for (int32_t i = 0; i < k; ++i) {
+    const Tri& t = t_[size_t(tris_[size_t(b + i)])];
+    tc_d3 m = geo::cross(t[1] - t[0], t[2] - t[0]);
+    const double l = geo::length(m);
+    if (!(l > 0)) return false;
+    m = m * (1 / l);
+    if (i == 0) n0 = m;
+    n = n + (dot(m, n0) < 0 ? m * -1.0 : m);
+    for (const tc_d3& p : t) radius = std::max(radius, geo::length(p - o));
+  }
+  const double nl = geo::length(n);
+  if (!(nl > 0)) return false;
+  n = n * (1 / nl);
+  const tc_d3 e1 = geo::normalize(geo::cross(n, std::fabs(n.x) < 0.9 ? tc_d3{1, 0, 0} : tc_d3{0, 1, 0}));
+  const tc_d3 e2 = geo::cross(n, e1);
+  const auto angle = [&](int32_t u) {
+    const tc_d3 d = verts_[size_t(u)] - o;
+    return std::atan2(dot(d, e2), dot(d, e1));
+  };
+  struct Wedge {
+    int32_t tri, from, to;
+    double angle, span;
+  } w[kMaxFan];
+  constexpr double kTurn = 2 * M_PI;
+  double total = 0;
+  for (int32_t i = 0; i < k; ++i) {
+    const int32_t t = tris_[size_t(b + i)];
+    int32_t other[2], m = 0;
+    for (int32_t u : tri_verts_[size_t(t)])
+      if (u != v && m < 2) other[m++] = u;
+    if (m != 2) return false;
+    const double a0 = angle(other[0]), a1 = angle(other[1]);
+    double span = a1 - a0;
+    if (span < 0) span += kTurn;
+    w[i] = span <= M_PI ? Wedge{t, other[0], other[1], a0, span} : Wedge{t, other[1], other[0], a1, kTurn - span};
+    if (!(w[i].span > 1e-9 && w[i].span < M_PI - 1e-9)) return false;
+    total += w[i].span;
+  }
+  if (!(std::fabs(total - kTurn) < 1e-6)) return false;
+  std::sort(w, w + k, [](const Wedge& x, const Wedge& y) { return x.angle < y.angle; });
+  for (int32_t i = 0; i < k; ++i) {
+    if (w[i].to != w[(i + 1) % k].from) return false;
+    tri[i] = w[i].tri;
+    from[i] = w[i].from;
+  }
+  return true;
+}
+
 ReferenceSurface::ReferenceSurface(const std::vector<double>& triangles) {
   tris_.resize(triangles.size() / 9);
   double total = 0;
@@ -323,6 +526,7 @@ ReferenceSurface::ReferenceSurface(const std::vector<double>& triangles) {
     total += geo::length(tris_[i][1] - tris_[i][0]);
   }
   if (tris_.empty()) return;
+  fans_ = std::make_unique<Fans>(tris_);
   cell_ = 2 * total / double(tris_.size());
   if (!(cell_ > 0)) cell_ = 1;
   origin_ = tris_[0][0];
@@ -529,7 +733,7 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
     for (size_t k = next++; k < jobs && !failed.load(std::memory_order_relaxed); k = next++) {
       bool ok;
       if (k < news.size()) {
-        pieces.reset(near[k], e2, nullptr);
+        pieces.reset(near[k], e2, nullptr, fans_.get(), tris_.data());  // (near: triangles of tris_)
         ok = pieces.within(news[k], kDepth);
       } else {
         const size_t r = size_t(ids[k - news.size()]);

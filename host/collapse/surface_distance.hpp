@@ -26,12 +26,15 @@ using Tri = std::array<tc_d3, 3>;
 double point_triangle_dist2(tc_d3 p, const Tri& t);
 void box_of(const Tri& t, tc_d3& lo, tc_d3& hi);
 
+class ReferenceSurface;
+
 // Whether every point of `piece` lies within sqrt(e2) of the union of `features` (certified:
 // false also when `depth` splits run out). With `relevant`, a piece it declines needs no check,
 // and the features need not be all the surface near the piece, so a corner beyond them is no
-// proof of a failure: the piece is split instead.
+// proof of a failure: the piece is split instead. With `surface`, whose triangles the features
+// are, the triangles around a vertex of theirs may hold a piece together (the fan cover).
 bool within(const Tri& piece, const std::vector<const Tri*>& features, double e2, int depth,
-            const std::function<bool(const Tri&)>* relevant = nullptr);
+            const std::function<bool(const Tri&)>* relevant = nullptr, const ReferenceSurface* surface = nullptr);
 
 // The first bytes of a file of checks recorded with TETCOLLAPSE_RECORD_CHECKS (surface_distance.cpp).
 inline constexpr char kRecordMagic[8] = {'t', 'c', 'c', 'h', 'e', 'c', 'k', '1'};
@@ -53,6 +56,7 @@ class ReferenceSurface {
   ~ReferenceSurface();
   size_t size() const { return tris_.size(); }
   const Tri& tri(int32_t i) const { return tris_[size_t(i)]; }
+  const class Fans* fans() const { return fans_.get(); }
   // The triangles whose boxes meet [lo, hi], into out.
   void query(tc_d3 lo, tc_d3 hi, std::vector<int32_t>& out) const;
 
@@ -71,6 +75,7 @@ class ReferenceSurface {
   static constexpr size_t kTwoThreadJobs = 8;  // triangles measured from which a check takes two threads
   std::vector<Tri> tris_;
   std::vector<tc_d3> lo_, hi_;  // per triangle: its box
+  std::unique_ptr<class Fans> fans_;  // the triangles around each vertex (surface_distance.cpp)
   std::unordered_map<int64_t, std::vector<int32_t>> cells_;
   double cell_ = 1;
   tc_d3 origin_{0, 0, 0};

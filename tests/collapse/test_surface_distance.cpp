@@ -118,6 +118,84 @@ TEST(SurfaceDistance, WhatTheCutCertifiesIsWithinTheBound) {
   EXPECT_GT(certified, 40) << "the random pieces test something";
 }
 
+// k triangles around the origin, their outer corners at radius 1 and the given heights.
+std::vector<double> fan(const std::vector<double>& heights, double twist = 0) {
+  std::vector<double> t;
+  const size_t k = heights.size();
+  const auto corner = [&](size_t i) {
+    const double a = 2 * M_PI * (double(i % k) + (i % 2 ? twist : 0)) / double(k);
+    return tc_d3{std::cos(a), std::sin(a), heights[i % k]};
+  };
+  for (size_t i = 0; i < k; ++i)
+    for (const tc_d3& v : {tc_d3{0, 0, 0}, corner(i), corner(i + 1)}) t.insert(t.end(), {v.x, v.y, v.z});
+  return t;
+}
+
+std::vector<const Tri*> all_of(const surface_distance::ReferenceSurface& ref) {
+  std::vector<const Tri*> f;
+  for (size_t i = 0; i < ref.size(); ++i) f.push_back(&ref.tri(int32_t(i)));
+  return f;
+}
+
+// Over a vertex of the reference, the wedges around its fan cut a piece into parts, each
+// within e of its own triangle: certified whole (depth 0), which no two triangles do.
+TEST(SurfaceDistance, APieceOverAVertexIsHeldByItsFan) {
+  const surface_distance::ReferenceSurface ref(fan(std::vector<double>(6, 0.0)));
+  const std::vector<const Tri*> feats = all_of(ref);
+  const double e = 0.01;
+  const auto over = [](double h) {
+    return Tri{tc_d3{-0.3, -0.2, h}, tc_d3{0.35, -0.25, h}, tc_d3{0.05, 0.4, h}};
+  };
+  EXPECT_TRUE(surface_distance::within(over(0.5 * e), feats, e * e, 0, nullptr, &ref));
+  EXPECT_FALSE(surface_distance::within(over(0.5 * e), feats, e * e, 0)) << "not without the fans";
+  EXPECT_FALSE(surface_distance::within(over(1.1 * e), feats, e * e, 0, nullptr, &ref));
+  EXPECT_FALSE(surface_distance::within(over(1.1 * e), feats, e * e, 8, nullptr, &ref));
+  // a piece reaching past the fan's outer edges: not held by it
+  const Tri past{tc_d3{-1.2, -0.2, 0}, tc_d3{0.35, -0.25, 0}, tc_d3{0.05, 0.4, 0}};
+  EXPECT_FALSE(surface_distance::within(past, feats, e * e, 0, nullptr, &ref));
+}
+
+// Sound on bent and twisted fans: whatever within() certifies with the fans (any depth), every
+// point of the piece, densely sampled, lies within e of the reference.
+TEST(SurfaceDistance, WhatTheFanCertifiesIsWithinTheBound) {
+  std::mt19937 g(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int certified = 0, whole = 0;
+  for (int it = 0; it < 600; ++it) {
+    const size_t k = 3 + size_t(it % 6);
+    std::vector<double> heights(k);
+    const double bend = it % 4 == 0 ? 1.5 : 0.3;  // (some fans folded past what wedges allow)
+    for (double& h : heights) h = bend * u(g);
+    const surface_distance::ReferenceSurface ref(fan(heights, 0.3 * u(g)));
+    const std::vector<const Tri*> feats = all_of(ref);
+    const double e = 0.01 + 0.02 * (u(g) + 1);
+    // corners on three of the fan's triangles (within 0.5 of its vertex), off it by up to e
+    const auto near_fan = [&](size_t i) {
+      const Tri& t = *feats[i % k];
+      const double b1 = 0.25 * (u(g) + 1), b2 = 0.25 * (u(g) + 1);
+      return t[0] + (t[1] - t[0]) * b1 + (t[2] - t[0]) * b2 + tc_d3{0, 0, e * u(g)};
+    };
+    const size_t first = size_t(it);
+    const Tri piece{near_fan(first), near_fan(first + 1 + size_t(it / 7) % (k - 1)), near_fan(first + k / 2)};
+    const int depth = it % 3;
+    if (!surface_distance::within(piece, feats, e * e, depth, nullptr, &ref)) continue;
+    ++certified;
+    whole += !surface_distance::within(piece, feats, e * e, depth);
+    double worst = 0;
+    const int n = 60;
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j) {
+        const tc_d3 q = piece[0] + (piece[1] - piece[0]) * (double(i) / n) + (piece[2] - piece[0]) * (double(j) / n);
+        double d2 = INFINITY;
+        for (const Tri* t : feats) d2 = std::min(d2, surface_distance::point_triangle_dist2(q, *t));
+        worst = std::max(worst, d2);
+      }
+    EXPECT_LE(std::sqrt(worst), e * (1 + 1e-12)) << it;
+  }
+  EXPECT_GT(certified, 50) << "the random pieces test something";
+  EXPECT_GT(whole, 25) << "and the fans certify what the splits alone do not";
+}
+
 // A tent of height h over the unit square's centre (four triangles) as the reference and as S;
 // the collapse of the apex onto a corner flattens it (two triangles).
 struct Tent {
