@@ -13,8 +13,22 @@ namespace tc::improve_detail {
 namespace {
 
 constexpr int kMaxRing = TCI_MAX_RING;
+static_assert(EdgeRing::kMaxRing == kMaxRing);
 
 }  // namespace
+
+bool edge_ring(const ImpMesh& m, int32_t a, int32_t b, EdgeRing& ring) {
+  ring.tets.clear();
+  for (int32_t t : m.tets_of(a))
+    if (contains(m.tet(t), b)) ring.tets.push_back(t);
+  const int n = int(ring.tets.size());
+  if (n < 2 || n > kMaxRing) return false;
+  for (int i = 0; i < n; ++i) {
+    if (m.label(ring.tets[size_t(i)]) != m.label(ring.tets[0])) return false;
+    geo::tci_others(m.tet(ring.tets[size_t(i)]).data(), a, b, &ring.from[i], &ring.to[i]);
+  }
+  return geo::tci_chain(n, ring.from, ring.to, ring.r, &ring.mm, &ring.closed, &ring.start);
+}
 
 // The ring of the edge (a, b): r[0..m) with (a, b, r[i], r[i+1]) the tets around it, of one
 // label. A closed ring (m tets) means no boundary or interface face contains the edge, and the
@@ -27,24 +41,17 @@ constexpr int kMaxRing = TCI_MAX_RING;
 // its generalisation for more.
 bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b, bool open_rings_only) {
   if (m.tagged_edge(a, b) || !m.selected(a) || !m.selected(b)) return false;
-  std::vector<int32_t> ring_tets;
-  for (int32_t t : m.tets_of(a)) {
-    const Tet& q = m.tet(t);
-    if (contains(q, b)) ring_tets.push_back(t);
-  }
+  EdgeRing ring;
+  if (!edge_ring(m, a, b, ring)) return false;
+  const std::vector<int32_t>& ring_tets = ring.tets;
   const int n = int(ring_tets.size());  // tets
-  if (n < 2 || n > kMaxRing) return false;
-  int32_t from[kMaxRing] = {}, to[kMaxRing] = {};
+  const int32_t *to = ring.to, *r = ring.r;
+  const int mm = ring.mm, closed = ring.closed, start = ring.start;  // mm: polygon vertices, n closed, n + 1 open
   double old_min = std::numeric_limits<double>::infinity(), old_cos = -1;
-  for (int i = 0; i < n; ++i) {
-    if (m.label(ring_tets[size_t(i)]) != m.label(ring_tets[0])) return false;
-    geo::tci_others(m.tet(ring_tets[size_t(i)]).data(), a, b, &from[i], &to[i]);
-    old_min = std::min(old_min, m.quality(ring_tets[size_t(i)]));
-    old_cos = std::max(old_cos, m.max_cos(ring_tets[size_t(i)]));
+  for (int32_t t : ring_tets) {
+    old_min = std::min(old_min, m.quality(t));
+    old_cos = std::max(old_cos, m.max_cos(t));
   }
-  int32_t r[kMaxRing + 1] = {};
-  int mm = 0, closed = 0, start = 0;  // mm: polygon vertices, n closed, n + 1 open
-  if (!geo::tci_chain(n, from, to, r, &mm, &closed, &start)) return false;
   if (closed ? n < 3 : !m.may_change_boundary() || mm > kMaxRing) return false;
   if (open_rings_only && closed) return false;
   for (int i = 0; i < mm; ++i) {  // a face of the old tets that the input tags must stay

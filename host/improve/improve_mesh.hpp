@@ -220,6 +220,18 @@ void smooth_pass(ImpMesh& m, const std::vector<int32_t>& bad, ImprovePassStats& 
 // vertices no two of which share a tet; the others then move on the host.
 void smooth_pass(ImpMesh& m, Context& ctx, const std::vector<int32_t>& bad, ImprovePassStats& stats);
 
+// The tets around the edge (a, b) and the polygon of their other vertices (geo::tci_chain):
+// r[0..mm) with (a, b, r[i], r[i+1]) the tets; closed, or open from the face (a, b, r[0]) to
+// (a, b, r[mm-1]) on the boundary. Filled by edge_ring (flips.cpp), which is false for an edge
+// of fewer than 2 or more than kMaxRing tets, of tets of two labels, or of no chain.
+struct EdgeRing {
+  static constexpr int kMaxRing = 7;  // (TCI_MAX_RING, cl/improve_flip.h)
+  std::vector<int32_t> tets;
+  int32_t from[kMaxRing] = {}, to[kMaxRing] = {}, r[kMaxRing + 1] = {};
+  int mm = 0, closed = 0, start = 0;
+};
+bool edge_ring(const ImpMesh& m, int32_t a, int32_t b, EdgeRing& ring);
+
 // The operations alone (tests): each returns whether it changed the mesh.
 // open_rings_only: only the edges of the boundary (the device takes the others).
 bool try_edge_removal(ImpMesh& m, int32_t a, int32_t b, bool open_rings_only = false);

@@ -10,34 +10,20 @@
 #include <limits>
 
 #include "improve/improve_mesh.hpp"
-#include "improve_flip.h"
 #include "improve_relocate.h"
 
 namespace tc::improve_detail {
 
 namespace {
 
-constexpr int kMaxRing = TCI_MAX_RING;
-
 // The tets around the edge (a, b), when they close around it inside one label with no face at
 // it that the input tags (an interior edge), else empty.
 std::vector<int32_t> interior_ring(const ImpMesh& m, int32_t a, int32_t b) {
-  std::vector<int32_t> ring;
-  if (m.tagged_edge(a, b)) return ring;
-  for (int32_t t : m.tets_of(a))
-    if (contains(m.tet(t), b)) ring.push_back(t);
-  const int n = int(ring.size());
-  if (n < 3 || n > kMaxRing) return {};
-  int32_t from[kMaxRing] = {}, to[kMaxRing] = {}, r[kMaxRing + 1] = {};
-  for (int i = 0; i < n; ++i) {
-    if (m.label(ring[size_t(i)]) != m.label(ring[0])) return {};
-    geo::tci_others(m.tet(ring[size_t(i)]).data(), a, b, &from[i], &to[i]);
-  }
-  int mm = 0, closed = 0, start = 0;
-  if (!geo::tci_chain(n, from, to, r, &mm, &closed, &start) || !closed) return {};
-  for (int i = 0; i < mm; ++i)
-    if (m.tagged_face(a, b, r[i]) || !m.selected(r[i])) return {};
-  return ring;
+  EdgeRing ring;
+  if (m.tagged_edge(a, b) || !edge_ring(m, a, b, ring) || !ring.closed || ring.tets.size() < 3) return {};
+  for (int i = 0; i < ring.mm; ++i)
+    if (m.tagged_face(a, b, ring.r[i]) || !m.selected(ring.r[i])) return {};
+  return ring.tets;
 }
 
 }  // namespace
