@@ -198,4 +198,17 @@ double bbox_diagonal(const Mesh& mesh) {
   return std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
 }
 
+double mean_tet_volume(const Mesh& mesh, const std::vector<uint8_t>* skip) {
+  double sum = 0;
+  int64_t n = 0;
+  for (int64_t t = 0; t < mesh.num_tets(); ++t) {
+    if (skip && (*skip)[size_t(t)]) continue;
+    geo::tc_d3 p[4];
+    for (size_t k = 0; k < 4; ++k) p[k] = geo::tc_point(mesh.points.data(), mesh.tets[size_t(4 * t) + k]);
+    sum += std::fabs(geo::tc_tet_volume(p[0], p[1], p[2], p[3]));
+    ++n;
+  }
+  return n > 0 ? sum / double(n) : 0;
+}
+
 }  // namespace tc

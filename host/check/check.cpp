@@ -316,15 +316,8 @@ void Analysis::orientation() {
   FindingBuilder flat(Severity::Error, "flat_tet", "tets with zero volume (exact)", opt.max_offenders);
   double small_below = opt.eps_volume;
   if (!opt.eps_volume_absolute) {  // x the mean tet volume, as the collapse's threshold
-    double sum = 0;
-    int64_t n = 0;
-    for (int64_t t = 0; t < nt; ++t) {
-      if (unusable[size_t(t)]) continue;
-      const int32_t* v = &m.tets[4 * t];
-      sum += std::fabs(geo::tc_tet_volume(P(v[0]), P(v[1]), P(v[2]), P(v[3])));
-      ++n;
-    }
-    small_below *= n > 0 ? sum / double(n) : 1.0;
+    const double mean = mean_tet_volume(m, &unusable);
+    small_below *= mean > 0 ? mean : 1.0;
   }
   FindingBuilder small(opt.small_volume_is_error ? Severity::Error : Severity::Warning, "small_volume",
                        "positive tets with volume below " + num(small_below), opt.max_offenders);

@@ -78,14 +78,7 @@ double volume_threshold(const Mesh& mesh, const CollapseOptions& options) {
       break;
   }
   // (unsigned: a mesh of negative tets refused later is measured as well)
-  double sum = 0;
-  for (size_t t = 0; t + 3 < mesh.tets.size(); t += 4) {
-    geo::tc_d3 p[4];
-    for (size_t k = 0; k < 4; ++k) p[k] = geo::tc_point(mesh.points.data(), mesh.tets[t + k]);
-    sum += std::fabs(geo::tc_tet_volume(p[0], p[1], p[2], p[3]));
-  }
-  const int64_t n = mesh.num_tets();
-  return n > 0 ? options.eps_v * (sum / double(n)) : options.eps_v;
+  return mesh.num_tets() > 0 ? options.eps_v * mean_tet_volume(mesh) : options.eps_v;
 }
 
 double boundary_error_bound(const Mesh& mesh, const CollapseOptions& options) {

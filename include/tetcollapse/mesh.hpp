@@ -81,6 +81,11 @@ enum class OrientationPolicy {
 // distances (ImproveOptions::max_boundary_move, ...) are shares of.
 double bbox_diagonal(const Mesh& mesh);
 
+// The mean of the tets' unsigned volumes, the tets that `skip` marks (non-zero) left out (0
+// without tets): what the volume thresholds (CollapseOptions::eps_v, CheckOptions::eps_volume)
+// are shares of by default.
+double mean_tet_volume(const Mesh& mesh, const std::vector<uint8_t>* skip = nullptr);
+
 // Bring the mesh to positive orientation. A consistently negative mesh is flipped
 // (swap of the last two vertices of each tet). Mixed orientation: with Refuse, throws
 // tc::InputError naming the counts; with Fix, flips the negative tets.
