@@ -302,15 +302,21 @@ bool SequentialRun::step() {
     double base = 0, change = 0;  // (the bound's, for dir)
     const bool merge = merges_feature(e.a, e.b);  // (measured alone, onto its end point)
     if (bound_ > 0 && !merge) dir = sm_.closest_placement(e.a, e.b, dir, eps_, &base, &change);
-    if (!sm_.guard_ok(e.a, e.b, dir)) {
+    const auto guard_refuses = [&] {
+      if (sm_.guard_ok(e.a, e.b, dir)) return false;
       // refused by the surface guard, which looks beyond the star: its end points count as
       // touched, so the edge is tested again next iteration (S nearby may have moved away)
       touched_[e.a] = touched_[e.b] = cur;
       ++guard_refusals;
       ++s.refused_by_guard;
       if (greedy_) refused_.insert(refused_.end(), {e.a, e.b});
-      continue;
-    }
+      return true;
+    };
+    // Greedy (the host tail), the bounds come first: they refuse most of what is popped there,
+    // the guard hardly anything they let through, and an edge both refuse is tested again only
+    // once its star changes either way. Else the guard first: its refusal defers the edges at
+    // its end points (sequential_skip_invalidated).
+    if (!greedy_ && guard_refuses()) continue;
     double eps_after = 0;
     bool measured = false;
     if (bound_ > 0) {
@@ -328,6 +334,7 @@ bool SequentialRun::step() {
       ++s.refused_by_bound;
       continue;  // (as the boundary bound: the verdict changes only with the star)
     }
+    if (greedy_ && guard_refuses()) continue;
     const int32_t survivor = sm_.collapse(e.a, e.b, dir);
     ++collapses_;
     if (field_) field_->apply(mesh_, survivor);
