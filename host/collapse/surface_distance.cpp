@@ -212,7 +212,9 @@ class Pieces {
     }
     // most pieces are certified by the nearest: the order of the others only when it fails
     if (!L.order.empty() && holds(c, std::min_element(L.order.begin(), L.order.end())->second)) return true;
-    std::sort(L.order.begin(), L.order.end());
+    // (the nearest in order, for two_cover and fan_cover; any feature that holds certifies)
+    std::partial_sort(L.order.begin(), L.order.begin() + ptrdiff_t(std::min(kNearest, L.order.size())),
+                      L.order.end());
     for (const auto& [key, f] : L.order)
       if (holds(c, f)) return true;
     if (two_cover(c, L.order) || fan_cover(c, L.order)) return true;
@@ -227,7 +229,7 @@ class Pieces {
       }
     tc_d3 lo, hi;
     box_of(P, lo, hi);
-    L.near.clear();  // the features within reach of the piece, nearest first
+    L.near.clear();  // the features within reach of the piece (the nearest first)
     for (const auto& [key, f] : L.order)
       if (!boxes_apart(lo_[size_t(f)], hi_[size_t(f)], lo, hi, e_)) L.near.push_back(f);
     const size_t keep = pts_.size();
@@ -246,8 +248,9 @@ class Pieces {
   // feature where its corners do. A piece across an edge of the features is then certified
   // whole instead of being split down to the edge. (Any plane would do for the proof; rounding
   // moves the cut points by far less than the margin of change_ok.)
+  static constexpr size_t kNearest = 6;  // the features two_cover tries, nearest first
+
   bool two_cover(const std::array<int32_t, 3>& c, const std::vector<std::pair<double, int32_t>>& order) {
-    constexpr size_t kNearest = 6;  // the features tried, nearest first
     int32_t f[kNearest];
     int mask[kNearest];
     size_t n = 0;
