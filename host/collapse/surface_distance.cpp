@@ -342,11 +342,16 @@ class Pieces {
     for (int32_t i = 0; i < f.k; ++i) {
       const tc_d3 ms = next;
       next = side(i + 1);
-      tc_d3 a[5] = {P[0], P[1], P[2]}, r[5];
+      // Sutherland-Hodgman: the part on m's positive side. Each clip adds a point per edge that
+      // changes side: one triangle gives at most 4 points, and 4 give at most 6 when rounding
+      // alternates their sides (a polygon nearly in the plane), so 8 hold both clips.
+      constexpr int kPoly = 8;
+      tc_d3 a[kPoly] = {P[0], P[1], P[2]}, r[kPoly];
       int na = 3;
-      for (const tc_d3& m : {ms, next * -1.0}) {  // Sutherland-Hodgman: the part on m's positive side
+      for (const tc_d3& m : {ms, next * -1.0}) {
         int nr = 0;
         for (int j = 0; j < na; ++j) {
+          if (nr + 2 > kPoly) return false;  // (never: see above; not certified rather than overrun)
           const tc_d3 p = a[j], q = a[(j + 1) % na];
           const double hp = dot(p - f.o, m), hq = dot(q - f.o, m);
           if (hp >= 0) r[nr++] = p;
