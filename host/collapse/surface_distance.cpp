@@ -10,6 +10,8 @@
 #include <mutex>
 #include <thread>
 
+#include "topology/topology_detail.hpp"
+
 namespace tc::surface_distance {
 
 using geo::dot;
@@ -420,18 +422,13 @@ Fans::Fans(const std::vector<Tri>& t) : t_(t) {
   };
   std::sort(c.begin(), c.end(), less);
   tri_verts_.resize(t.size());
+  std::vector<int32_t> corner_vertex(c.size()), corner_tri(c.size());
   for (size_t i = 0; i < c.size(); ++i) {
     if (i == 0 || less(c[i - 1], c[i])) verts_.push_back(c[i].p);
-    tri_verts_[size_t(c[i].at / 3)][size_t(c[i].at % 3)] = int32_t(verts_.size() - 1);
+    corner_vertex[size_t(c[i].at)] = tri_verts_[size_t(c[i].at / 3)][size_t(c[i].at % 3)] = int32_t(verts_.size() - 1);
+    corner_tri[size_t(c[i].at)] = c[i].at / 3;
   }
-  off_.assign(verts_.size() + 1, 0);
-  for (const auto& tv : tri_verts_)
-    for (int32_t v : tv) ++off_[size_t(v) + 1];
-  for (size_t v = 0; v < verts_.size(); ++v) off_[v + 1] += off_[v];
-  tris_.resize(size_t(off_.back()));
-  std::vector<int32_t> fill(off_.begin(), off_.end() - 1);
-  for (size_t i = 0; i < tri_verts_.size(); ++i)
-    for (int32_t v : tri_verts_[i]) tris_[size_t(fill[size_t(v)]++)] = int32_t(i);
+  topology_detail::build_csr(int32_t(verts_.size()), corner_vertex, corner_tri, off_, tris_);
   state_ = std::make_unique<std::atomic<uint8_t>[]>(verts_.size());
   for (size_t v = 0; v < verts_.size(); ++v) state_[v] = 0;
   axis_.resize(verts_.size());
