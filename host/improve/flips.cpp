@@ -13,7 +13,6 @@ namespace tc::improve_detail {
 namespace {
 
 constexpr int kMaxRing = TCI_MAX_RING;
-static_assert(EdgeRing::kMaxRing == kMaxRing);
 
 }  // namespace
 

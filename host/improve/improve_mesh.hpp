@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "geometry.h"
+#include "improve_flip.h"
 #include "tetcollapse/device.hpp"
 #include "tetcollapse/improve.hpp"
 #include "tetcollapse/mesh.hpp"
@@ -225,7 +226,7 @@ void smooth_pass(ImpMesh& m, Context& ctx, const std::vector<int32_t>& bad, Impr
 // (a, b, r[mm-1]) on the boundary. Filled by edge_ring (flips.cpp), which is false for an edge
 // of fewer than 2 or more than kMaxRing tets, of tets of two labels, or of no chain.
 struct EdgeRing {
-  static constexpr int kMaxRing = 7;  // (TCI_MAX_RING, cl/improve_flip.h)
+  static constexpr int kMaxRing = TCI_MAX_RING;
   std::vector<int32_t> tets;
   int32_t from[kMaxRing] = {}, to[kMaxRing] = {}, r[kMaxRing + 1] = {};
   int mm = 0, closed = 0, start = 0;
