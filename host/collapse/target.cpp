@@ -26,8 +26,8 @@ double median_of(std::vector<double> v) {
 
 double median_edge_length(const Mesh& mesh) {
   // Each edge once, at its smaller end point, from a vertex -> tets list: 4 bytes per tet corner
-  // and 8 per edge, where sorting the tets' edge keys took 32 bytes per tet edge (2 GB on the
-  // 10.7M-tet mesh, which rank 0 of the MPI tool measures before anything else).
+  // and 8 per edge, where sorting the tets' edge keys took 32 bytes per tet edge (and rank 0 of
+  // the MPI tool measures the whole input before anything else: bench/README.md).
   const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
   const auto valid = [nv](int32_t v) { return v >= 0 && v < nv; };
   std::vector<int64_t> offset(size_t(nv + 1), 0);
