@@ -720,3 +720,34 @@ TEST(CollapseUserFunctions, BadSourcesAndTheSequentialMethodAreRefused) {
   Mesh c = m;
   EXPECT_THROW(collapse(c, o, ctx), std::invalid_argument);
 }
+
+namespace {
+
+// The lower median of the lengths of the distinct edges, from a set of vertex pairs.
+double brute_median(const Mesh& m, bool each_tet_edge = false) {
+  std::set<std::pair<int32_t, int32_t>> seen;
+  std::vector<double> len;
+  for (size_t t = 0; t + 3 < m.tets.size(); t += 4)
+    for (const auto& e : geo::TC_TET_EDGES) {
+      const int32_t a = std::min(m.tets[t + size_t(e[0])], m.tets[t + size_t(e[1])]);
+      const int32_t b = std::max(m.tets[t + size_t(e[0])], m.tets[t + size_t(e[1])]);
+      if (!each_tet_edge && !seen.insert({a, b}).second) continue;
+      len.push_back(geo::length(geo::tc_point(m.points.data(), b) - geo::tc_point(m.points.data(), a)));
+    }
+  std::sort(len.begin(), len.end());
+  return len.empty() ? 0 : len[(len.size() - 1) / 2];
+}
+
+}  // namespace
+
+TEST(TargetLength, TheMedianCountsEachEdgeOnce) {
+  // two tets on a common face, its three edges short: counted once each they are three of nine
+  // edges; counted per tet, six of twelve, and the lower median would be one of them
+  Mesh two;
+  two.points = {0, 0, 5, 0, 0, 0, 0.1, 0, 0, 0, 0.1, 0, 0, 0, -5};
+  two.tets = {1, 2, 3, 0, 1, 3, 2, 4};
+  ASSERT_NE(brute_median(two), brute_median(two, true));  // (the case tells the two apart)
+  EXPECT_EQ(median_edge_length(two), brute_median(two));
+  for (const Mesh& m : {test::cube_tets(3), test::ball(5), test::notched_cube(4)}) EXPECT_EQ(median_edge_length(m), brute_median(m));
+  EXPECT_EQ(median_edge_length(Mesh{}), 0.0);
+}
