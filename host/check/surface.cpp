@@ -88,7 +88,9 @@ Hausdorff hausdorff(const Soup& a, const Soup& b, double error_bound) {
   // does not); every task reads meshes of its own, since CGAL may add a property map to a mesh it
   // reads. Each task gives the same value whatever the thread that runs it. (CGAL's parallel tag
   // would need TBB and METIS.)
-  const size_t threads = std::max(1u, std::thread::hardware_concurrency());
+  // (at most kMaxParts per direction: each part holds a copy of the other surface)
+  constexpr size_t kMaxParts = 4;
+  const size_t threads = std::min<size_t>(kMaxParts, std::max(1u, std::thread::hardware_concurrency()));
   const auto from_parts = [&](const Soup& from, const SM& to) {
     const size_t nf = from.tris.size() / 3, parts = std::min(threads, std::max<size_t>(1, nf / 1024));
     std::vector<std::future<double>> tasks;
