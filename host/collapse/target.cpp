@@ -9,6 +9,7 @@
 #include "collapse/cost.hpp"
 #include "collapse/edge_state.hpp"
 #include "geometry.h"
+#include "topology/faces_at_vertices.hpp"
 
 namespace tc {
 
@@ -28,39 +29,21 @@ double median_edge_length(const Mesh& mesh) {
   // Each edge once, at its smaller end point, from a vertex -> tets list: 4 bytes per tet corner
   // and 8 per edge, where sorting the tets' edge keys took 32 bytes per tet edge (and rank 0 of
   // the MPI tool measures the whole input before anything else: bench/README.md).
-  const int64_t nv = mesh.num_vertices(), nt = mesh.num_tets();
+  const int64_t nv = mesh.num_vertices();
   const auto valid = [nv](int32_t v) { return v >= 0 && v < nv; };
-  std::vector<int64_t> offset(size_t(nv + 1), 0);
-  for (int32_t v : mesh.tets)
-    if (valid(v)) ++offset[size_t(v) + 1];
-  for (int64_t v = 0; v < nv; ++v) offset[size_t(v + 1)] += offset[size_t(v)];
-  std::vector<int32_t> around(static_cast<size_t>(offset[size_t(nv)]));
-  {
-    std::vector<int64_t> fill(offset.begin(), offset.end() - 1);
-    for (int64_t t = 0; t < nt; ++t)
-      for (int k = 0; k < 4; ++k)
-        if (const int32_t v = mesh.tets[size_t(4 * t + k)]; valid(v)) around[size_t(fill[size_t(v)]++)] = int32_t(t);
-  }
+  const topology_detail::VertexTets vt(mesh);
   std::vector<int32_t> seen(size_t(nv), -1);  // seen[w] == v: the edge (v, w) is counted
   std::vector<double> len;
-  const auto dist = [&](int32_t a, int32_t b) {
-    double d = 0;
-    for (int c = 0; c < 3; ++c) {
-      const double x = mesh.points[3 * size_t(b) + size_t(c)] - mesh.points[3 * size_t(a) + size_t(c)];
-      d += x * x;
-    }
-    return std::sqrt(d);
-  };
   for (int32_t v = 0; v < int32_t(nv); ++v)
-    for (int64_t i = offset[size_t(v)]; i < offset[size_t(v) + 1]; ++i) {
-      const int32_t* q = &mesh.tets[4 * size_t(around[size_t(i)])];
+    for (int64_t i = vt.offset[size_t(v)]; i < vt.offset[size_t(v) + 1]; ++i) {
+      const int32_t* q = &mesh.tets[4 * size_t(vt.around[size_t(i)])];
       int self = 0;  // (a tet that repeats v has the edge (v, v), of length 0)
       for (int k = 0; k < 4; ++k) {
         const int32_t w = q[k];
         self += w == v;
         if (valid(w) && (w > v || (w == v && self == 2)) && seen[size_t(w)] != v) {
           seen[size_t(w)] = v;
-          len.push_back(dist(v, w));
+          len.push_back(geo::length(geo::tc_point(mesh.points.data(), w) - geo::tc_point(mesh.points.data(), v)));
         }
       }
     }
