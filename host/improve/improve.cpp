@@ -120,12 +120,13 @@ void passes(Mesh& mesh, ImproveOptions& options, Context* ctx, int max_passes, I
     if (options.progress) options.progress(stats);
     if (stats.edge_removals + stats.flips23 + stats.boundary_removals + stats.splits + stats.relocated == 0) break;
     // Later passes make ever smaller gains on the same vertices: stop once a pass leaves the
-    // worst angle and the counts below 10 and 13 degrees (nearly) as they were.
+    // worst angle and the counts below 10 and 13 degrees (nearly) as they were (counts at zero
+    // included, which no pass can lower).
     if (it > 0) {
       const ImprovePassStats& prev = report.passes[report.passes.size() - 2];
-      if (stats.min_dihedral_deg < prev.min_dihedral_deg + kMinAngleGain &&
-          stats.below_10_deg > prev.below_10_deg * (1 - kMinCountGain) &&
-          stats.below_13_deg > prev.below_13_deg * (1 - kMinCountGain))
+      const auto kept = [](int64_t now, int64_t before) { return !(double(now) < double(before) * (1 - kMinCountGain)); };
+      if (stats.min_dihedral_deg < prev.min_dihedral_deg + kMinAngleGain && kept(stats.below_10_deg, prev.below_10_deg) &&
+          kept(stats.below_13_deg, prev.below_13_deg))
         break;
     }
   }

@@ -473,6 +473,30 @@ TEST(ImproveDevice, SameMeshWhateverTheWorkGroupSize) {
   }
 }
 
+// The passes stop at the first that leaves the smallest angle (within 0.05 degrees) and the
+// counts below 10 and 13 degrees (within 5%) as they were, counts of zero included: a mesh
+// with nothing below 13 degrees but tets below the threshold (40 degrees here), whose
+// relocations go on moving a few vertices, is not polished pass after pass up to
+// max_iterations.
+TEST(ImprovePhase, StopsAtThePassThatGainsNothingEvenWithNoBadCounts) {
+  const Mesh m = jiggled_cube(6, 0.03, 9);
+  ImproveOptions o;
+  o.threshold_deg = 40;
+  o.collapse = false;
+  Mesh d = m;
+  const ImproveReport r = improve(d, o);
+  ASSERT_GE(r.passes.size(), 2u);
+  EXPECT_EQ(r.before.below_13_deg, 0) << "nothing below 13 degrees to begin with";
+  EXPECT_LT(r.passes.size(), size_t(o.max_iterations)) << "stopped by the stall rule";
+  for (size_t i = 1; i + 1 < r.passes.size(); ++i) {
+    const ImprovePassStats &prev = r.passes[i - 1], &p = r.passes[i];
+    const bool gained = p.min_dihedral_deg >= prev.min_dihedral_deg + 0.05 ||
+                        double(p.below_10_deg) < 0.95 * double(prev.below_10_deg) ||
+                        double(p.below_13_deg) < 0.95 * double(prev.below_13_deg);
+    EXPECT_TRUE(gained) << "pass " << i << " gained nothing, yet pass " << i + 1 << " ran";
+  }
+}
+
 TEST(ImprovePhase, OnlyTheMaskedVerticesMove) {
   Mesh m = jiggled_cube(5, 0.03, 11);
   ImproveOptions o;
