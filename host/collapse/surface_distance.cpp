@@ -97,6 +97,8 @@ double box_dist2(tc_d3 p, tc_d3 lo, tc_d3 hi) {
   return dx * dx + dy * dy + dz * dz;
 }
 
+tc_d3 centroid_of(const Tri& t) { return (t[0] + t[1] + t[2]) * (1.0 / 3); }
+
 bool boxes_apart(tc_d3 alo, tc_d3 ahi, tc_d3 blo, tc_d3 bhi, double pad) {
   return alo.x > bhi.x + pad || ahi.x < blo.x - pad || alo.y > bhi.y + pad || ahi.y < blo.y - pad ||
          alo.z > bhi.z + pad || ahi.z < blo.z - pad;
@@ -144,9 +146,16 @@ class Pieces {
   // set by another thread when the verdict is known: every piece then fails at once
   const std::atomic<bool>* stop = nullptr;
 
+  // Boxes and centroids computed once for an array of triangles the features point into
+  // (feature i's at index feats[i] - base), instead of at each reset.
+  struct Known {
+    const Tri* base;
+    const tc_d3 *lo, *hi, *centroid;
+  };
+
   // fans: the fans of the surface the features point into (fan_cover), or null
   void reset(const std::vector<const Tri*>& feats, double e2, const std::function<bool(const Tri&)>* relevant,
-             const Fans* fans = nullptr, const Tri* fans_base = nullptr) {
+             const Fans* fans = nullptr, const Tri* fans_base = nullptr, const Known* known = nullptr) {
     feats_ = &feats;
     fans_ = fans;
     fans_base_ = fans_base;
@@ -157,9 +166,15 @@ class Pieces {
     lo_.resize(feats.size());
     hi_.resize(feats.size());
     for (size_t f = 0; f < feats.size(); ++f) {
-      const Tri& t = *feats[f];
-      centroids_[f] = (t[0] + t[1] + t[2]) * (1.0 / 3);
-      box_of(t, lo_[f], hi_[f]);
+      if (known) {
+        const size_t i = size_t(feats[f] - known->base);
+        centroids_[f] = known->centroid[i];
+        lo_[f] = known->lo[i];
+        hi_[f] = known->hi[i];
+      } else {
+        centroids_[f] = centroid_of(*feats[f]);
+        box_of(*feats[f], lo_[f], hi_[f]);
+      }
     }
   }
 
@@ -208,12 +223,15 @@ class Pieces {
     // the features nearest the piece first: the one that certifies it is then found at once
     const tc_d3 m = (P[0] + P[1] + P[2]) * (1.0 / 3);
     L.order.clear();
+    std::pair<double, int32_t> nearest{INFINITY, -1};  // (as std::min_element over L.order)
     for (int32_t f : feats) {
       const tc_d3 d = m - centroids_[size_t(f)];
-      L.order.push_back({dot(d, d), f});
+      const std::pair<double, int32_t> key{dot(d, d), f};
+      L.order.push_back(key);
+      if (nearest.second < 0 || key < nearest) nearest = key;
     }
     // most pieces are certified by the nearest: the order of the others only when it fails
-    if (!L.order.empty() && holds(c, std::min_element(L.order.begin(), L.order.end())->second)) return true;
+    if (nearest.second >= 0 && holds(c, nearest.second)) return true;
     // (the nearest in order, for two_cover and fan_cover; any feature that holds certifies)
     std::partial_sort(L.order.begin(), L.order.begin() + ptrdiff_t(std::min(kNearest, L.order.size())),
                       L.order.end());
@@ -538,6 +556,8 @@ ReferenceSurface::ReferenceSurface(const std::vector<double>& triangles) {
   seen_.assign(tris_.size(), 0);
   lo_.resize(tris_.size());
   hi_.resize(tris_.size());
+  centroids_.resize(tris_.size());
+  for (size_t i = 0; i < tris_.size(); ++i) centroids_[i] = centroid_of(tris_[i]);
   const auto c = [&](double x, double o) { return int64_t(std::floor((x - o) / cell_)); };
   for (int32_t i = 0; i < int32_t(tris_.size()); ++i) {
     tc_d3& lo = lo_[size_t(i)];
@@ -717,16 +737,16 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
   };
   // The pieces, the new triangles' first, taken in turn by each thread: the verdict is that
   // all hold, whichever thread measures which.
-  std::vector<const Tri*> sides;  // the new triangles and those around, with their boxes
-  std::vector<tc_d3> side_lo, side_hi;
-  for (const auto* set : {&news, &around})
-    for (const Tri& f : *set) {
-      tc_d3 fl, fh;
-      box_of(f, fl, fh);
-      sides.push_back(&f);
-      side_lo.push_back(fl);
-      side_hi.push_back(fh);
-    }
+  std::vector<Tri> sides;  // the new triangles and those around, with their boxes and centroids
+  sides.insert(sides.end(), news.begin(), news.end());
+  sides.insert(sides.end(), around.begin(), around.end());
+  std::vector<tc_d3> side_lo(sides.size()), side_hi(sides.size()), side_c(sides.size());
+  for (size_t f = 0; f < sides.size(); ++f) {
+    box_of(sides[f], side_lo[f], side_hi[f]);
+    side_c[f] = centroid_of(sides[f]);
+  }
+  const Pieces::Known known_sides{sides.data(), side_lo.data(), side_hi.data(), side_c.data()};
+  const Pieces::Known known_tris{tris_.data(), lo_.data(), hi_.data(), centroids_.data()};
   const size_t jobs = news.size() + ids.size();
   std::atomic<size_t> next{0};
   std::atomic<bool> failed{false};
@@ -735,22 +755,25 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
     thread_local Pieces pieces;
     thread_local std::vector<const Tri*> feats;
     pieces.stop = &failed;
-    for (size_t k = next++; k < jobs && !failed.load(std::memory_order_relaxed); k = next++) {
-      bool ok;
-      if (k < news.size()) {
-        pieces.reset(near[k], e2, nullptr, fans_.get(), tris_.data());  // (near: triangles of tris_)
-        ok = pieces.within(news[k], kDepth);
-      } else {
-        const size_t r = size_t(ids[k - news.size()]);
-        const Tri& t = tris_[r];
-        feats.clear();
-        for (size_t f = 0; f < sides.size(); ++f)
-          if (!boxes_apart(side_lo[f], side_hi[f], lo_[r], hi_[r], e)) feats.push_back(sides[f]);
-        pieces.reset(feats, e2, &relevant);
-        ok = pieces.within(t, kDepth);
+    // (the jobs in chunks: one atomic per job bounced its cache line between the threads)
+    for (size_t k0 = next.fetch_add(kJobChunk); k0 < jobs && !failed.load(std::memory_order_relaxed);
+         k0 = next.fetch_add(kJobChunk))
+      for (size_t k = k0, k1 = std::min(jobs, k0 + kJobChunk); k < k1 && !failed.load(std::memory_order_relaxed); ++k) {
+        bool ok;
+        if (k < news.size()) {
+          pieces.reset(near[k], e2, nullptr, fans_.get(), tris_.data(), &known_tris);  // (near: triangles of tris_)
+          ok = pieces.within(news[k], kDepth);
+        } else {
+          const size_t r = size_t(ids[k - news.size()]);
+          const Tri& t = tris_[r];
+          feats.clear();
+          for (size_t f = 0; f < sides.size(); ++f)
+            if (!boxes_apart(side_lo[f], side_hi[f], lo_[r], hi_[r], e)) feats.push_back(&sides[f]);
+          pieces.reset(feats, e2, &relevant, nullptr, nullptr, &known_sides);
+          ok = pieces.within(t, kDepth);
+        }
+        if (!ok) failed = true;
       }
-      if (!ok) failed = true;
-    }
   };
   // (the core count once: the library reads it from the system at each call)
   static const bool two_cores = std::thread::hardware_concurrency() > 1;

@@ -73,8 +73,9 @@ class ReferenceSurface {
   class Helper;
   static constexpr int kDepth = 8;          // splits of a piece: 4^8 pieces at most
   static constexpr size_t kTwoThreadJobs = 8;  // triangles measured from which a check takes two threads
+  static constexpr size_t kJobChunk = 4;       // triangles a thread takes at a time
   std::vector<Tri> tris_;
-  std::vector<tc_d3> lo_, hi_;  // per triangle: its box
+  std::vector<tc_d3> lo_, hi_, centroids_;  // per triangle: its box and centroid
   std::unique_ptr<class Fans> fans_;  // the triangles around each vertex (surface_distance.cpp)
   std::unordered_map<int64_t, std::vector<int32_t>> cells_;
   double cell_ = 1;
