@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <mutex>
 #include <thread>
 
@@ -99,6 +100,24 @@ double box_dist2(tc_d3 p, tc_d3 lo, tc_d3 hi) {
 
 tc_d3 centroid_of(const Tri& t) { return (t[0] + t[1] + t[2]) * (1.0 / 3); }
 
+// A triangle's name whatever the order of its corners (a hash of their bits, never 0): a hint
+// only, every use of it checks the distances again.
+uint64_t tri_key(const Tri& t) {
+  std::array<tc_d3, 3> c = t;
+  const auto less = [](const tc_d3& a, const tc_d3& b) {
+    return a.x < b.x || (a.x == b.x && (a.y < b.y || (a.y == b.y && a.z < b.z)));
+  };
+  std::sort(c.begin(), c.end(), less);
+  uint64_t h = 0x9e3779b97f4a7c15ull;
+  for (const tc_d3& p : c)
+    for (double x : {p.x, p.y, p.z}) {
+      uint64_t b;
+      std::memcpy(&b, &x, sizeof b);
+      h ^= b + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+    }
+  return h ? h : 1;
+}
+
 bool boxes_apart(tc_d3 alo, tc_d3 ahi, tc_d3 blo, tc_d3 bhi, double pad) {
   return alo.x > bhi.x + pad || ahi.x < blo.x - pad || alo.y > bhi.y + pad || ahi.y < blo.y - pad ||
          alo.z > bhi.z + pad || ahi.z < blo.z - pad;
@@ -178,9 +197,15 @@ class Pieces {
     }
   }
 
+  // The feature that held the whole triangle of the last within() (every point within e of
+  // it), or -1 when none did alone.
+  int32_t whole() const { return whole_; }
+
   bool within(const Tri& P, int depth) {
     pts_.clear();
     dist_.clear();
+    whole_ = -1;
+    top_ = depth;
     const std::array<int32_t, 3> c = {add(P[0]), add(P[1]), add(P[2])};
     if (levels_.size() < size_t(depth) + 1) levels_.resize(size_t(depth) + 1);
     std::vector<int32_t>& all = levels_[size_t(depth)].all;
@@ -231,12 +256,18 @@ class Pieces {
       if (nearest.second < 0 || key < nearest) nearest = key;
     }
     // most pieces are certified by the nearest: the order of the others only when it fails
-    if (nearest.second >= 0 && holds(c, nearest.second)) return true;
+    if (nearest.second >= 0 && holds(c, nearest.second)) {
+      if (depth == top_) whole_ = nearest.second;
+      return true;
+    }
     // (the nearest in order, for two_cover and fan_cover; any feature that holds certifies)
     std::partial_sort(L.order.begin(), L.order.begin() + ptrdiff_t(std::min(kNearest, L.order.size())),
                       L.order.end());
     for (const auto& [key, f] : L.order)
-      if (holds(c, f)) return true;
+      if (holds(c, f)) {
+        if (depth == top_) whole_ = f;
+        return true;
+      }
     if (two_cover(c, L.order) || fan_cover(c, L.order)) return true;
     // (whether the piece matters at all only now: most pieces are certified before)
     if (relevant_ && !(*relevant_)(P)) return true;
@@ -392,6 +423,8 @@ class Pieces {
   const Fans* fans_ = nullptr;
   const Tri* fans_base_ = nullptr;
   double e2_ = 0, e_ = 0;
+  int top_ = 0;        // the depth within() started at
+  int32_t whole_ = -1;  // whole()
   const std::function<bool(const Tri&)>* relevant_ = nullptr;
   std::vector<tc_d3> centroids_, lo_, hi_;  // per feature
   std::vector<tc_d3> pts_;                  // the corners of the pieces on the way down
@@ -558,6 +591,7 @@ ReferenceSurface::ReferenceSurface(const std::vector<double>& triangles) {
   hi_.resize(tris_.size());
   centroids_.resize(tris_.size());
   for (size_t i = 0; i < tris_.size(); ++i) centroids_[i] = centroid_of(tris_[i]);
+  holder_.assign(tris_.size(), 0);
   const auto c = [&](double x, double o) { return int64_t(std::floor((x - o) / cell_)); };
   for (int32_t i = 0; i < int32_t(tris_.size()); ++i) {
     tc_d3& lo = lo_[size_t(i)];
@@ -746,6 +780,8 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
     side_c[f] = centroid_of(sides[f]);
   }
   const Pieces::Known known_sides{sides.data(), side_lo.data(), side_hi.data(), side_c.data()};
+  std::vector<uint64_t> side_key(sides.size());
+  for (size_t f = 0; f < sides.size(); ++f) side_key[f] = tri_key(sides[f]);
   const Pieces::Known known_tris{tris_.data(), lo_.data(), hi_.data(), centroids_.data()};
   const size_t jobs = news.size() + ids.size();
   std::atomic<size_t> next{0};
@@ -766,11 +802,25 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
         } else {
           const size_t r = size_t(ids[k - news.size()]);
           const Tri& t = tris_[r];
+          // The S triangle that held all of t in an earlier check, if it is still there: the
+          // nearest-first search would find it too (it is within e of t's box), so trying it
+          // first gives the same verdict (the reference's triangles are measured again in
+          // check after check, and most keep the triangle that held them).
+          if (const uint64_t h = holder_[r]) {
+            const auto at = std::find(side_key.begin(), side_key.end(), h);
+            if (at != side_key.end()) {
+              const Tri& s = sides[size_t(at - side_key.begin())];
+              if (point_triangle_dist2(t[0], s) <= e2 && point_triangle_dist2(t[1], s) <= e2 &&
+                  point_triangle_dist2(t[2], s) <= e2)
+                continue;
+            }
+          }
           feats.clear();
           for (size_t f = 0; f < sides.size(); ++f)
             if (!boxes_apart(side_lo[f], side_hi[f], lo_[r], hi_[r], e)) feats.push_back(&sides[f]);
           pieces.reset(feats, e2, &relevant, nullptr, nullptr, &known_sides);
           ok = pieces.within(t, kDepth);
+          if (ok && pieces.whole() >= 0) holder_[r] = side_key[size_t(feats[size_t(pieces.whole())] - sides.data())];
         }
         if (!ok) failed = true;
       }

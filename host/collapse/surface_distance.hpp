@@ -83,6 +83,9 @@ class ReferenceSurface {
   mutable std::vector<uint32_t> seen_;
   mutable uint32_t stamp_ = 0;
   mutable std::unique_ptr<Helper> helper_;  // the second thread, from the first check that takes it
+  // per triangle: tri_key of the S triangle that held all of it in the last check that measured
+  // it (0: none), tried first the next time (change_ok)
+  mutable std::vector<uint64_t> holder_;
 };
 
 }  // namespace tc::surface_distance

@@ -290,6 +290,43 @@ TEST(SurfaceDistance, RecordedChecksReplayToTheSameVerdicts) {
   EXPECT_FALSE(surface_distance::read_recorded_checks(dir.file("missing.bin").c_str(), none, checks));
 }
 
+// A reference triangle held whole by an S triangle in one check is tried against that triangle
+// first in the next (ReferenceSurface::holder_): the verdicts of a surface that has measured
+// before are those of a fresh one, whether the triangle that held it is still there or gone
+// (its place left bare: the new triangles lie on the reference, so only the reference's side
+// can refuse).
+TEST(SurfaceDistance, ATriangleThatHeldTheReferenceBeforeDecidesNothingOnceItIsGone) {
+  const double e = 0.01;
+  std::vector<double> reference;  // [0, 2] x [0, 1] at z = 0 in small triangles, diagonals (x0, y0)-(x1, y1)
+  const int n = 16;
+  for (int i = 0; i < 2 * n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double x0 = double(i) / n, x1 = double(i + 1) / n, y0 = double(j) / n, y1 = double(j + 1) / n;
+      reference.insert(reference.end(), {x0, y0, 0, x1, y0, 0, x1, y1, 0, x0, y0, 0, x1, y1, 0, x0, y1, 0});
+    }
+  // S: two unit squares, two triangles each along the reference's diagonals (each small
+  // triangle lies in one of them whole)
+  const tc_d3 a{0, 0, 0}, b{1, 0, 0}, c{1, 1, 0}, d{0, 1, 0}, f{2, 0, 0}, g{2, 1, 0};
+  const std::vector<Tri> left = {Tri{a, b, c}, Tri{a, c, d}}, right = {Tri{b, f, g}, Tri{b, g, c}};
+  const std::vector<Tri> right_half = {Tri{b, f, g}};  // (b, g, c) gone, nothing in its place
+  struct Step {
+    const std::vector<Tri>&olds, &news, &around;
+    bool verdict;
+  };
+  const Step steps[] = {
+      {right, right, left, true},        // every small triangle of the right square held by one of it
+      {right, right_half, left, false},  // those (b, g, c) held are left bare: no hint may hold them
+      {right_half, right, left, true},   // (b, g, c) back: held again
+  };
+  const surface_distance::ReferenceSurface used(reference);
+  for (size_t i = 0; i < std::size(steps); ++i) {
+    const Step& st = steps[i];
+    const surface_distance::ReferenceSurface fresh(reference);
+    EXPECT_EQ(fresh.change_ok(st.olds, st.news, st.around, e, e), st.verdict) << i;
+    EXPECT_EQ(used.change_ok(st.olds, st.news, st.around, e, e), st.verdict) << i;
+  }
+}
+
 // Direction from the reference: a new S far from the old one fails through the reference
 // points the old S stood for, even when the new triangles lie on the reference (a tent's base
 // collapsed away from its apex: the base lies on nothing of a raised reference).
