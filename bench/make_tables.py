@@ -20,6 +20,7 @@ results files:
     peers_robot514k
     shared_meshes   bench/results/shared_meshes.json                    (bench/shared_meshes.py; its table)
     quality_peers   bench/results/quality_peers.json                    (bench/quality_peers.py; its table)
+    quality_generality bench/results/quality_generality.json           (bench/quality_generality.py; its table)
     improve_slivers bench/results/improve_slivers.json                  (bench/improve_slivers.py; its table)
     improve_paths   bench/results/improve_paths.json                    (bench/improve_paths.py; its tables)
     volume_rendering bench/results/volume_rendering.json               (bench/volume_rendering.py; its table)
@@ -377,6 +378,7 @@ BLOCKS = {
     "peers_robot514k": lambda: peers_block("robot514k"),
     "shared_meshes": shared_meshes_block,
     "quality_peers": lambda: recorded_block("quality_peers", "quality_peers"),
+    "quality_generality": lambda: recorded_block("quality_generality", "quality_generality"),
     "improve_slivers": lambda: recorded_block("improve_slivers", "improve_slivers"),
     "improve_paths": lambda: recorded_block("improve_paths", "improve_paths"),
     "volume_rendering": lambda: recorded_block("volume_rendering", "volume_rendering"),
