@@ -268,9 +268,12 @@ class Pieces {
         if (depth == top_) whole_ = f;
         return true;
       }
-    if (two_cover(c, L.order) || fan_cover(c, L.order)) return true;
+    if (two_cover(c, L.order)) return true;
     // (whether the piece matters at all only now: most pieces are certified before)
     if (relevant_ && !(*relevant_)(P)) return true;
+    // (the fans of a check's own triangles, which the reference's pieces are measured against,
+    // only for a piece longer than kSideFanMin x e: a shorter one splits down at less cost)
+    if ((!relevant_ || longer_than(P, kSideFanMin * e_)) && fan_cover(c, L.order)) return true;
     if (depth == 0) return false;
     if (!relevant_)  // a corner farther than e from every feature: no split can help
       for (int32_t k : c) {
@@ -318,6 +321,15 @@ class Pieces {
     for (size_t i = 0; i < n; ++i)
       for (size_t j = i + 1; j < n; ++j)
         if ((mask[i] | mask[j]) == 7 && cut_holds(c, f[i], f[j])) return true;
+    return false;
+  }
+
+  static constexpr double kSideFanMin = 8;
+  static bool longer_than(const Tri& P, double l) {
+    for (int i = 0; i < 3; ++i) {
+      const tc_d3 d = P[size_t(i)] - P[size_t((i + 1) % 3)];
+      if (dot(d, d) > l * l) return true;
+    }
     return false;
   }
 
@@ -371,8 +383,9 @@ class Pieces {
   // each convex (less than half a turn), together all of it; the piece's part in a wedge (a
   // convex polygon) lies within e of the wedge's triangle where that polygon's corners do. A
   // piece over a vertex of the features is then certified whole instead of split down to the
-  // size of e around it. Only against a surface whose fans are known (the reference); a fan
-  // that does not wind once around its normal (a sharp corner, a fold) is not tried.
+  // size of e around it. Only against a surface whose fans are known (the reference, or a
+  // check's new and surrounding triangles, whose fans at the patch's rim are not whole); a fan
+  // that does not wind once around its normal (a sharp corner, a fold, a rim) is not tried.
   bool fan_cover(const std::array<int32_t, 3>& c, const std::vector<std::pair<double, int32_t>>& order) {
     if (!fans_ || order.empty()) return false;
     const size_t t = size_t((*feats_)[size_t(order[0].second)] - fans_base_);  // the nearest feature
@@ -780,6 +793,9 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
     side_c[f] = centroid_of(sides[f]);
   }
   const Pieces::Known known_sides{sides.data(), side_lo.data(), side_hi.data(), side_c.data()};
+  // The fans of the new and surrounding triangles, for the reference's pieces over one of their
+  // vertices (a fan the patch holds whole: one at its rim is not one turn, and is not tried).
+  const Fans side_fans(sides);
   std::vector<uint64_t> side_key(sides.size());
   for (size_t f = 0; f < sides.size(); ++f) side_key[f] = tri_key(sides[f]);
   const Pieces::Known known_tris{tris_.data(), lo_.data(), hi_.data(), centroids_.data()};
@@ -818,7 +834,7 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
           feats.clear();
           for (size_t f = 0; f < sides.size(); ++f)
             if (!boxes_apart(side_lo[f], side_hi[f], lo_[r], hi_[r], e)) feats.push_back(&sides[f]);
-          pieces.reset(feats, e2, &relevant, nullptr, nullptr, &known_sides);
+          pieces.reset(feats, e2, &relevant, &side_fans, sides.data(), &known_sides);
           ok = pieces.within(t, kDepth);
           if (ok && pieces.whole() >= 0) holder_[r] = side_key[size_t(feats[size_t(pieces.whole())] - sides.data())];
         }

@@ -290,6 +290,22 @@ TEST(SurfaceDistance, RecordedChecksReplayToTheSameVerdicts) {
   EXPECT_FALSE(surface_distance::read_recorded_checks(dir.file("missing.bin").c_str(), none, checks));
 }
 
+// A reference triangle over a vertex inside the new patch, far larger than the bound, is
+// certified by the patch's fan around that vertex (each wedge's part within e of its triangle),
+// where splitting it would need pieces smaller than the bound around the vertex, deeper than
+// the branch and bound goes.
+TEST(SurfaceDistance, AReferenceTriangleOverANewVertexIsHeldByItsFan) {
+  const double e = 1e-4;
+  const tc_d3 a{0, 0, 0}, b{1, 0, 0}, c{0.3, 1, 0}, v{0.4, 0.35, 0};
+  const std::vector<double> reference = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z};
+  const surface_distance::ReferenceSurface ref(reference);
+  const std::vector<Tri> olds = {Tri{a, b, c}}, news = {Tri{a, b, v}, Tri{b, c, v}, Tri{c, a, v}};
+  EXPECT_TRUE(ref.change_ok(olds, news, {}, e, e)) << "a vertex inserted in the plane moves nothing";
+  // the same vertex lifted beyond the bound: refused
+  const tc_d3 up{v.x, v.y, 3 * e};
+  EXPECT_FALSE(ref.change_ok(olds, {Tri{a, b, up}, Tri{b, c, up}, Tri{c, a, up}}, {}, e, e));
+}
+
 // A reference triangle held whole by an S triangle in one check is tried against that triangle
 // first in the next (ReferenceSurface::holder_): the verdicts of a surface that has measured
 // before are those of a fresh one, whether the triangle that held it is still there or gone
