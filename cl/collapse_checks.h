@@ -124,53 +124,61 @@ TC_FN int tcc_volume_verdict(TCS_VOL_PARAMS, int a, int b, tc_d3 p, double eps_v
     t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
     f_p = f_a + (f_b - f_a) * t;
   }
-  for (int side = 0; side < 2; ++side) {
-    int x = side == 0 ? a : b, y = side == 0 ? b : a;
-    tc_d3 px = side == 0 ? pa : pb;
-    if (px.x == p.x && px.y == p.y && px.z == p.z) continue; /* x does not move: its tets keep their shape */
-    /* In chunks, two loops: first the vertices of the tets (independent loads, so that the
-     * processor has many cache misses in flight; branch-free), then their volumes. One loop
-     * doing both waited for each tet's vertices in turn. */
-    for (unsigned int i0 = TCS_RING_BEGIN(x), iend = TCS_RING_END(x); i0 < iend; i0 += TCC_VOL_CHUNK) {
-      tcs_q4 qs[TCC_VOL_CHUNK];
-      int ts[TCC_VOL_CHUNK];
-      unsigned int m = 0, i1 = iend - i0 < TCC_VOL_CHUNK ? iend : i0 + TCC_VOL_CHUNK;
-      for (unsigned int i = i0; i < i1; ++i) {
-        int t = TCS_RING_TET(i);
-        tcs_q4 q = TCS_Q4(t);
-        qs[m] = q;
-        ts[m] = t;
-        m += (TCS_Q4_HAS(q, y) | TCS_DEAD(t)) ? 0u : 1u; /* else removed by this collapse or an earlier one */
-      }
-      for (unsigned int j = 0; j < m; ++j) {
-        tcs_q4 q = qs[j];
-        tc_d3 c[4];
-        c[0] = q.x == x ? p : TCS_POINT(q.x);
-        c[1] = q.y == x ? p : TCS_POINT(q.y);
-        c[2] = q.z == x ? p : TCS_POINT(q.z);
-        c[3] = q.w == x ? p : TCS_POINT(q.w);
-        double vol = tc_tet_volume(c[0], c[1], c[2], c[3]);
-        if (!(vol >= eps_v)) return TCC_REFUSED_VOLUME;
-#ifdef TCC_USER_PLACEMENT
-        if (!(vol < INFINITY)) return TCC_REFUSED_VOLUME; /* a finite placement far enough overflows */
-#endif
-        if (f_eps > 0.0) {
-          const double f[4] = {q.x == x ? f_p : TCS_FIELD(q.x), q.y == x ? f_p : TCS_FIELD(q.y),
-                               q.z == x ? f_p : TCS_FIELD(q.z), q.w == x ? f_p : TCS_FIELD(q.w)};
-          if (pa.x != p.x || pa.y != p.y || pa.z != p.z) tcc_field_in_tet(c, f, pa, &best_a, &at_a);
-          if (pb.x != p.x || pb.y != p.y || pb.z != p.z) tcc_field_in_tet(c, f, pb, &best_b, &at_b);
+  /* Two passes with the field check: the volumes and the quality guard first, then, only for a
+   * collapse they admit, the field at the end points' old places (most tests are refused by the
+   * first, and the search for the tets that hold those places costs more than the volumes). The
+   * same tets in the same order: the same verdicts. */
+  const int passes = f_eps > 0.0 ? 2 : 1;
+  for (int pass = 0; pass < passes; ++pass) {
+    for (int side = 0; side < 2; ++side) {
+      int x = side == 0 ? a : b, y = side == 0 ? b : a;
+      tc_d3 px = side == 0 ? pa : pb;
+      if (px.x == p.x && px.y == p.y && px.z == p.z) continue; /* x does not move: its tets keep their shape */
+      /* In chunks, two loops: first the vertices of the tets (independent loads, so that the
+       * processor has many cache misses in flight; branch-free), then their volumes. One loop
+       * doing both waited for each tet's vertices in turn. */
+      for (unsigned int i0 = TCS_RING_BEGIN(x), iend = TCS_RING_END(x); i0 < iend; i0 += TCC_VOL_CHUNK) {
+        tcs_q4 qs[TCC_VOL_CHUNK];
+        int ts[TCC_VOL_CHUNK];
+        unsigned int m = 0, i1 = iend - i0 < TCC_VOL_CHUNK ? iend : i0 + TCC_VOL_CHUNK;
+        for (unsigned int i = i0; i < i1; ++i) {
+          int t = TCS_RING_TET(i);
+          tcs_q4 q = TCS_Q4(t);
+          qs[m] = q;
+          ts[m] = t;
+          m += (TCS_Q4_HAS(q, y) | TCS_DEAD(t)) ? 0u : 1u; /* else removed by this collapse or an earlier one */
         }
-        if (q_min > 0.0) {
-          double qn = tc_tet_quality_v(c[0], c[1], c[2], c[3], vol);
-          double qo = TCS_OLD_QUALITY(ts[j], q.x == x ? px : c[0], q.y == x ? px : c[1], q.z == x ? px : c[2],
-                                      q.w == x ? px : c[3]);
-          q_new = qn < q_new ? qn : q_new;
-          q_old = qo < q_old ? qo : q_old;
+        for (unsigned int j = 0; j < m; ++j) {
+          tcs_q4 q = qs[j];
+          tc_d3 c[4];
+          c[0] = q.x == x ? p : TCS_POINT(q.x);
+          c[1] = q.y == x ? p : TCS_POINT(q.y);
+          c[2] = q.z == x ? p : TCS_POINT(q.z);
+          c[3] = q.w == x ? p : TCS_POINT(q.w);
+          if (pass == 1) {
+            const double f[4] = {q.x == x ? f_p : TCS_FIELD(q.x), q.y == x ? f_p : TCS_FIELD(q.y),
+                                 q.z == x ? f_p : TCS_FIELD(q.z), q.w == x ? f_p : TCS_FIELD(q.w)};
+            if (pa.x != p.x || pa.y != p.y || pa.z != p.z) tcc_field_in_tet(c, f, pa, &best_a, &at_a);
+            if (pb.x != p.x || pb.y != p.y || pb.z != p.z) tcc_field_in_tet(c, f, pb, &best_b, &at_b);
+            continue;
+          }
+          double vol = tc_tet_volume(c[0], c[1], c[2], c[3]);
+          if (!(vol >= eps_v)) return TCC_REFUSED_VOLUME;
+#ifdef TCC_USER_PLACEMENT
+          if (!(vol < INFINITY)) return TCC_REFUSED_VOLUME; /* a finite placement far enough overflows */
+#endif
+          if (q_min > 0.0) {
+            double qn = tc_tet_quality_v(c[0], c[1], c[2], c[3], vol);
+            double qo = TCS_OLD_QUALITY(ts[j], q.x == x ? px : c[0], q.y == x ? px : c[1], q.z == x ? px : c[2],
+                                        q.w == x ? px : c[3]);
+            q_new = qn < q_new ? qn : q_new;
+            q_old = qo < q_old ? qo : q_old;
+          }
         }
       }
     }
+    if (pass == 0 && q_min > 0.0 && q_new < (q_old < q_min ? q_old : q_min)) return TCC_REFUSED_QUALITY;
   }
-  if (q_min > 0.0 && q_new < (q_old < q_min ? q_old : q_min)) return TCC_REFUSED_QUALITY;
   if (f_eps > 0.0 && ((best_a > -INFINITY && !(fabs(at_a - f_a) <= f_eps)) ||
                           (best_b > -INFINITY && !(fabs(at_b - f_b) <= f_eps))))
     return TCC_REFUSED_QUALITY;
