@@ -821,7 +821,7 @@ bool ReferenceSurface::change_ok(const std::vector<Tri>& olds, const std::vector
           // The S triangle that held all of t in an earlier check, if it is still there: the
           // nearest-first search would find it too (it is within e of t's box), so trying it
           // first gives the same verdict (the reference's triangles are measured again in
-          // check after check, and most keep the triangle that held them).
+          // check after check, and many keep the triangle that held them).
           if (const uint64_t h = holder_[r]) {
             const auto at = std::find(side_key.begin(), side_key.end(), h);
             if (at != side_key.end()) {

@@ -124,9 +124,11 @@ void passes(Mesh& mesh, ImproveOptions& options, Context* ctx, int max_passes, I
     // included, which no pass can lower).
     if (it > 0) {
       const ImprovePassStats& prev = report.passes[report.passes.size() - 2];
-      const auto kept = [](int64_t now, int64_t before) { return !(double(now) < double(before) * (1 - kMinCountGain)); };
-      if (stats.min_dihedral_deg < prev.min_dihedral_deg + kMinAngleGain && kept(stats.below_10_deg, prev.below_10_deg) &&
-          kept(stats.below_13_deg, prev.below_13_deg))
+      const auto kept = [](int64_t now, int64_t before) {
+        return !(double(now) < double(before) * (1 - kMinCountGain));
+      };
+      if (stats.min_dihedral_deg < prev.min_dihedral_deg + kMinAngleGain &&
+          kept(stats.below_10_deg, prev.below_10_deg) && kept(stats.below_13_deg, prev.below_13_deg))
         break;
     }
   }
