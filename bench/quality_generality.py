@@ -14,13 +14,13 @@ twice its median edge length L, one after the other on the same machine, by benc
 
     tetcollapse IN OUT --target-length L                        (defaults: bound, collapse, improvement)
     mmg3d_O3 IN.mesh -hmin L -hausd H                            (H = 0.001 x the bounding-box diagonal)
-    mmg3d_O3 IN.mesh -hmin L                                     (the issue's reference run)
+    mmg3d_O3 IN.mesh -hmin L                                     (the goals' reference run)
 
-and every output judged by `tetcollapse check OUT --reference IN`. "goals" says which of the
-goals hold for tetcollapse's row: tets below 10 degrees no more than MMG -hmin's (or the
-input's), smallest angle at least MMG -hmin's minus 0.5 degree (or the input's), own time at
-most a fifth of MMG -hmin's; boundary distance within the bound, tets at most 1.1x and own time
-at most a fifth of MMG -hmin -hausd's.
+and every output judged by `tetcollapse check OUT --reference IN`. Below the table, the goals
+that do not hold for each part's tetcollapse row: tets below 10 degrees no more than MMG
+-hmin's (or the input's), smallest angle at least MMG -hmin's minus 0.5 degree (or the
+input's), own time at most a fifth of MMG -hmin's; boundary distance within the bound, tets at
+most 1.1x and own time at most a fifth of MMG -hmin -hausd's.
 
     bench/quality_generality.py --table F.json   prints the markdown table of a results file
 """
@@ -35,6 +35,7 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 import peers  # noqa: E402
+import quality_peers  # noqa: E402
 
 PEERS = "tetcollapse,mmg3d_hmin_hausd,mmg3d_hmin"
 
@@ -113,24 +114,10 @@ def goals(mesh):
 
 
 def table(doc):
-    out = ["| part | tets in | input min dihedral / < 10 deg | peer | tets out | min dihedral | < 10 deg | "
-           "< 13 deg | Hausdorff rel | valid | own s | goals not met |",
-           "|---|---:|---|---|---:|---:|---:|---:|---:|---|---:|---|"]
-    for m in doc["meshes"]:
-        inp, first = m["input"], True
-        missed = ", ".join(k for k, ok in goals(m).items() if not ok) or "none"
-        for r in m["rows"]:
-            head = (f"| {m['mesh']} | {m['tets_in']} | {inp['min_dihedral_deg']:.1f} / {inp['tets_below_10_deg']} "
-                    if first else "| | | ")
-            if "skipped_reason" in r:
-                out.append(head + f"| {r['peer']} | skipped | | | | | | | |")
-            else:
-                out.append(head + f"| {r['peer']} | {r['tets_out']} | {r['min_dihedral_deg']:.1f} | "
-                           f"{r['tets_below_10_deg']} | {r['tets_below_13_deg']} | {r['hausdorff_rel']:.4f} | "
-                           f"{r['valid']} | {r['seconds_algorithm']:.3f} | "
-                           f"{missed if r['peer'] == 'tetcollapse' else ''} |")
-            first = False
-    return "\n".join(out)
+    """quality_peers.py's table, then the goals each part's tetcollapse row does not meet."""
+    missed = [f"- {m['mesh']}: {', '.join(k for k, ok in m['goals'].items() if not ok) or 'none'}"
+              for m in doc["meshes"]]
+    return quality_peers.table(doc) + "\n\nGoals not met by tetcollapse:\n\n" + "\n".join(missed)
 
 
 def main():
