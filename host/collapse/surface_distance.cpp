@@ -269,6 +269,7 @@ class Pieces {
         return true;
       }
     if (two_cover(c, L.order)) return true;
+    if (depth == top_ && !relevant_ && overlay_holds(c)) return true;
     // (whether the piece matters at all only now: most pieces are certified before)
     if (relevant_ && !(*relevant_)(P)) return true;
     // (the fans of a check's own triangles, which the reference's pieces are measured against,
@@ -431,6 +432,125 @@ class Pieces {
     return true;
   }
   tc_d3 fan_vertex(int32_t u) const { return fans_->vertex(u); }
+
+  // Whether the features seen from the piece cut it into cells, each within e of its own
+  // feature: the features projected onto the piece's plane that keep their orientation (the
+  // surface facing the piece's way) are clipped to it, and each cell, convex, lies within e of
+  // its feature where its corners do. They cover the piece when none of their free edges (an
+  // edge not shared, in opposite directions, by two of them) crosses the piece: the number of
+  // features over a point is then the same over all of it, and their cells' areas add up to
+  // the piece's once. A new triangle over many small ones of the features is then certified in
+  // one step instead of being split down to their size. Only where the features are triangles
+  // of the surface whose vertices are known (fans_: corners equal to the bit share a vertex).
+  // (Either way round: the piece's corners in the order given, or, where no feature then faces
+  // it, in the other.)
+  bool overlay_holds(const std::array<int32_t, 3>& c) {
+    if (!fans_) return false;
+    const Overlay o = overlay(c);
+    return o == Overlay::Held || (o == Overlay::Bare && overlay({c[0], c[2], c[1]}) == Overlay::Held);
+  }
+  enum class Overlay { Held, Failed, Bare };  // Bare: no feature faces the piece's way over it
+  Overlay overlay(const std::array<int32_t, 3>& c) {
+    const tc_d3 A = pts_[size_t(c[0])], B = pts_[size_t(c[1])], C = pts_[size_t(c[2])];
+    const tc_d3 nn = geo::cross(B - A, C - A);
+    const double ab = std::sqrt(dot(B - A, B - A));
+    if (!(dot(nn, nn) > 0) || !(ab > 0)) return Overlay::Failed;
+    const tc_d3 u = (B - A) * (1 / ab), w = geo::normalize(geo::cross(nn, u));
+    struct P2 {
+      double x, y;
+    };
+    const auto to2 = [&](tc_d3 p) { return P2{dot(p - A, u), dot(p - A, w)}; };
+    const auto cross2 = [](P2 o, P2 a, P2 b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); };
+    const P2 T[3] = {{0, 0}, {ab, 0}, to2(C)};  // counterclockwise: C lies on w's side
+    const double area = 0.5 * cross2(T[0], T[1], T[2]);
+    // the piece's sides as half-planes: inside when side(k, p) >= 0
+    double len[3];
+    for (int k = 0; k < 3; ++k) {
+      const P2 a = T[k], b = T[(k + 1) % 3];
+      len[k] = std::hypot(b.x - a.x, b.y - a.y);
+    }
+    // A free edge may cross into the piece by less than tol from its rim: the points of that
+    // band lie within tol / sin(half the corner's angle) of the rest, which the margin of
+    // change_ok (1e-9 e) covers with room for the rounding of the distances.
+    double s = 1;  // the smallest sin of half a corner's angle
+    for (int k = 0; k < 3; ++k) {
+      const P2 o = T[k], a = T[(k + 1) % 3], b = T[(k + 2) % 3];
+      const double c = ((a.x - o.x) * (b.x - o.x) + (a.y - o.y) * (b.y - o.y)) / (len[k] * len[(k + 2) % 3]);
+      s = std::min(s, std::sqrt(std::max(0.0, 0.5 * (1 - c))));
+    }
+    const double tol = kOverlayTol * s * e_, perimeter = len[0] + len[1] + len[2];
+    if (!(area > 0) || !(tol > 0) || !(tol * perimeter * double(feats_->size()) < 0.1 * area)) return Overlay::Failed;
+    const auto side = [&](int k, P2 p) { return cross2(T[k], T[(k + 1) % 3], p) / len[k]; };
+    edges_.clear();
+    double covered = 0;
+    for (size_t f = 0; f < feats_->size(); ++f) {
+      const Tri& F = *(*feats_)[f];
+      P2 poly[9] = {to2(F[0]), to2(F[1]), to2(F[2])}, next[9];
+      if (!(cross2(poly[0], poly[1], poly[2]) > 0)) continue;  // turned away, or seen edge-on
+      int n = 3;
+      for (int k = 0; k < 3 && n > 0; ++k) {  // Sutherland-Hodgman against side k
+        int m = 0;
+        for (int j = 0; j < n; ++j) {
+          const P2 p = poly[j], q = poly[(j + 1) % n];
+          const double hp = side(k, p), hq = side(k, q);
+          if (hp >= 0) next[m++] = p;
+          if ((hp > 0 && hq < 0) || (hp < 0 && hq > 0)) {
+            const double t = hp / (hp - hq);
+            next[m++] = {p.x + (q.x - p.x) * t, p.y + (q.y - p.y) * t};
+          }
+        }
+        n = m;
+        std::copy(next, next + n, poly);
+      }
+      double a = 0;
+      for (int j = 1; j + 1 < n; ++j) a += 0.5 * cross2(poly[0], poly[j], poly[j + 1]);
+      if (!(a > 0)) continue;  // not over the piece
+      for (int j = 0; j < n; ++j)
+        if (point_triangle_dist2(A + u * poly[j].x + w * poly[j].y, F) > e2_) return Overlay::Failed;
+      covered += a;
+      const std::array<int32_t, 3>& v = fans_->tri_verts(size_t((*feats_)[f] - fans_base_));
+      for (int k = 0; k < 3; ++k) edges_.push_back({v[size_t(k)], v[size_t((k + 1) % 3)], int32_t(f), k});
+    }
+    if (!(covered > 0.25 * area)) return edges_.empty() ? Overlay::Bare : Overlay::Failed;
+    if (!(covered > 0.75 * area && covered < 1.25 * area)) return Overlay::Failed;
+    // the free edges: those not met once each way
+    std::sort(edges_.begin(), edges_.end(), [](const Edge& x, const Edge& y) {
+      return std::min(x.a, x.b) != std::min(y.a, y.b) ? std::min(x.a, x.b) < std::min(y.a, y.b)
+                                                      : std::max(x.a, x.b) < std::max(y.a, y.b);
+    });
+    for (size_t i = 0; i < edges_.size();) {
+      size_t j = i + 1;
+      const auto same = [&](const Edge& x, const Edge& y) {
+        return std::min(x.a, x.b) == std::min(y.a, y.b) && std::max(x.a, x.b) == std::max(y.a, y.b);
+      };
+      while (j < edges_.size() && same(edges_[i], edges_[j])) ++j;
+      const bool shared = j - i == 2 && edges_[i].a == edges_[i + 1].b;
+      for (size_t k = i; k < j && !shared; ++k) {
+        const Tri& F = *(*feats_)[size_t(edges_[k].f)];
+        if (crosses(to2(F[size_t(edges_[k].k)]), to2(F[size_t((edges_[k].k + 1) % 3)]), side, tol)) return Overlay::Failed;
+      }
+      i = j;
+    }
+    return Overlay::Held;
+  }
+
+  // Whether the segment pq has a part inside the piece by more than tol from its rim.
+  template <class Side>
+  static bool crosses(const auto& p, const auto& q, const Side& side, double tol) {
+    double t0 = 0, t1 = 1;
+    for (int k = 0; k < 3; ++k) {
+      const double hp = side(k, p) - tol, hq = side(k, q) - tol;
+      if (hp < 0 && hq < 0) return false;
+      if (hp < 0) t0 = std::max(t0, hp / (hp - hq));
+      else if (hq < 0) t1 = std::min(t1, hp / (hp - hq));
+    }
+    return t0 < t1;
+  }
+  static constexpr double kOverlayTol = 1e-10;  // the band along the rim, a share of e (times s)
+  struct Edge {
+    int32_t a, b, f, k;  // from a to b, side k of feature f
+  };
+  std::vector<Edge> edges_;
 
   const std::vector<const Tri*>* feats_ = nullptr;
   const Fans* fans_ = nullptr;

@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <random>
 #include <string>
@@ -138,6 +140,19 @@ std::vector<const Tri*> all_of(const surface_distance::ReferenceSurface& ref) {
   return f;
 }
 
+// The largest distance to the features over points of the piece on a grid of n steps a side.
+double sampled_distance(const Tri& piece, const std::vector<const Tri*>& feats, int n) {
+  double worst = 0;
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; i + j <= n; ++j) {
+      const tc_d3 q = piece[0] + (piece[1] - piece[0]) * (double(i) / n) + (piece[2] - piece[0]) * (double(j) / n);
+      double d2 = INFINITY;
+      for (const Tri* t : feats) d2 = std::min(d2, surface_distance::point_triangle_dist2(q, *t));
+      worst = std::max(worst, d2);
+    }
+  return std::sqrt(worst);
+}
+
 // Over a vertex of the reference, the wedges around its fan cut a piece into parts, each
 // within e of its own triangle: certified whole (depth 0), which no two triangles do.
 TEST(SurfaceDistance, APieceOverAVertexIsHeldByItsFan) {
@@ -182,16 +197,7 @@ TEST(SurfaceDistance, WhatTheFanCertifiesIsWithinTheBound) {
     if (!surface_distance::within(piece, feats, e * e, depth, nullptr, &ref)) continue;
     ++certified;
     whole += !surface_distance::within(piece, feats, e * e, depth);
-    double worst = 0;
-    const int n = 60;
-    for (int i = 0; i <= n; ++i)
-      for (int j = 0; i + j <= n; ++j) {
-        const tc_d3 q = piece[0] + (piece[1] - piece[0]) * (double(i) / n) + (piece[2] - piece[0]) * (double(j) / n);
-        double d2 = INFINITY;
-        for (const Tri* t : feats) d2 = std::min(d2, surface_distance::point_triangle_dist2(q, *t));
-        worst = std::max(worst, d2);
-      }
-    EXPECT_LE(std::sqrt(worst), e * (1 + 1e-12)) << it;
+    EXPECT_LE(sampled_distance(piece, feats, 60), e * (1 + 1e-12)) << it;
   }
   EXPECT_GT(certified, 50) << "the random pieces test something";
   EXPECT_GT(whole, 25) << "and the fans certify what the splits alone do not";
@@ -215,17 +221,102 @@ TEST(SurfaceDistance, PiecesInAWedgesPlaneAreCutSafely) {
     const double e = 2e-3;
     if (!surface_distance::within(piece, feats, e * e, it % 3, nullptr, &ref)) continue;
     ++certified;
-    double worst = 0;
-    for (int i = 0; i <= 20; ++i)
-      for (int j = 0; i + j <= 20; ++j) {
-        const tc_d3 q = piece[0] + (piece[1] - piece[0]) * (i / 20.0) + (piece[2] - piece[0]) * (j / 20.0);
-        double d2 = INFINITY;
-        for (const Tri* t : feats) d2 = std::min(d2, surface_distance::point_triangle_dist2(q, *t));
-        worst = std::max(worst, d2);
-      }
-    EXPECT_LE(std::sqrt(worst), e * (1 + 1e-12)) << it;
+    EXPECT_LE(sampled_distance(piece, feats, 20), e * (1 + 1e-12)) << it;
   }
   EXPECT_GT(certified, 1000) << "the pieces test something";
+}
+
+// The unit square as a grid of n x n cells, two triangles each (counterclockwise seen from +z),
+// its vertices at the heights z(i, j); without the triangles `skip` lists.
+std::vector<double> grid(int n, const std::function<double(int, int)>& z, const std::vector<int>& skip = {}) {
+  std::vector<double> t;
+  const auto at = [&](int i, int j) { return tc_d3{double(i) / n, double(j) / n, z(i, j)}; };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const tc_d3 tris[2][3] = {{at(i, j), at(i + 1, j), at(i + 1, j + 1)}, {at(i, j), at(i + 1, j + 1), at(i, j + 1)}};
+      for (int k = 0; k < 2; ++k) {
+        if (std::find(skip.begin(), skip.end(), 2 * (i * n + j) + k) != skip.end()) continue;
+        for (const tc_d3& v : tris[k]) t.insert(t.end(), {v.x, v.y, v.z});
+      }
+    }
+  return t;
+}
+
+// A piece over many triangles of the reference, each far smaller than it, is cut by their
+// outlines into parts each within e of its own triangle: certified whole (depth 0), which
+// neither two triangles nor one fan do; not where a triangle under it is missing (its middle
+// farther than e from the rest) or a vertex under it stands too high.
+TEST(SurfaceDistance, APieceOverManyTrianglesIsCutByTheirOutlines) {
+  const double e = 0.01;
+  const auto flat = [](int, int) { return 0.0; };
+  const Tri piece{tc_d3{0.1, 0.12, 0.5 * e}, tc_d3{0.9, 0.2, 0.3 * e}, tc_d3{0.4, 0.85, 0.6 * e}};
+  const surface_distance::ReferenceSurface ref(grid(10, flat));
+  const std::vector<const Tri*> feats = all_of(ref);
+  EXPECT_TRUE(surface_distance::within(piece, feats, e * e, 0, nullptr, &ref));
+  EXPECT_FALSE(surface_distance::within(piece, feats, e * e, 0)) << "not without the reference's vertices";
+  // turned over: the same cut, the triangles' orientation seen from the piece reversed
+  const Tri turned{piece[0], piece[2], piece[1]};
+  EXPECT_TRUE(surface_distance::within(turned, feats, e * e, 0, nullptr, &ref));
+  // cell (4, 4)'s first triangle missing: its middle is 0.03 from the others
+  const surface_distance::ReferenceSurface holed(grid(10, flat, {2 * 44}));
+  EXPECT_FALSE(surface_distance::within(piece, all_of(holed), e * e, 0, nullptr, &holed));
+  EXPECT_FALSE(surface_distance::within(piece, all_of(holed), e * e, 8, nullptr, &holed));
+  // a vertex under the piece 2e high
+  const surface_distance::ReferenceSurface peak(grid(10, [](int i, int j) { return i == 5 && j == 4 ? 0.02 : 0.0; }));
+  EXPECT_FALSE(surface_distance::within(piece, all_of(peak), e * e, 0, nullptr, &peak));
+  // two sheets under the piece (the grid twice, 0.5 e apart): each point is over two triangles,
+  // which the cut does not count as a cover (the splits may certify it)
+  std::vector<double> two = grid(10, flat), upper = grid(10, [&](int, int) { return 0.5 * e; });
+  two.insert(two.end(), upper.begin(), upper.end());
+  const surface_distance::ReferenceSurface sheets(two);
+  EXPECT_FALSE(surface_distance::within(piece, all_of(sheets), e * e, 0, nullptr, &sheets));
+  // a patch whose rim is the piece's (the triangles of a grid inside x + y <= 1, under the
+  // piece over the same triangle): its free edges lie on the piece's sides, which they do not cross
+  std::vector<double> half;
+  const int n = 8;
+  const auto at = [&](int i, int j) { return tc_d3{double(i) / n, double(j) / n, 0.0}; };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; i + j < n; ++j) {
+      std::vector<std::array<tc_d3, 3>> tris = {{at(i, j), at(i + 1, j), at(i, j + 1)}};
+      if (i + j + 2 <= n) tris.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+      for (const auto& t : tris)
+        for (const tc_d3& v : t) half.insert(half.end(), {v.x, v.y, v.z});
+    }
+  const surface_distance::ReferenceSurface patch(half);
+  const Tri over{tc_d3{0, 0, 0.5 * e}, tc_d3{1, 0, 0.5 * e}, tc_d3{0, 1, 0.5 * e}};
+  EXPECT_TRUE(surface_distance::within(over, all_of(patch), e * e, 0, nullptr, &patch));
+  // and one reaching past it by 2e: not held
+  const Tri past{tc_d3{0, 0, 0}, tc_d3{1 + 2 * e, 0, 0}, tc_d3{0, 1, 0}};
+  EXPECT_FALSE(surface_distance::within(past, all_of(patch), e * e, 0, nullptr, &patch));
+}
+
+// Sound on bumpy and folded grids and tilted pieces: whatever within() certifies with the
+// reference's vertices, every point of the piece, densely sampled, lies within e of it.
+TEST(SurfaceDistance, WhatTheOutlinesCertifyIsWithinTheBound) {
+  std::mt19937 g(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int certified = 0, whole = 0;
+  for (int it = 0; it < 400; ++it) {
+    const double e = 0.005 + 0.01 * (u(g) + 1);
+    // heights up to 0.3 e on most grids; some up to 10 e (folded as the tilted piece sees them)
+    const double amp = (it % 4 == 0 ? 10 : 0.3) * e;
+    std::vector<double> h(13 * 13);
+    for (double& x : h) x = amp * u(g);
+    const std::vector<int> skip = it % 5 == 0 ? std::vector<int>{int(g() % 288)} : std::vector<int>{};
+    const surface_distance::ReferenceSurface ref(grid(12, [&](int i, int j) { return h[size_t(13 * i + j)]; }, skip));
+    const std::vector<const Tri*> feats = all_of(ref);
+    const auto corner = [&] {
+      return tc_d3{0.5 + 0.45 * u(g), 0.5 + 0.45 * u(g), (it % 3 == 0 ? 0.1 : 1.2 * e) * u(g)};
+    };
+    const Tri piece{corner(), corner(), corner()};
+    const int depth = it % 2;
+    if (!surface_distance::within(piece, feats, e * e, depth, nullptr, &ref)) continue;
+    ++certified;
+    whole += !surface_distance::within(piece, feats, e * e, depth);
+    EXPECT_LE(sampled_distance(piece, feats, 50), e * (1 + 1e-12)) << it;
+  }
+  EXPECT_GT(certified, 40) << "the random pieces test something";
+  EXPECT_GT(whole, 20) << "and the outlines certify what the splits alone do not";
 }
 
 // A tent of height h over the unit square's centre (four triangles) as the reference and as S;
