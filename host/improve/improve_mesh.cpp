@@ -385,6 +385,9 @@ void ImpMesh::surface_moved(int32_t v) {
 }
 
 int32_t ImpMesh::across(int32_t t, int32_t a, int32_t b, int32_t c) const {
+  // (through the shortest of the three vertices' lists: a tet with the face is in each)
+  if (vtets_[size_t(b)].size() < vtets_[size_t(a)].size()) std::swap(a, b);
+  if (vtets_[size_t(c)].size() < vtets_[size_t(a)].size()) std::swap(a, c);
   for (int32_t s : vtets_[size_t(a)]) {
     if (s == t) continue;
     if (contains(tets_[size_t(s)], b) && contains(tets_[size_t(s)], c)) return s;
