@@ -527,7 +527,8 @@ class Pieces {
       const bool shared = j - i == 2 && edges_[i].a == edges_[i + 1].b;
       for (size_t k = i; k < j && !shared; ++k) {
         const Tri& F = *(*feats_)[size_t(edges_[k].f)];
-        if (crosses(to2(F[size_t(edges_[k].k)]), to2(F[size_t((edges_[k].k + 1) % 3)]), side, tol)) return Overlay::Failed;
+        if (crosses(to2(F[size_t(edges_[k].k)]), to2(F[size_t((edges_[k].k + 1) % 3)]), side, tol))
+          return Overlay::Failed;
       }
       i = j;
     }
