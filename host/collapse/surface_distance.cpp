@@ -407,24 +407,10 @@ class Pieces {
     for (int32_t i = 0; i < f.k; ++i) {
       const tc_d3 ms = next;
       next = side(i + 1);
-      // Sutherland-Hodgman: the part on m's positive side. Each clip adds a point per edge that
-      // changes side: one triangle gives at most 4 points, and 4 give at most 6 when rounding
-      // alternates their sides (a polygon nearly in the plane), so 8 hold both clips.
-      constexpr int kPoly = 8;
-      tc_d3 a[kPoly] = {P[0], P[1], P[2]}, r[kPoly];
+      tc_d3 a[kPoly] = {P[0], P[1], P[2]};
       int na = 3;
-      for (const tc_d3& m : {ms, next * -1.0}) {
-        int nr = 0;
-        for (int j = 0; j < na; ++j) {
-          if (nr + 2 > kPoly) return false;  // (never: see above; not certified rather than overrun)
-          const tc_d3 p = a[j], q = a[(j + 1) % na];
-          const double hp = dot(p - f.o, m), hq = dot(q - f.o, m);
-          if (hp >= 0) r[nr++] = p;
-          if ((hp > 0 && hq < 0) || (hp < 0 && hq > 0)) r[nr++] = p + (q - p) * (hp / (hp - hq));
-        }
-        na = nr;
-        std::copy(r, r + nr, a);
-      }
+      for (const tc_d3& m : {ms, next * -1.0})
+        if ((na = clip(a, na, [&](tc_d3 x) { return dot(x - f.o, m); })) < 0) return false;
       const Tri& t = fans_base_[f.tri[i]];
       for (int j = 0; j < na; ++j)
         if (point_triangle_dist2(a[j], t) > e2_) return false;
@@ -432,6 +418,27 @@ class Pieces {
     return true;
   }
   tc_d3 fan_vertex(int32_t u) const { return fans_->vertex(u); }
+
+  // Sutherland-Hodgman: polygon a[0..n) replaced by its part where h (a signed distance to a
+  // plane) is >= 0; returns its corners, or -1 where they might not fit in kPoly (not certified
+  // rather than overrun). Each clip adds a point per edge that changes side: a triangle clipped
+  // by two planes keeps at most 5 corners, by three at most 6, more only where rounding
+  // alternates the corners' sides (a polygon nearly in the plane), within 8.
+  static constexpr int kPoly = 8;
+  template <class H>
+  static int clip(tc_d3 (&a)[kPoly], int n, const H& h) {
+    tc_d3 r[kPoly];
+    int m = 0;
+    for (int j = 0; j < n; ++j) {
+      if (m + 2 > kPoly) return -1;
+      const tc_d3 p = a[j], q = a[(j + 1) % n];
+      const double hp = h(p), hq = h(q);
+      if (hp >= 0) r[m++] = p;
+      if ((hp > 0 && hq < 0) || (hp < 0 && hq > 0)) r[m++] = p + (q - p) * (hp / (hp - hq));
+    }
+    std::copy(r, r + m, a);
+    return m;
+  }
 
   // Whether the features seen from the piece cut it into cells, each within e of its own
   // feature: the features projected onto the piece's plane that keep their orientation (the
@@ -456,17 +463,15 @@ class Pieces {
     const double ab = std::sqrt(dot(B - A, B - A));
     if (!(dot(nn, nn) > 0) || !(ab > 0)) return Overlay::Failed;
     const tc_d3 u = (B - A) * (1 / ab), w = geo::normalize(geo::cross(nn, u));
-    struct P2 {
-      double x, y;
-    };
-    const auto to2 = [&](tc_d3 p) { return P2{dot(p - A, u), dot(p - A, w)}; };
-    const auto cross2 = [](P2 o, P2 a, P2 b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); };
-    const P2 T[3] = {{0, 0}, {ab, 0}, to2(C)};  // counterclockwise: C lies on w's side
+    // (in the piece's plane: x along u, y along w, z 0)
+    const auto to2 = [&](tc_d3 p) { return tc_d3{dot(p - A, u), dot(p - A, w), 0}; };
+    const auto cross2 = [](tc_d3 o, tc_d3 a, tc_d3 b) { return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x); };
+    const tc_d3 T[3] = {{0, 0, 0}, {ab, 0, 0}, to2(C)};  // counterclockwise: C lies on w's side
     const double area = 0.5 * cross2(T[0], T[1], T[2]);
     // the piece's sides as half-planes: inside when side(k, p) >= 0
     double len[3];
     for (int k = 0; k < 3; ++k) {
-      const P2 a = T[k], b = T[(k + 1) % 3];
+      const tc_d3 a = T[k], b = T[(k + 1) % 3];
       len[k] = std::hypot(b.x - a.x, b.y - a.y);
     }
     // A free edge may cross into the piece by less than tol from its rim: the points of that
@@ -474,34 +479,22 @@ class Pieces {
     // change_ok (1e-9 e) covers with room for the rounding of the distances.
     double s = 1;  // the smallest sin of half a corner's angle
     for (int k = 0; k < 3; ++k) {
-      const P2 o = T[k], a = T[(k + 1) % 3], b = T[(k + 2) % 3];
+      const tc_d3 o = T[k], a = T[(k + 1) % 3], b = T[(k + 2) % 3];
       const double c = ((a.x - o.x) * (b.x - o.x) + (a.y - o.y) * (b.y - o.y)) / (len[k] * len[(k + 2) % 3]);
       s = std::min(s, std::sqrt(std::max(0.0, 0.5 * (1 - c))));
     }
     const double tol = kOverlayTol * s * e_, perimeter = len[0] + len[1] + len[2];
     if (!(area > 0) || !(tol > 0) || !(tol * perimeter * double(feats_->size()) < 0.1 * area)) return Overlay::Failed;
-    const auto side = [&](int k, P2 p) { return cross2(T[k], T[(k + 1) % 3], p) / len[k]; };
+    const auto side = [&](int k, tc_d3 p) { return cross2(T[k], T[(k + 1) % 3], p) / len[k]; };
     edges_.clear();
     double covered = 0;
     for (size_t f = 0; f < feats_->size(); ++f) {
       const Tri& F = *(*feats_)[f];
-      P2 poly[9] = {to2(F[0]), to2(F[1]), to2(F[2])}, next[9];
+      tc_d3 poly[kPoly] = {to2(F[0]), to2(F[1]), to2(F[2])};
       if (!(cross2(poly[0], poly[1], poly[2]) > 0)) continue;  // turned away, or seen edge-on
       int n = 3;
-      for (int k = 0; k < 3 && n > 0; ++k) {  // Sutherland-Hodgman against side k
-        int m = 0;
-        for (int j = 0; j < n; ++j) {
-          const P2 p = poly[j], q = poly[(j + 1) % n];
-          const double hp = side(k, p), hq = side(k, q);
-          if (hp >= 0) next[m++] = p;
-          if ((hp > 0 && hq < 0) || (hp < 0 && hq > 0)) {
-            const double t = hp / (hp - hq);
-            next[m++] = {p.x + (q.x - p.x) * t, p.y + (q.y - p.y) * t};
-          }
-        }
-        n = m;
-        std::copy(next, next + n, poly);
-      }
+      for (int k = 0; k < 3 && n > 0; ++k)
+        if ((n = clip(poly, n, [&](tc_d3 x) { return side(k, x); })) < 0) return Overlay::Failed;
       double a = 0;
       for (int j = 1; j + 1 < n; ++j) a += 0.5 * cross2(poly[0], poly[j], poly[j + 1]);
       if (!(a > 0)) continue;  // not over the piece
