@@ -502,21 +502,18 @@ class Pieces {
         if (point_triangle_dist2(A + u * poly[j].x + w * poly[j].y, F) > e2_) return Overlay::Failed;
       covered += a;
       const std::array<int32_t, 3>& v = fans_->tri_verts(size_t((*feats_)[f] - fans_base_));
-      for (int k = 0; k < 3; ++k) edges_.push_back({v[size_t(k)], v[size_t((k + 1) % 3)], int32_t(f), k});
+      for (int k = 0; k < 3; ++k) {
+        const int32_t a = v[size_t(k)], b = v[size_t((k + 1) % 3)];
+        edges_.push_back({a, b, int32_t(f), k, uint64_t(uint32_t(std::min(a, b))) << 32 | uint32_t(std::max(a, b))});
+      }
     }
     if (!(covered > 0.25 * area)) return edges_.empty() ? Overlay::Bare : Overlay::Failed;
     if (!(covered > 0.75 * area && covered < 1.25 * area)) return Overlay::Failed;
     // the free edges: those not met once each way
-    std::sort(edges_.begin(), edges_.end(), [](const Edge& x, const Edge& y) {
-      return std::min(x.a, x.b) != std::min(y.a, y.b) ? std::min(x.a, x.b) < std::min(y.a, y.b)
-                                                      : std::max(x.a, x.b) < std::max(y.a, y.b);
-    });
+    std::sort(edges_.begin(), edges_.end(), [](const Edge& x, const Edge& y) { return x.key < y.key; });
     for (size_t i = 0; i < edges_.size();) {
       size_t j = i + 1;
-      const auto same = [&](const Edge& x, const Edge& y) {
-        return std::min(x.a, x.b) == std::min(y.a, y.b) && std::max(x.a, x.b) == std::max(y.a, y.b);
-      };
-      while (j < edges_.size() && same(edges_[i], edges_[j])) ++j;
+      while (j < edges_.size() && edges_[j].key == edges_[i].key) ++j;
       const bool shared = j - i == 2 && edges_[i].a == edges_[i + 1].b;
       for (size_t k = i; k < j && !shared; ++k) {
         const Tri& F = *(*feats_)[size_t(edges_[k].f)];
@@ -543,6 +540,7 @@ class Pieces {
   static constexpr double kOverlayTol = 1e-10;  // the band along the rim, a share of e (times s)
   struct Edge {
     int32_t a, b, f, k;  // from a to b, side k of feature f
+    uint64_t key;        // the smaller end, then the larger: the same both ways
   };
   std::vector<Edge> edges_;
 
